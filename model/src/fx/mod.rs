@@ -1,0 +1,140 @@
+//! The fixed-point core: runtime formats, exact arithmetic, and declared quantization points.
+//!
+//! Arithmetic is exact until a declared quantization point (SPEC §2): [`Fx::add`] grows one
+//! bit, [`Fx::mul`] adds widths, and only [`Fx::quantize`] / [`Quantizer::apply`] round (six
+//! [`Rounding`] modes) and wrap or saturate ([`Overflow`]). Codes are carried in `i128`, so
+//! every intermediate up to 128 bits is exact; plans refuse anything wider.
+//!
+//! Rounding every mode applies, to an integer (`frac = 0`), as the RTL does:
+//!
+//! | value | floor | ceil | zero | nearest | round | convergent |
+//! |------:|------:|-----:|-----:|--------:|------:|-----------:|
+//! |   2.2 |     2 |    3 |    2 |       2 |     2 |          2 |
+//! |   2.7 |     2 |    3 |    2 |       3 |     3 |          3 |
+//! |  −1.5 |    −2 |   −1 |   −1 |      −1 |    −2 |         −2 |
+//! |  −0.5 |    −1 |    0 |    0 |       0 |    −1 |          0 |
+//! |   0.5 |     0 |    1 |    0 |       1 |     1 |          0 |
+//! |   1.5 |     1 |    2 |    1 |       2 |     2 |          2 |
+
+mod format;
+mod quantize;
+
+pub use format::{Format, MAX_DECLARED_WIDTH, MAX_INTERMEDIATE_WIDTH};
+pub use quantize::{from_f64, requantize, Overflow, Quantized, Quantizer, Rounding};
+
+/// Errors of the fixed-point core. Each names the offending value and what is allowed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FxError {
+    /// A declared width outside 1..=64.
+    #[error("width {width} is not allowed: a format's width must be 1..={max} bits")]
+    Width {
+        /// The width given.
+        width: u32,
+        /// The largest allowed.
+        max: u32,
+    },
+    /// An exact intermediate that would not fit the model's 128-bit carrier.
+    #[error("an exact intermediate would need {width} bits; at most {max} are supported: narrow the operand formats")]
+    IntermediateWidth {
+        /// The width needed.
+        width: u32,
+        /// The largest supported.
+        max: u32,
+    },
+    /// A format string that does not parse.
+    #[error("'{text}' is not a fixed-point format: expected s<width>.<frac> or u<width>.<frac>, e.g. s18.16 or u12.12")]
+    Parse {
+        /// The text given.
+        text: String,
+    },
+    /// An unknown rounding-mode name.
+    #[error("'{text}' is not a rounding mode: expected one of floor, ceil, zero, nearest, round, convergent")]
+    RoundingName {
+        /// The text given.
+        text: String,
+    },
+    /// An unknown overflow-mode name.
+    #[error("'{text}' is not an overflow mode: expected wrap or saturate")]
+    OverflowName {
+        /// The text given.
+        text: String,
+    },
+    /// NaN or infinity where a real value is quantized.
+    #[error("{value} cannot be quantized: only finite values have a fixed-point code")]
+    NotFinite {
+        /// The value given.
+        value: f64,
+    },
+}
+
+/// `2^exp` as f64, exact for -1074 <= exp <= 1023 (pure bit construction: no libm).
+pub fn pow2(exp: i32) -> f64 {
+    libm::ldexp(1.0, exp)
+}
+
+/// A code together with its format: the exact-arithmetic view of a fixed-point value.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Fx {
+    /// The integer code; the value is `code · 2^-format.frac`.
+    pub code: i128,
+    /// Its format.
+    pub format: Format,
+}
+
+impl Fx {
+    /// A value from its code. Debug builds check that the code fits.
+    pub fn new(code: i128, format: Format) -> Self {
+        debug_assert!(format.contains(code), "code {code} does not fit {format}");
+        Fx { code, format }
+    }
+
+    /// The real value (see [`Format::to_f64`]).
+    pub fn to_f64(self) -> f64 {
+        self.format.to_f64(self.code)
+    }
+
+    fn aligned(self, frac: i32) -> i128 {
+        self.code << (frac - self.format.frac)
+    }
+
+    /// Exact sum: format from [`Format::sum`].
+    ///
+    /// # Errors
+    /// [`FxError::IntermediateWidth`] when the sum would exceed 128 bits.
+    pub fn add(self, other: Fx) -> Result<Fx, FxError> {
+        let format = Format::sum(self.format, other.format, false)?;
+        Ok(Fx::new(
+            self.aligned(format.frac) + other.aligned(format.frac),
+            format,
+        ))
+    }
+
+    /// Exact difference: format from [`Format::sum`] (always signed).
+    ///
+    /// # Errors
+    /// [`FxError::IntermediateWidth`] when the difference would exceed 128 bits.
+    pub fn sub(self, other: Fx) -> Result<Fx, FxError> {
+        let format = Format::sum(self.format, other.format, true)?;
+        Ok(Fx::new(
+            self.aligned(format.frac) - other.aligned(format.frac),
+            format,
+        ))
+    }
+
+    /// Exact product: format from [`Format::product`].
+    ///
+    /// # Errors
+    /// [`FxError::IntermediateWidth`] when the product would exceed 128 bits.
+    pub fn mul(self, other: Fx) -> Result<Fx, FxError> {
+        let format = Format::product(self.format, other.format)?;
+        Ok(Fx::new(self.code * other.code, format))
+    }
+
+    /// Rounds with `rounding` and wraps or saturates with `overflow` into `to`.
+    pub fn quantize(self, to: Format, rounding: Rounding, overflow: Overflow) -> Quantized {
+        requantize(self.code, self.format.frac, to, rounding, overflow)
+    }
+}
+
+#[cfg(test)]
+mod tests;

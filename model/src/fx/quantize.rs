@@ -1,0 +1,393 @@
+//! Quantization: rounding and overflow handling at a declared point.
+
+use std::fmt;
+use std::str::FromStr;
+
+use super::{pow2, Format, FxError};
+
+/// How dropped fraction bits are rounded, exactly as the RTL implements each mode.
+///
+/// | value | floor | ceil | zero | nearest | round | convergent |
+/// |------:|------:|-----:|-----:|--------:|------:|-----------:|
+/// |   2.2 |     2 |    3 |    2 |       2 |     2 |          2 |
+/// |   2.7 |     2 |    3 |    2 |       3 |     3 |          3 |
+/// |  −1.5 |    −2 |   −1 |   −1 |      −1 |    −2 |         −2 |
+/// |  −0.5 |    −1 |    0 |    0 |       0 |    −1 |          0 |
+/// |   0.5 |     0 |    1 |    0 |       1 |     1 |          0 |
+/// |   1.5 |     1 |    2 |    1 |       2 |     2 |          2 |
+///
+/// (Rounding to an integer, i.e. into a format with `frac = 0`; the table is a unit test.)
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Rounding {
+    /// Drop the bits: toward −∞ (two's-complement truncation). No adder in hardware.
+    Floor,
+    /// Toward +∞.
+    Ceil,
+    /// Toward zero (sign-magnitude truncation).
+    Zero,
+    /// Nearest, ties toward +∞: add half an LSB, then floor. The cheap hardware rounding.
+    Nearest,
+    /// Nearest, ties away from zero (MATLAB `round`).
+    Round,
+    /// Nearest, ties to even (unbiased; MATLAB `convergent`).
+    Convergent,
+}
+
+impl Rounding {
+    /// All modes, in the order of the table above.
+    pub const ALL: [Rounding; 6] = [
+        Rounding::Floor,
+        Rounding::Ceil,
+        Rounding::Zero,
+        Rounding::Nearest,
+        Rounding::Round,
+        Rounding::Convergent,
+    ];
+
+    /// Config and RTL name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Rounding::Floor => "floor",
+            Rounding::Ceil => "ceil",
+            Rounding::Zero => "zero",
+            Rounding::Nearest => "nearest",
+            Rounding::Round => "round",
+            Rounding::Convergent => "convergent",
+        }
+    }
+
+    /// Integer code of the mode as the RTL's `ROUNDING` parameter takes it.
+    pub fn rtl_code(self) -> u32 {
+        match self {
+            Rounding::Floor => 0,
+            Rounding::Ceil => 1,
+            Rounding::Zero => 2,
+            Rounding::Nearest => 3,
+            Rounding::Round => 4,
+            Rounding::Convergent => 5,
+        }
+    }
+
+    /// Largest rounding error, in LSB of the target: 1 (exclusive) for the directed modes,
+    /// 1/2 for the round-to-nearest family.
+    pub fn max_error_lsb(self) -> f64 {
+        match self {
+            Rounding::Floor | Rounding::Ceil | Rounding::Zero => 1.0,
+            Rounding::Nearest | Rounding::Round | Rounding::Convergent => 0.5,
+        }
+    }
+
+    /// Whether to add one LSB to `floor(value / 2^shift)`, given the dropped `remainder`
+    /// (`0 <= remainder < 2^shift`), `half = 2^(shift-1)` (0 when shift is 0, where nothing is
+    /// dropped), the sign of the value and the parity of the floored quotient.
+    #[inline(always)]
+    fn increment(self, remainder: i128, half: i128, negative: bool, quotient_odd: bool) -> bool {
+        if remainder == 0 {
+            return false;
+        }
+        match self {
+            Rounding::Floor => false,
+            Rounding::Ceil => true,
+            Rounding::Zero => negative,
+            Rounding::Nearest => remainder >= half,
+            Rounding::Round => remainder > half || (remainder == half && !negative),
+            Rounding::Convergent => remainder > half || (remainder == half && quotient_odd),
+        }
+    }
+}
+
+impl fmt::Display for Rounding {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Rounding {
+    type Err = FxError;
+    fn from_str(text: &str) -> Result<Self, FxError> {
+        Rounding::ALL
+            .into_iter()
+            .find(|r| r.name() == text)
+            .ok_or_else(|| FxError::RoundingName {
+                text: text.to_string(),
+            })
+    }
+}
+
+/// What happens to a value outside the target format's range.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Overflow {
+    /// Keep the low `width` bits (two's-complement wrap-around).
+    Wrap,
+    /// Clamp to the nearest representable code.
+    Saturate,
+}
+
+impl Overflow {
+    /// Both modes.
+    pub const ALL: [Overflow; 2] = [Overflow::Wrap, Overflow::Saturate];
+
+    /// Config name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Overflow::Wrap => "wrap",
+            Overflow::Saturate => "saturate",
+        }
+    }
+
+    /// Integer code of the mode as the RTL's `SATURATE` parameter takes it.
+    pub fn rtl_code(self) -> u32 {
+        match self {
+            Overflow::Wrap => 0,
+            Overflow::Saturate => 1,
+        }
+    }
+}
+
+impl fmt::Display for Overflow {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Overflow {
+    type Err = FxError;
+    fn from_str(text: &str) -> Result<Self, FxError> {
+        Overflow::ALL
+            .into_iter()
+            .find(|o| o.name() == text)
+            .ok_or_else(|| FxError::OverflowName {
+                text: text.to_string(),
+            })
+    }
+}
+
+/// Result of one quantization: the code, and whether the rounded value lay outside the
+/// target range (and so was wrapped or saturated).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Quantized {
+    /// The code in the target format.
+    pub code: i128,
+    /// The rounded value did not fit the target format.
+    pub overflowed: bool,
+}
+
+/// Re-quantizes `code` (with `from_frac` fractional bits) into `to`: rounds the dropped bits
+/// with `rounding`, then wraps or saturates with `overflow`. Exact when no bits are dropped
+/// and the value fits.
+///
+/// # Example
+/// ```
+/// use gyrofx_model::fx::{requantize, Format, Overflow, Rounding};
+/// let to: Format = "s8.1".parse().unwrap();
+/// // 1.25 (code 5 at 2 fraction bits) -> 1.5 under `nearest` (a tie, rounded toward +inf)
+/// let q = requantize(5, 2, to, Rounding::Nearest, Overflow::Saturate);
+/// assert_eq!(q.code, 3);
+/// ```
+#[inline(always)]
+pub fn requantize(
+    code: i128,
+    from_frac: i32,
+    to: Format,
+    rounding: Rounding,
+    overflow: Overflow,
+) -> Quantized {
+    let shift = from_frac - to.frac;
+    let (rounded, shift_overflow) = if shift > 0 {
+        round_shift_right(code, shift as u32, rounding)
+    } else {
+        let left = (-shift) as u32;
+        if left >= 128 {
+            (0, code != 0)
+        } else {
+            let shifted = code << left;
+            (shifted, (shifted >> left) != code)
+        }
+    };
+    finish_overflow(rounded, shift_overflow, code < 0, to, overflow)
+}
+
+/// `value / 2^shift` rounded with `rounding` (shift >= 1). Never overflows: the increment is
+/// applied to the already shifted quotient.
+#[inline(always)]
+fn round_shift_right(value: i128, shift: u32, rounding: Rounding) -> (i128, bool) {
+    if shift >= 128 {
+        // |value / 2^shift| <= 1/2, with equality only for i128::MIN at shift 128.
+        let exact_negative_half = shift == 128 && value == i128::MIN;
+        let code = match rounding {
+            Rounding::Floor => -i128::from(value < 0),
+            Rounding::Ceil => i128::from(value > 0),
+            Rounding::Zero | Rounding::Nearest | Rounding::Convergent => 0,
+            Rounding::Round => -i128::from(exact_negative_half),
+        };
+        return (code, false);
+    }
+    let quotient = value >> shift;
+    let remainder = value & (i128::MAX >> (127 - shift));
+    let half = 1i128 << (shift - 1);
+    let up = rounding.increment(remainder, half, value < 0, quotient & 1 == 1);
+    (quotient + i128::from(up), false)
+}
+
+#[inline(always)]
+fn finish_overflow(
+    rounded: i128,
+    shift_overflow: bool,
+    negative: bool,
+    to: Format,
+    overflow: Overflow,
+) -> Quantized {
+    if !shift_overflow && to.contains(rounded) {
+        return Quantized {
+            code: rounded,
+            overflowed: false,
+        };
+    }
+    let code = match overflow {
+        Overflow::Wrap => to.wrap(rounded),
+        Overflow::Saturate => {
+            let too_low = if shift_overflow {
+                negative
+            } else {
+                rounded < to.min_code()
+            };
+            if too_low {
+                to.min_code()
+            } else {
+                to.max_code()
+            }
+        }
+    };
+    Quantized {
+        code,
+        overflowed: true,
+    }
+}
+
+/// Quantizes a real value into `to`, rounding with `rounding` and wrapping or saturating with
+/// `overflow`. Scaling by `2^frac` is exact in f64, so the only rounding is the declared one.
+///
+/// # Errors
+/// [`FxError::NotFinite`] for NaN or ±∞.
+///
+/// # Example
+/// ```
+/// use gyrofx_model::fx::{from_f64, Format, Overflow, Rounding};
+/// let f: Format = "s8.1".parse().unwrap();
+/// assert_eq!(from_f64(-1.25, f, Rounding::Nearest, Overflow::Saturate).unwrap().code, -2);
+/// assert_eq!(from_f64(1.25, f, Rounding::Nearest, Overflow::Saturate).unwrap().code, 3);
+/// ```
+pub fn from_f64(
+    value: f64,
+    to: Format,
+    rounding: Rounding,
+    overflow: Overflow,
+) -> Result<Quantized, FxError> {
+    if !value.is_finite() {
+        return Err(FxError::NotFinite { value });
+    }
+    let scaled = scale_by_pow2(value, to.frac);
+    let floor = scaled.floor();
+    let remainder = scaled - floor; // exact: both are f64 with the same exponent range
+    let negative = scaled < 0.0;
+    let quotient_odd = (floor % 2.0).abs() == 1.0;
+    let up = if remainder == 0.0 {
+        false
+    } else {
+        match rounding {
+            Rounding::Floor => false,
+            Rounding::Ceil => true,
+            Rounding::Zero => negative,
+            Rounding::Nearest => remainder >= 0.5,
+            Rounding::Round => remainder > 0.5 || (remainder == 0.5 && !negative),
+            Rounding::Convergent => remainder > 0.5 || (remainder == 0.5 && quotient_odd),
+        }
+    };
+    let rounded = floor + if up { 1.0 } else { 0.0 };
+    // 2^127 is exactly representable; anything at or beyond it cannot fit any format.
+    let limit = pow2(127);
+    if rounded >= limit || rounded < -limit {
+        let sat = finish_overflow(0, true, negative, to, Overflow::Saturate);
+        let code = match overflow {
+            Overflow::Saturate => sat.code,
+            // Beyond i128 the low bits of an f64 integer are zeros.
+            Overflow::Wrap => 0,
+        };
+        return Ok(Quantized {
+            code,
+            overflowed: true,
+        });
+    }
+    Ok(finish_overflow(
+        rounded as i128,
+        false,
+        negative,
+        to,
+        overflow,
+    ))
+}
+
+/// `value · 2^exp`, exact unless the result leaves the normal f64 range.
+fn scale_by_pow2(value: f64, exp: i32) -> f64 {
+    // Split large exponents so that each factor is a normal power of two.
+    let mut result = value;
+    let mut remaining = exp;
+    while remaining != 0 {
+        let step = remaining.clamp(-1000, 1000);
+        result *= pow2(step);
+        remaining -= step;
+    }
+    result
+}
+
+/// A declared quantization point: a fixed source fraction, a target format and modes, and a
+/// count of the values that overflowed there (wrapped or saturated), like a logging fimath.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Quantizer {
+    /// Fraction bits of the values that arrive here.
+    pub from_frac: i32,
+    /// Target format.
+    pub to: Format,
+    /// Rounding of the dropped bits.
+    pub rounding: Rounding,
+    /// Handling of out-of-range values.
+    pub overflow: Overflow,
+    /// Values that did not fit `to` since construction or the last [`Quantizer::clear_count`].
+    pub overflow_count: u64,
+}
+
+impl Quantizer {
+    /// A quantization point from `from_frac` fraction bits into `to`.
+    pub fn new(from_frac: i32, to: Format, rounding: Rounding, overflow: Overflow) -> Self {
+        Quantizer {
+            from_frac,
+            to,
+            rounding,
+            overflow,
+            overflow_count: 0,
+        }
+    }
+
+    /// Quantizes one value (see [`requantize`]) and counts an overflow.
+    #[inline(always)]
+    pub fn apply(&mut self, code: i128) -> i128 {
+        let q = requantize(code, self.from_frac, self.to, self.rounding, self.overflow);
+        self.overflow_count += u64::from(q.overflowed);
+        q.code
+    }
+
+    /// Whether the dropped bits of `code` are exactly half an LSB of the target: the case
+    /// where the round-to-nearest modes differ.
+    pub fn is_tie(&self, code: i128) -> bool {
+        let shift = self.from_frac - self.to.frac;
+        if shift <= 0 || shift >= 128 {
+            return false;
+        }
+        code & (i128::MAX >> (127 - shift)) == 1i128 << (shift - 1)
+    }
+
+    /// Resets the overflow count.
+    pub fn clear_count(&mut self) {
+        self.overflow_count = 0;
+    }
+}

@@ -1,0 +1,8 @@
+//! gyrofx-model: the bit-accurate fixed-point core, the float golden models beside it, and
+//! the offline design algebra of the gyro signal chain.
+//!
+//! Data flows one way: a config is resolved into a *plan* (every node's format, every ROM's
+//! contents), and both the models here and the writers in `gyrofx-codegen` read that plan.
+#![warn(missing_docs)]
+
+pub mod fx;
