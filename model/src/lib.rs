@@ -6,3 +6,5 @@
 #![warn(missing_docs)]
 
 pub mod fx;
+pub mod kf;
+pub mod stimulus;

@@ -1,7 +1,7 @@
 //! The fixed-point core: runtime formats, exact arithmetic, and declared quantization points.
 //!
-//! Arithmetic is exact until a declared quantization point (SPEC §2): [`Fx::add`] grows one
-//! bit, [`Fx::mul`] adds widths, and only [`Fx::quantize`] / [`Quantizer::apply`] round (six
+//! Arithmetic is exact until a declared quantization point (SPEC §2): [`Fx::exact_add`] grows one
+//! bit, [`Fx::exact_mul`] adds widths, and only [`Fx::quantize`] / [`Quantizer::apply`] round (six
 //! [`Rounding`] modes) and wrap or saturate ([`Overflow`]). Codes are carried in `i128`, so
 //! every intermediate up to 128 bits is exact; plans refuse anything wider.
 //!
@@ -101,7 +101,7 @@ impl Fx {
     ///
     /// # Errors
     /// [`FxError::IntermediateWidth`] when the sum would exceed 128 bits.
-    pub fn add(self, other: Fx) -> Result<Fx, FxError> {
+    pub fn exact_add(self, other: Fx) -> Result<Fx, FxError> {
         let format = Format::sum(self.format, other.format, false)?;
         Ok(Fx::new(
             self.aligned(format.frac) + other.aligned(format.frac),
@@ -113,7 +113,7 @@ impl Fx {
     ///
     /// # Errors
     /// [`FxError::IntermediateWidth`] when the difference would exceed 128 bits.
-    pub fn sub(self, other: Fx) -> Result<Fx, FxError> {
+    pub fn exact_sub(self, other: Fx) -> Result<Fx, FxError> {
         let format = Format::sum(self.format, other.format, true)?;
         Ok(Fx::new(
             self.aligned(format.frac) - other.aligned(format.frac),
@@ -125,7 +125,7 @@ impl Fx {
     ///
     /// # Errors
     /// [`FxError::IntermediateWidth`] when the product would exceed 128 bits.
-    pub fn mul(self, other: Fx) -> Result<Fx, FxError> {
+    pub fn exact_mul(self, other: Fx) -> Result<Fx, FxError> {
         let format = Format::product(self.format, other.format)?;
         Ok(Fx::new(self.code * other.code, format))
     }

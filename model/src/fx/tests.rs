@@ -163,20 +163,20 @@ fn non_finite_values_are_refused() {
 fn exact_arithmetic_grows_as_declared() {
     let a = Fx::new(-128, fmt("s8.4"));
     let b = Fx::new(31, fmt("s6.2"));
-    let sum = a.add(b).unwrap();
+    let sum = a.exact_add(b).unwrap();
     assert_eq!(sum.format, fmt("s9.4").into_intermediate());
     assert_eq!(sum.to_f64(), -8.0 + 7.75);
     let diff = Fx::new(0, fmt("u4.0"))
-        .sub(Fx::new(15, fmt("u4.0")))
+        .exact_sub(Fx::new(15, fmt("u4.0")))
         .unwrap();
     assert_eq!((diff.code, diff.format.signed), (-15, true));
-    let prod = a.mul(b).unwrap();
+    let prod = a.exact_mul(b).unwrap();
     assert_eq!(prod.format, fmt("s14.6").into_intermediate());
     assert_eq!(prod.to_f64(), -8.0 * 7.75);
     // s64 x s64 needs all 128 bits (only for MIN x MIN), and is carried exactly.
     let s64 = fmt("s64.0");
     let min = Fx::new(i128::from(i64::MIN), s64);
-    let square = min.mul(min).unwrap();
+    let square = min.exact_mul(min).unwrap();
     assert_eq!((square.code, square.format.width), (1i128 << 126, 128));
     let wide = Format::intermediate(true, 100, 0).unwrap();
     assert!(matches!(
@@ -348,7 +348,7 @@ mod against_fixed_crate {
         #[test]
         fn add_wrapping_and_saturating(a in any::<i32>(), b in any::<i32>()) {
             let f = i16f16();
-            let sum = Fx::new(a.into(), f).add(Fx::new(b.into(), f)).unwrap();
+            let sum = Fx::new(a.into(), f).exact_add(Fx::new(b.into(), f)).unwrap();
             let wrap = sum.quantize(f, Rounding::Floor, Overflow::Wrap).code;
             let sat = sum.quantize(f, Rounding::Floor, Overflow::Saturate).code;
             let (fa, fb) = (I16F16::from_bits(a), I16F16::from_bits(b));
@@ -360,7 +360,7 @@ mod against_fixed_crate {
         fn mul_wrapping_and_saturating_i16f16(a in any::<i32>(), b in any::<i32>()) {
             // `fixed` truncates the product's extra fraction bits (toward -inf).
             let f = i16f16();
-            let prod = Fx::new(a.into(), f).mul(Fx::new(b.into(), f)).unwrap();
+            let prod = Fx::new(a.into(), f).exact_mul(Fx::new(b.into(), f)).unwrap();
             let (fa, fb) = (I16F16::from_bits(a), I16F16::from_bits(b));
             prop_assert_eq!(
                 prod.quantize(f, Rounding::Floor, Overflow::Wrap).code,
@@ -375,14 +375,14 @@ mod against_fixed_crate {
         #[test]
         fn mul_i32f32_and_i8f24(a in any::<i64>(), b in any::<i64>(), c in any::<i32>(), d in any::<i32>()) {
             let f = fmt("s64.32");
-            let prod = Fx::new(a.into(), f).mul(Fx::new(b.into(), f)).unwrap();
+            let prod = Fx::new(a.into(), f).exact_mul(Fx::new(b.into(), f)).unwrap();
             let (fa, fb) = (I32F32::from_bits(a), I32F32::from_bits(b));
             prop_assert_eq!(
                 prod.quantize(f, Rounding::Floor, Overflow::Saturate).code,
                 i128::from(fa.saturating_mul(fb).to_bits())
             );
             let g = fmt("s32.24");
-            let prod = Fx::new(c.into(), g).mul(Fx::new(d.into(), g)).unwrap();
+            let prod = Fx::new(c.into(), g).exact_mul(Fx::new(d.into(), g)).unwrap();
             let (fc, fd) = (I8F24::from_bits(c), I8F24::from_bits(d));
             prop_assert_eq!(
                 prod.quantize(g, Rounding::Floor, Overflow::Wrap).code,
