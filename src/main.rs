@@ -1,1 +1,377 @@
-fn main() {}
+//! gyrofx: the command line. Parsing here, work in gyrofx-model and gyrofx-codegen.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{bail, Context, Result};
+use clap::{Parser, Subcommand};
+
+use gyrofx_codegen::config::{Config, DEFAULT_TOML};
+use gyrofx_codegen::generate::generate;
+use gyrofx_codegen::input::read_column;
+use gyrofx_codegen::job::{design_bandwidths, plan_for, Job};
+use gyrofx_codegen::report;
+use gyrofx_codegen::simulate::{self, Simulator};
+use gyrofx_model::fx::{from_f64, Overflow, Rounding};
+use gyrofx_model::kf::design::{design, design_for_bandwidth, Convergence, Method, Noise};
+use gyrofx_model::kf::{CoefficientFormat, FixedKf, FloatKf, Plan, Spec};
+
+#[derive(Parser)]
+#[command(
+    name = "gyrofx",
+    version,
+    about = "Bit-accurate fixed-point model, vector and testbench generator for a MEMS-gyro FPGA signal chain"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Print the annotated default config (a starting point for --config).
+    Init,
+    /// Design the steady-state KF gain and quantize it.
+    Design {
+        /// Random-walk intensity of the true rate, (°/s)²/s (sets the bandwidth).
+        #[arg(long, allow_negative_numbers = true)]
+        qw: Option<f64>,
+        /// Rate-random-walk intensity of the bias, (°/s)²/s (RRW²).
+        #[arg(long, allow_negative_numbers = true)]
+        qb: f64,
+        /// White-noise intensity, (°/s)²·s (ARW² with ARW in °/√s).
+        #[arg(long, allow_negative_numbers = true)]
+        qn: f64,
+        /// Sample rate, Hz.
+        #[arg(long, allow_negative_numbers = true)]
+        fs: f64,
+        /// Design for this −3 dB bandwidth (Hz) instead of --qw.
+        #[arg(long, allow_negative_numbers = true)]
+        bandwidth: Option<f64>,
+        /// Discretisation: direct or paper.
+        #[arg(long, default_value = "direct")]
+        method: String,
+        /// Coefficient width, bits (fraction bits chosen per coefficient).
+        #[arg(long, default_value_t = 18)]
+        coefficient_width: u32,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Write the verification package (vectors, ROM, testbench, RTL, manifest) atomically.
+    Generate {
+        /// Output folder (replaced only if empty or a previous gyrofx output).
+        #[arg(long)]
+        out: PathBuf,
+        /// Config file (TOML, overlays the embedded default).
+        #[arg(long)]
+        config: Option<PathBuf>,
+        /// Stimulus samples (overrides the config).
+        #[arg(long)]
+        samples: Option<usize>,
+        /// Seed (overrides the config).
+        #[arg(long)]
+        seed: Option<u64>,
+    },
+    /// Run a generated package's testbench in a simulator; non-zero exit on failure.
+    Verify {
+        /// The package folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// iverilog or verilator.
+        #[arg(long, default_value = "iverilog")]
+        sim: String,
+    },
+    /// Run recorded rate data (°/s) through the bit-accurate KF and its float model.
+    Filter {
+        /// CSV file with a header line.
+        #[arg(long)]
+        input: PathBuf,
+        /// Column of rates in °/s.
+        #[arg(long, default_value = "rate_dps")]
+        column: String,
+        /// Sample rate of the data, Hz.
+        #[arg(long, allow_negative_numbers = true)]
+        fs: f64,
+        /// KF bandwidth, Hz (default: the config's first).
+        #[arg(long, allow_negative_numbers = true)]
+        bandwidth: Option<f64>,
+        /// Config for formats and noise model (default: the embedded one).
+        #[arg(long)]
+        config: Option<PathBuf>,
+        /// Output CSV.
+        #[arg(long)]
+        output: PathBuf,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<ExitCode> {
+    match cli.command {
+        Command::Init => {
+            print!("{DEFAULT_TOML}");
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Design {
+            qw,
+            qb,
+            qn,
+            fs,
+            bandwidth,
+            method,
+            coefficient_width,
+            json,
+        } => run_design(qw, qb, qn, fs, bandwidth, &method, coefficient_width, json),
+        Command::Generate {
+            out,
+            config,
+            samples,
+            seed,
+        } => run_generate(&out, config.as_deref(), samples, seed),
+        Command::Verify { out, sim } => run_verify(&out, &sim),
+        Command::Filter {
+            input,
+            column,
+            fs,
+            bandwidth,
+            config,
+            output,
+        } => run_filter(&input, &column, fs, bandwidth, config.as_deref(), &output),
+    }
+}
+
+fn load_config(path: Option<&Path>) -> Result<Config> {
+    Ok(match path {
+        Some(p) => Config::from_file(p)?,
+        None => Config::embedded(),
+    })
+}
+
+#[allow(clippy::too_many_arguments)]
+fn run_design(
+    qw: Option<f64>,
+    qb: f64,
+    qn: f64,
+    fs: f64,
+    bandwidth: Option<f64>,
+    method: &str,
+    coefficient_width: u32,
+    json: bool,
+) -> Result<ExitCode> {
+    let method: Method = method.parse()?;
+    let convergence = Convergence::default();
+    let designed = match (bandwidth, qw) {
+        (Some(bw), _) => design_for_bandwidth(
+            bw,
+            Noise {
+                q_w: 0.0,
+                q_b: qb,
+                q_n: qn,
+            },
+            fs,
+            method,
+            convergence,
+        )?,
+        (None, Some(q_w)) => design(
+            Noise {
+                q_w,
+                q_b: qb,
+                q_n: qn,
+            },
+            fs,
+            method,
+            convergence,
+        )?,
+        (None, None) => bail!("give --qw (°/s)²/s or --bandwidth HZ"),
+    };
+    let label = match bandwidth {
+        Some(bw) => format!("{bw} Hz"),
+        None => "design".to_string(),
+    };
+    let plan = Plan::new(&Spec {
+        input: "s24.14".parse()?,
+        state: "s36.26".parse()?,
+        output: "s24.14".parse()?,
+        coefficients: [CoefficientFormat::Auto {
+            width: coefficient_width,
+        }; 2],
+        rounding: Rounding::Nearest,
+        overflow: Overflow::Saturate,
+        gains: vec![designed.g],
+        labels: vec![label],
+    })?;
+    let summary = &report::designs(std::slice::from_ref(&designed), &plan)[0];
+    let coefficients = report::coefficients(&plan);
+    if json {
+        let mut value = serde_json::to_value(summary)?;
+        value["coefficients"] = serde_json::to_value(&coefficients)?;
+        println!("{}", serde_json::to_string_pretty(&value)?);
+    } else {
+        println!(
+            "method {}, fs {} Hz, q_w {:e}, q_b {:e}, q_n {:e}",
+            summary.method, fs, summary.q_w, summary.q_b, summary.q_n
+        );
+        println!(
+            "K = [{:e}, {:e}] after {} iterations",
+            summary.k[0], summary.k[1], summary.iterations
+        );
+        println!("g = [{:e}, {:e}]", summary.g[0], summary.g[1]);
+        match summary.bandwidth_hz {
+            Some(bw) => println!("bandwidth {bw} Hz (-3 dB), DC gain {}", summary.dc_gain),
+            None => println!("no -3 dB point below Nyquist, DC gain {}", summary.dc_gain),
+        }
+        for c in &coefficients {
+            println!(
+                "{} = {:e} -> {} code {} (0x{}) = {:e}, error {:e}",
+                c.name, c.value, c.format, c.code, c.hex, c.quantized, c.error
+            );
+        }
+        println!(
+            "eigenvalues of quantized A: {} and {}",
+            summary.eigenvalues[0], summary.eigenvalues[1]
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn run_generate(
+    out: &Path,
+    config_path: Option<&Path>,
+    samples: Option<usize>,
+    seed: Option<u64>,
+) -> Result<ExitCode> {
+    let mut config = load_config(config_path)?;
+    if let Some(n) = samples {
+        config.samples = n;
+    }
+    if let Some(s) = seed {
+        config.seed = s;
+    }
+    let job = Job::new(config)?;
+    let bar = indicatif::ProgressBar::new_spinner();
+    let long = job.config.samples >= 1_000_000;
+    let summary = generate(&job, out, config_path, &mut |phase| {
+        if long {
+            bar.set_message(format!("generate: {phase}"));
+            bar.tick();
+        }
+    })?;
+    bar.finish_and_clear();
+    let stats = &summary.vectors.stats;
+    println!(
+        "wrote {} files to {}: {} vectors ({} stimulus samples)",
+        summary.files.len(),
+        out.display(),
+        summary.vectors.rows.len(),
+        stats.samples
+    );
+    println!("kf plan: {}", job.plan);
+    println!(
+        "fixed vs float: max {:.3} LSB, rms {:.3} LSB, bound {:.3} LSB; vs ideal gains: max {:.3} LSB, SQNR {:.1} dB",
+        stats.max_lsb, stats.rms_lsb, stats.bound_lsb, stats.ideal_max_lsb, stats.sqnr_db
+    );
+    let o = summary.vectors.overflow;
+    println!(
+        "overflows: x1 {}, x2 {}, rate_hat {}; ADC saturations {}",
+        o.x1, o.x2, o.rate_hat, summary.adc_saturations
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+fn run_verify(out: &Path, sim: &str) -> Result<ExitCode> {
+    let simulator: Simulator = sim.parse()?;
+    let outcome = simulate::run(out, simulator)?;
+    for line in &outcome.report {
+        println!("{line}");
+    }
+    if outcome.passed {
+        println!("{}: passed", simulator.name());
+        Ok(ExitCode::SUCCESS)
+    } else {
+        if outcome.report.is_empty() {
+            eprintln!("{}", outcome.log);
+        }
+        eprintln!("{}: FAILED", simulator.name());
+        Ok(ExitCode::FAILURE)
+    }
+}
+
+fn run_filter(
+    input: &Path,
+    column: &str,
+    fs: f64,
+    bandwidth: Option<f64>,
+    config_path: Option<&Path>,
+    output: &Path,
+) -> Result<ExitCode> {
+    let mut config = load_config(config_path)?;
+    config.stimulus.fs_hz = fs;
+    if let Some(bw) = bandwidth {
+        config.kf.bandwidths_hz = vec![bw];
+    }
+    let (_, settings) = config.validate()?;
+    let designs = design_bandwidths(
+        &settings,
+        fs,
+        config.kf.arw_deg_per_sqrt_h,
+        config.kf.rrw_deg_per_h_per_sqrt_h,
+    )?;
+    let plan = plan_for(&settings, &designs)?;
+    let values = read_column(input, column)?;
+    let mut fixed = FixedKf::new(&plan);
+    let mut float = FloatKf::new(plan.gains.clone());
+    let mut text = String::with_capacity(values.len() * 80);
+    text.push_str("sample,z_dps,z_code,rate_code,rate_dps,float_rate_dps\n");
+    let mut saturated = 0u64;
+    for (k, value) in values.iter().enumerate() {
+        let q = from_f64(*value, plan.input, Rounding::Nearest, Overflow::Saturate)?;
+        saturated += u64::from(q.overflowed);
+        let z = q.code as i64;
+        let rate = fixed.step(z, 0);
+        let reference = float.step(*value, 0);
+        text.push_str(&format!(
+            "{k},{},{z},{rate},{},{reference}\n",
+            plan.input.to_f64(q.code),
+            plan.output.to_f64(i128::from(rate))
+        ));
+    }
+    let folder = match output.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let mut staged = tempfile::NamedTempFile::new_in(folder).with_context(|| {
+        format!(
+            "output {}: cannot create a file in {}",
+            output.display(),
+            folder.display()
+        )
+    })?;
+    std::io::Write::write_all(&mut staged, text.as_bytes())
+        .with_context(|| format!("output {}", output.display()))?;
+    staged
+        .persist(output)
+        .with_context(|| format!("output {}: cannot move into place", output.display()))?;
+    let o = fixed.overflow_counts();
+    println!(
+        "filtered {} samples at {} Hz, bandwidth {} Hz -> {}; ADC saturations {}, overflows x1 {} x2 {} rate_hat {}",
+        values.len(),
+        fs,
+        settings.bandwidths_hz[0],
+        output.display(),
+        saturated,
+        o.x1,
+        o.x2,
+        o.rate_hat
+    );
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,7 +1,7 @@
 //! [`FixedKf`]: the bit-accurate fixed-point steady-state KF.
 
 use super::plan::Plan;
-use crate::fx::Quantizer;
+use crate::fx::{requantize, Quantizer};
 
 /// The fixed-point KF: `e = z − x1 − x2` exact, `x_i ← Q(x_i + g_i·e)` into the state format,
 /// `rate_hat = Q(x1)` into the output format, rounding and overflow as the plan declares.
@@ -100,12 +100,21 @@ impl FixedKf {
         }
     }
 
-    /// Whether, from the current state, the sample `z` at `bw_sel` puts the `x1` update exactly
-    /// on a rounding tie (half an LSB of the state): used to build tie-case vectors.
-    pub fn x1_update_is_tie(&self, z: i64, bw_sel: usize) -> bool {
-        let g1 = self.rom[bw_sel][0];
+    /// Which of the three quantization points (`x1`, `x2`, `rate_hat`) the sample `z` at
+    /// `bw_sel` would put exactly on a rounding tie (half an LSB), from the current state,
+    /// without changing it: used to build tie-case vectors.
+    pub fn ties(&self, z: i64, bw_sel: usize) -> [bool; 3] {
+        let [g1, g2] = self.rom[bw_sel];
         let e = (i128::from(z) << self.z_shift) - self.x[0] - self.x[1];
-        self.state_quantizer[0].is_tie((self.x[0] << self.x_shift[0]) + g1 * e)
+        let s1 = (self.x[0] << self.x_shift[0]) + g1 * e;
+        let s2 = (self.x[1] << self.x_shift[1]) + g2 * e;
+        let q = &self.state_quantizer[0];
+        let x1_next = requantize(s1, q.from_frac, q.to, q.rounding, q.overflow).code;
+        [
+            self.state_quantizer[0].is_tie(s1),
+            self.state_quantizer[1].is_tie(s2),
+            self.output_quantizer.is_tie(x1_next),
+        ]
     }
 }
 
