@@ -58,7 +58,6 @@ initial begin
     end
 end
 
-wire negative = in[IN_W-1];
 wire signed [Q_W-1:0] rounded;
 
 generate
@@ -67,6 +66,7 @@ generate
     end else begin : g_round
         wire signed [Q_W-1:0] quotient = {in[IN_W-1], in[IN_W-1:SHIFT]};
         wire [SHIFT-1:0] remainder = in[SHIFT-1:0];
+        wire negative = in[IN_W-1];
         wire any_dropped = |remainder;
         wire half_bit = remainder[SHIFT-1];
         wire below_half;

@@ -1,1 +1,24 @@
-fn main() {}
+//! `generate` of 10^6 samples with all files, written to disk (goal: < 1 s).
+
+use criterion::{criterion_group, criterion_main, Criterion};
+
+use gyrofx_codegen::config::Config;
+use gyrofx_codegen::generate::generate;
+use gyrofx_codegen::job::Job;
+
+fn generate_million(c: &mut Criterion) {
+    let mut config = Config::embedded();
+    config.samples = 1_000_000;
+    let job = Job::new(config).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("pkg");
+    let mut group = c.benchmark_group("generate");
+    group.sample_size(10);
+    group.bench_function("default_1M_samples_all_files", |b| {
+        b.iter(|| generate(&job, &out, None, &mut |_| {}).unwrap())
+    });
+    group.finish();
+}
+
+criterion_group!(benches, generate_million);
+criterion_main!(benches);

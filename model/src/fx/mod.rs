@@ -20,7 +20,9 @@ mod format;
 mod quantize;
 
 pub use format::{Format, MAX_DECLARED_WIDTH, MAX_INTERMEDIATE_WIDTH};
-pub use quantize::{from_f64, requantize, Overflow, Quantized, Quantizer, Rounding};
+pub use quantize::{
+    from_f64, mode, requantize, round_right, Overflow, Quantized, Quantizer, Rounding,
+};
 
 /// Errors of the fixed-point core. Each names the offending value and what is allowed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

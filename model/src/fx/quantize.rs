@@ -229,6 +229,44 @@ fn round_shift_right(value: i128, shift: u32, rounding: Rounding) -> (i128, bool
     (quotient + i128::from(up), false)
 }
 
+/// The rounding modes as const-generic parameters (their [`Rounding::rtl_code`] values), for
+/// hot loops monomorphized per mode.
+pub mod mode {
+    /// [`super::Rounding::Floor`].
+    pub const FLOOR: u8 = 0;
+    /// [`super::Rounding::Ceil`].
+    pub const CEIL: u8 = 1;
+    /// [`super::Rounding::Zero`].
+    pub const ZERO: u8 = 2;
+    /// [`super::Rounding::Nearest`].
+    pub const NEAREST: u8 = 3;
+    /// [`super::Rounding::Round`].
+    pub const ROUND: u8 = 4;
+    /// [`super::Rounding::Convergent`].
+    pub const CONVERGENT: u8 = 5;
+}
+
+/// `value / 2^shift` rounded with the mode `MODE` (see [`mode`]), for `1 <= shift <= 127`:
+/// branch-free, the same result as [`requantize`]'s rounding (an exhaustive test checks it).
+#[inline(always)]
+pub fn round_right<const MODE: u8>(value: i128, shift: u32) -> i128 {
+    let quotient = value >> shift;
+    let dropped_mask = i128::MAX >> (127 - shift);
+    let any_dropped = i128::from(value & dropped_mask != 0);
+    let half_bit = (value >> (shift - 1)) & 1;
+    let below_half = i128::from(value & (dropped_mask >> 1) != 0);
+    let negative = i128::from(value < 0);
+    let increment = match MODE {
+        mode::FLOOR => 0,
+        mode::CEIL => any_dropped,
+        mode::ZERO => any_dropped & negative,
+        mode::NEAREST => half_bit,
+        mode::ROUND => half_bit & (below_half | (1 - negative)),
+        _ => half_bit & (below_half | (quotient & 1)),
+    };
+    quotient + increment
+}
+
 #[inline(always)]
 fn finish_overflow(
     rounded: i128,
@@ -342,6 +380,9 @@ fn scale_by_pow2(value: f64, exp: i32) -> f64 {
 
 /// A declared quantization point: a fixed source fraction, a target format and modes, and a
 /// count of the values that overflowed there (wrapped or saturated), like a logging fimath.
+///
+/// Rounds and overflows exactly as [`requantize`]; the range and shift are precomputed so the
+/// per-sample path is a shift, a compare and an add.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Quantizer {
     /// Fraction bits of the values that arrive here.
@@ -354,6 +395,9 @@ pub struct Quantizer {
     pub overflow: Overflow,
     /// Values that did not fit `to` since construction or the last [`Quantizer::clear_count`].
     pub overflow_count: u64,
+    shift: i32,
+    min: i128,
+    max: i128,
 }
 
 impl Quantizer {
@@ -365,25 +409,53 @@ impl Quantizer {
             rounding,
             overflow,
             overflow_count: 0,
+            shift: from_frac - to.frac,
+            min: to.min_code(),
+            max: to.max_code(),
         }
     }
 
     /// Quantizes one value (see [`requantize`]) and counts an overflow.
-    #[inline(always)]
+    #[inline]
     pub fn apply(&mut self, code: i128) -> i128 {
-        let q = requantize(code, self.from_frac, self.to, self.rounding, self.overflow);
-        self.overflow_count += u64::from(q.overflowed);
-        q.code
+        match self.rounding {
+            Rounding::Floor => self.apply_mode::<{ mode::FLOOR }>(code),
+            Rounding::Ceil => self.apply_mode::<{ mode::CEIL }>(code),
+            Rounding::Zero => self.apply_mode::<{ mode::ZERO }>(code),
+            Rounding::Nearest => self.apply_mode::<{ mode::NEAREST }>(code),
+            Rounding::Round => self.apply_mode::<{ mode::ROUND }>(code),
+            Rounding::Convergent => self.apply_mode::<{ mode::CONVERGENT }>(code),
+        }
+    }
+
+    /// [`Quantizer::apply`] with the rounding mode fixed at compile time. `MODE` must be this
+    /// quantizer's mode (debug builds check it).
+    #[inline(always)]
+    pub fn apply_mode<const MODE: u8>(&mut self, code: i128) -> i128 {
+        debug_assert_eq!(u32::from(MODE), self.rounding.rtl_code());
+        if self.shift <= 0 || self.shift >= 128 {
+            let q = requantize(code, self.from_frac, self.to, self.rounding, self.overflow);
+            self.overflow_count += u64::from(q.overflowed);
+            return q.code;
+        }
+        let rounded = round_right::<MODE>(code, self.shift as u32);
+        if rounded >= self.min && rounded <= self.max {
+            return rounded;
+        }
+        self.overflow_count += 1;
+        match self.overflow {
+            Overflow::Saturate => rounded.clamp(self.min, self.max),
+            Overflow::Wrap => self.to.wrap(rounded),
+        }
     }
 
     /// Whether the dropped bits of `code` are exactly half an LSB of the target: the case
     /// where the round-to-nearest modes differ.
     pub fn is_tie(&self, code: i128) -> bool {
-        let shift = self.from_frac - self.to.frac;
-        if shift <= 0 || shift >= 128 {
+        if self.shift <= 0 || self.shift >= 128 {
             return false;
         }
-        code & (i128::MAX >> (127 - shift)) == 1i128 << (shift - 1)
+        code & (i128::MAX >> (127 - self.shift)) == 1i128 << (self.shift - 1)
     }
 
     /// Resets the overflow count.

@@ -236,6 +236,55 @@ fn exhaustive_tiny_formats_against_the_reference() {
     assert!(checked > 1_000_000, "{checked}");
 }
 
+/// The branch-free per-mode fast path of [`Quantizer`] against [`requantize`], exhaustively on
+/// small values, every shift, every mode, both overflow modes (including overflowing targets).
+#[test]
+fn quantizer_fast_path_equals_requantize() {
+    for rounding in Rounding::ALL {
+        for overflow in Overflow::ALL {
+            for shift in 1..=9i32 {
+                for to in [fmt("s4.0"), fmt("s9.2"), fmt("u3.1"), fmt("s16.0")] {
+                    let from_frac = to.frac + shift;
+                    let mut q = Quantizer::new(from_frac, to, rounding, overflow);
+                    let mut overflows = 0;
+                    for code in -3000i128..=3000 {
+                        let want = requantize(code, from_frac, to, rounding, overflow);
+                        overflows += u64::from(want.overflowed);
+                        assert_eq!(
+                            q.apply(code),
+                            want.code,
+                            "{code} >> {shift} into {to} {rounding} {overflow}"
+                        );
+                    }
+                    assert_eq!(q.overflow_count, overflows);
+                }
+            }
+        }
+    }
+    // Wide values and the largest shifts.
+    for rounding in Rounding::ALL {
+        let to = Format::intermediate(true, 100, 0).unwrap();
+        for shift in [100i32, 126, 127] {
+            let mut q = Quantizer::new(shift, to, rounding, Overflow::Saturate);
+            for code in [
+                i128::MIN,
+                i128::MIN + 1,
+                -(1 << 126),
+                -(1 << 100) - 1,
+                -1,
+                0,
+                1,
+                1 << 99,
+                (1 << 126) + 5,
+                i128::MAX,
+            ] {
+                let want = requantize(code, shift, to, rounding, Overflow::Saturate).code;
+                assert_eq!(q.apply(code), want, "{code} >> {shift} {rounding}");
+            }
+        }
+    }
+}
+
 #[test]
 fn extreme_shifts_round_correctly() {
     let to = fmt("s8.0");

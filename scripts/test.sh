@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Runs every check of gyrofx, installing what it needs first. CI runs exactly this.
+#
+#   scripts/test.sh
+#
+# Installs the simulators and synthesis tool with apt-get where missing (iverilog, verilator,
+# ghdl, yosys, make): a missing simulator is a failure, never a skipped test. Then: rustfmt,
+# clippy, Verilator lint of the RTL, and the whole test suite (unit, property, end-to-end
+# with both simulators, golden vectors). Benchmarks are compiled (clippy --all-targets) but
+# not run: run them with `cargo bench`.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+missing=()
+for program in iverilog vvp verilator ghdl yosys make sha256sum; do
+    command -v "$program" >/dev/null 2>&1 || missing+=("$program")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+    echo "== installing (missing: ${missing[*]})"
+    sudo=""
+    if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
+    $sudo apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq \
+        iverilog verilator ghdl yosys make coreutils >/dev/null
+fi
+for program in iverilog vvp verilator ghdl yosys make sha256sum; do
+    command -v "$program" >/dev/null 2>&1 || { echo "FAIL: $program is still missing after apt-get" >&2; exit 1; }
+done
+
+echo "== tools: $(iverilog -V 2>&1 | head -1); $(verilator --version); $(yosys -V)"
+echo "== cargo fmt --check"
+cargo fmt --all -- --check
+echo "== cargo clippy --all-targets -D warnings"
+cargo clippy --workspace --all-targets --quiet -- -D warnings
+echo "== verilator --lint-only -Wall (hdl/)"
+verilator --lint-only -Wall --top-module gyrofx_kf hdl/gyrofx_quantize.v hdl/gyrofx_kf.v
+echo "== cargo test"
+cargo test --workspace

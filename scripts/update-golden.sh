@@ -1,0 +1,7 @@
+#!/usr/bin/env bash
+# Regenerates the golden vector set in vectors/ from the embedded default config. Run it only
+# when a change to the model, the writers or the default is intended; commit the result.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+GYROFX_UPDATE_GOLDEN=1 cargo test --test golden
+git status --short vectors/

@@ -1,0 +1,258 @@
+//! Bad input: a clear error naming the field, the value and what is allowed, a non-zero exit,
+//! and no output left behind.
+
+mod common;
+
+use common::*;
+
+/// Generates with `toml` as config into a fresh folder; asserts failure, that every `needle`
+/// is in the message, and that no output (nor staging folder) was left.
+fn refused(toml: &str, needles: &[&str]) {
+    let dir = tempfile::tempdir().unwrap();
+    let config = write_config(dir.path(), "bad.toml", toml);
+    let out = dir.path().join("out");
+    let log = fails(&[
+        "generate",
+        "--out",
+        out.to_str().unwrap(),
+        "--config",
+        &config,
+    ]);
+    for needle in needles {
+        assert!(
+            log.contains(needle),
+            "{toml:?}: expected {needle:?} in:\n{log}"
+        );
+    }
+    assert!(log.starts_with("error: "), "{log}");
+    assert!(!out.exists(), "{toml:?} left an output folder");
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n != "bad.toml")
+        .collect();
+    assert!(leftovers.is_empty(), "{toml:?} left {leftovers:?}");
+}
+
+#[test]
+fn unknown_config_key() {
+    refused(
+        "[kf]\nbandwith_hz = [10.0]\n",
+        &["unknown key kf.bandwith_hz", "line 2", "bandwidths_hz"],
+    );
+    refused("sampels = 10\n", &["unknown key sampels", "line 1"]);
+}
+
+#[test]
+fn widths_out_of_range_and_bad_format_strings() {
+    refused(
+        "[kf]\nstate_format = \"s0.10\"\n",
+        &["kf.state_format = \"s0.10\"", "1..=64"],
+    );
+    refused(
+        "[kf]\ninput_format = \"s65.14\"\n",
+        &["kf.input_format = \"s65.14\"", "1..=64"],
+    );
+    refused(
+        "[kf]\noutput_format = \"24.14\"\n",
+        &["kf.output_format = \"24.14\"", "s18.16"],
+    );
+    refused(
+        "[kf]\ng1_format = \"s18.x\"\n",
+        &["kf.g1_format = \"s18.x\""],
+    );
+    refused(
+        "[kf]\ncoefficient_width = 65\n",
+        &["kf.coefficient_width = 65", "1..=64"],
+    );
+}
+
+#[test]
+fn negative_or_zero_variances_and_sample_rates() {
+    refused(
+        "[kf]\narw_deg_per_sqrt_h = -4.87\n",
+        &["kf.arw_deg_per_sqrt_h = -4.87", "> 0"],
+    );
+    refused(
+        "[kf]\nrrw_deg_per_h_per_sqrt_h = 0.0\n",
+        &["kf.rrw_deg_per_h_per_sqrt_h = 0", "> 0"],
+    );
+    refused("[stimulus]\nfs_hz = 0.0\n", &["stimulus.fs_hz = 0", "> 0"]);
+    refused(
+        "[stimulus]\nfs_hz = -50.0\n",
+        &["stimulus.fs_hz = -50", "> 0"],
+    );
+    refused(
+        "[kf]\nbandwidths_hz = [10.0, 120.0]\n",
+        &["kf.bandwidths_hz[1] = 120", "fs/2 = 100"],
+    );
+    let log = fails(&[
+        "design", "--qw", "26", "--qb", "3e-5", "--qn", "-1", "--fs", "200",
+    ]);
+    assert!(log.contains("q_n = -1") && log.contains("> 0"), "{log}");
+    let log = fails(&[
+        "design", "--qw", "0", "--qb", "3e-5", "--qn", "1e-3", "--fs", "200",
+    ]);
+    assert!(log.contains("q_w = 0"), "{log}");
+    let log = fails(&[
+        "design", "--qw", "26", "--qb", "3e-5", "--qn", "1e-3", "--fs", "0",
+    ]);
+    assert!(log.contains("fs = 0"), "{log}");
+    let log = fails(&[
+        "design",
+        "--bandwidth",
+        "150",
+        "--qb",
+        "3e-5",
+        "--qn",
+        "1e-3",
+        "--fs",
+        "200",
+    ]);
+    assert!(log.contains("fs/2 = 100"), "{log}");
+}
+
+#[test]
+fn a_coefficient_that_does_not_fit() {
+    // g1 of the 30 Hz entry is about 0.58: s18.18 holds only [-0.5, 0.5).
+    refused(
+        "[kf]\ng1_format = \"s18.18\"\n",
+        &[
+            "coefficient g1 for 30 Hz",
+            "does not fit s18.18",
+            "needs 19 bits",
+        ],
+    );
+    // g2 (~1e-7) vanishes at 17 fraction bits.
+    refused(
+        "[kf]\ng2_format = \"s18.17\"\n",
+        &["coefficient g2", "quantizes to zero in s18.17"],
+    );
+}
+
+#[test]
+fn a_missing_or_nan_csv_cell_names_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("rate.csv"),
+        "t,rate_dps\n0,1.0\n1,2.0\n2,NaN\n",
+    )
+    .unwrap();
+    std::fs::write(dir.path().join("gap.csv"), "t,rate_dps\n0,1.0\n1,\n").unwrap();
+    for (file, needle) in [
+        (
+            "rate.csv",
+            "line 4, column \"rate_dps\": NaN is not allowed",
+        ),
+        ("gap.csv", "line 3, column \"rate_dps\": the cell is empty"),
+    ] {
+        let config = write_config(
+            dir.path(),
+            "csv.toml",
+            &format!("[stimulus]\nsource = \"csv\"\ncsv_path = \"{file}\"\n"),
+        );
+        let out = dir.path().join("out");
+        let log = fails(&[
+            "generate",
+            "--out",
+            out.to_str().unwrap(),
+            "--config",
+            &config,
+        ]);
+        assert!(log.contains(needle) && log.contains(file), "{log}");
+        assert!(!out.exists());
+        let output = dir.path().join("filtered.csv");
+        let input = dir.path().join(file);
+        let log = fails(&[
+            "filter",
+            "--input",
+            input.to_str().unwrap(),
+            "--fs",
+            "200",
+            "--output",
+            output.to_str().unwrap(),
+        ]);
+        assert!(log.contains(needle), "{log}");
+        assert!(!output.exists());
+    }
+}
+
+#[test]
+fn an_unwritable_output_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    // A regular file where a parent folder should be: no user, root included, can write there.
+    let blocker = dir.path().join("file");
+    std::fs::write(&blocker, "not a folder").unwrap();
+    let out = blocker.join("out");
+    let log = fails(&[
+        "generate",
+        "--out",
+        out.to_str().unwrap(),
+        "--samples",
+        "100",
+    ]);
+    assert!(
+        log.contains("output folder") && log.contains("file/out"),
+        "{log}"
+    );
+    // A non-empty folder that is not a gyrofx output is never replaced.
+    let user = dir.path().join("mine");
+    std::fs::create_dir(&user).unwrap();
+    std::fs::write(user.join("notes.txt"), "keep me").unwrap();
+    let log = fails(&[
+        "generate",
+        "--out",
+        user.to_str().unwrap(),
+        "--samples",
+        "100",
+    ]);
+    assert!(log.contains("not a gyrofx output"), "{log}");
+    assert_eq!(
+        std::fs::read_to_string(user.join("notes.txt")).unwrap(),
+        "keep me"
+    );
+    // A previous gyrofx output is replaced whole.
+    let previous = dir.path().join("previous");
+    ok(&[
+        "generate",
+        "--out",
+        previous.to_str().unwrap(),
+        "--samples",
+        "100",
+    ]);
+    std::fs::write(previous.join("stale.txt"), "old").unwrap();
+    ok(&[
+        "generate",
+        "--out",
+        previous.to_str().unwrap(),
+        "--samples",
+        "120",
+    ]);
+    assert!(!previous.join("stale.txt").exists());
+    let names: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names.len(), 3, "no staging leftovers: {names:?}");
+}
+
+#[test]
+fn verify_refuses_a_folder_that_is_not_a_package_and_unknown_simulators() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = fails(&[
+        "verify",
+        "--out",
+        dir.path().to_str().unwrap(),
+        "--sim",
+        "iverilog",
+    ]);
+    assert!(log.contains("not a gyrofx package"), "{log}");
+    let log = fails(&[
+        "verify",
+        "--out",
+        dir.path().to_str().unwrap(),
+        "--sim",
+        "modelsim",
+    ]);
+    assert!(log.contains("\"modelsim\" is not supported"), "{log}");
+}

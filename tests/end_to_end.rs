@@ -1,0 +1,342 @@
+//! generate → verify in Icarus and Verilator → pass; and every way it must fail.
+
+mod common;
+
+use common::*;
+
+fn generate_default(dir: &std::path::Path, samples: &str) -> String {
+    let out = dir.join("pkg");
+    ok(&[
+        "generate",
+        "--out",
+        out.to_str().unwrap(),
+        "--samples",
+        samples,
+    ]);
+    out.to_string_lossy().into_owned()
+}
+
+#[test]
+fn default_package_passes_in_icarus_and_verilator_and_a_flipped_bit_fails_both() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = generate_default(dir.path(), "10000");
+    for sim in ["iverilog", "verilator"] {
+        let log = ok(&["verify", "--out", &out, "--sim", sim]);
+        assert!(log.contains("PASS n=10166"), "{sim}: {log}");
+    }
+    let build_log = std::fs::read_to_string(dir.path().join("pkg/kf/verilator_build.log")).unwrap();
+    assert!(
+        !build_log.contains("%Warning"),
+        "Verilator warns on the testbench:\n{build_log}"
+    );
+
+    flip_expected_bit(std::path::Path::new(&out), 4321);
+    for sim in ["iverilog", "verilator"] {
+        let log = fails(&["verify", "--out", &out, "--sim", sim]);
+        assert!(
+            log.contains("MISMATCH sample 4321 signal rate_out"),
+            "{sim}: {log}"
+        );
+        assert!(
+            log.contains("FAIL mismatches=1 n=10166 first=4321"),
+            "{sim}: {log}"
+        );
+    }
+}
+
+#[test]
+fn the_package_runs_without_gyrofx_through_its_makefile() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = generate_default(dir.path(), "500");
+    let make = std::process::Command::new("make")
+        .args(["-C", &out, "sim-iverilog"])
+        .output()
+        .unwrap();
+    assert!(make.status.success(), "{}", text(&make));
+    assert!(String::from_utf8_lossy(&make.stdout).contains("PASS n="));
+}
+
+#[test]
+fn a_vector_file_with_other_formats_or_missing_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = generate_default(dir.path(), "300");
+    let stimulus = dir.path().join("pkg/kf/kf_stimulus.hex");
+    let original = std::fs::read_to_string(&stimulus).unwrap();
+    std::fs::write(&stimulus, original.replacen("z:s24.14", "z:s24.13", 1)).unwrap();
+    let log = fails(&["verify", "--out", &out, "--sim", "iverilog"]);
+    assert!(
+        log.contains("declares formats rst:u1.0 bw_sel:u2.0 z:s24.13"),
+        "{log}"
+    );
+
+    // A truncated stimulus file: the testbench names the sample whose line is missing.
+    let lines: Vec<&str> = original.lines().take(102).collect();
+    std::fs::write(&stimulus, lines.join("\n") + "\n").unwrap();
+    let log = fails(&["verify", "--out", &out, "--sim", "iverilog"]);
+    assert!(
+        log.contains("line for sample 100 is missing or malformed"),
+        "{log}"
+    );
+
+    std::fs::remove_file(&stimulus).unwrap();
+    let log = fails(&["verify", "--out", &out, "--sim", "iverilog"]);
+    assert!(log.contains("cannot open kf_stimulus.hex"), "{log}");
+}
+
+/// Every rounding mode, and wrap-around overflow, through the RTL: the quantizer's six modes
+/// and both overflow behaviours are bit-exact with the model.
+#[test]
+fn every_rounding_mode_and_wrapping_overflow_pass_in_icarus() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut cases: Vec<(String, String)> = ["floor", "ceil", "zero", "nearest", "round", "convergent"]
+        .iter()
+        .map(|mode| {
+            (
+                mode.to_string(),
+                format!("samples = 1500\n[kf]\nrounding = \"{mode}\"\nstate_format = \"s30.22\"\ncoefficient_width = 16\n"),
+            )
+        })
+        .collect();
+    // A state with only ±2 °/s of range: the full-scale segment overflows and wraps.
+    cases.push((
+        "wrap".into(),
+        "samples = 1500\n[stimulus]\nrate_dps = 1.0\n[kf]\noverflow = \"wrap\"\nstate_format = \"s24.22\"\noutput_format = \"s20.14\"\n".into(),
+    ));
+    for (name, toml) in cases {
+        let config = write_config(dir.path(), &format!("{name}.toml"), &toml);
+        let out = dir.path().join(&name);
+        let log = ok(&[
+            "generate",
+            "--out",
+            out.to_str().unwrap(),
+            "--config",
+            &config,
+        ]);
+        if name == "wrap" {
+            assert!(
+                !log.contains("overflows: x1 0,"),
+                "the wrap case must overflow: {log}"
+            );
+        }
+        let log = ok(&[
+            "verify",
+            "--out",
+            out.to_str().unwrap(),
+            "--sim",
+            "iverilog",
+        ]);
+        assert!(log.contains("PASS"), "{name}: {log}");
+    }
+}
+
+#[test]
+fn one_seed_gives_byte_identical_packages_and_another_seed_differs() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("a");
+    let b = dir.path().join("b");
+    let c = dir.path().join("c");
+    ok(&[
+        "generate",
+        "--out",
+        a.to_str().unwrap(),
+        "--samples",
+        "3000",
+        "--seed",
+        "42",
+    ]);
+    ok(&[
+        "generate",
+        "--out",
+        b.to_str().unwrap(),
+        "--samples",
+        "3000",
+        "--seed",
+        "42",
+    ]);
+    ok(&[
+        "generate",
+        "--out",
+        c.to_str().unwrap(),
+        "--samples",
+        "3000",
+        "--seed",
+        "43",
+    ]);
+    let files = files_below(&a);
+    assert_eq!(files, files_below(&b));
+    assert!(files.len() >= 10);
+    for file in &files {
+        assert_eq!(
+            std::fs::read(a.join(file)).unwrap(),
+            std::fs::read(b.join(file)).unwrap(),
+            "{file:?}"
+        );
+    }
+    let stimulus = |p: &std::path::Path| std::fs::read(p.join("kf/kf_stimulus.hex")).unwrap();
+    assert_ne!(stimulus(&a), stimulus(&c));
+}
+
+#[test]
+fn the_manifest_lists_every_file_with_its_sha256() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = generate_default(dir.path(), "200");
+    let root = std::path::Path::new(&out);
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(root.join("manifest.json")).unwrap())
+            .unwrap();
+    let listed = manifest["files"].as_array().unwrap();
+    let on_disk = files_below(root);
+    assert_eq!(
+        listed.len() + 1,
+        on_disk.len(),
+        "every file but the manifest itself"
+    );
+    for entry in listed {
+        let path = entry["path"].as_str().unwrap();
+        let data = std::fs::read(root.join(path)).unwrap();
+        use sha2_check::hex_sha256;
+        assert_eq!(
+            entry["sha256"].as_str().unwrap(),
+            hex_sha256(&data),
+            "{path}"
+        );
+    }
+    assert_eq!(manifest["seed"], 1);
+    assert_eq!(manifest["kf"]["formats"]["state"], "s36.26");
+    assert_eq!(manifest["kf"]["overflow_counts"]["x1"], 0);
+    assert!(
+        manifest["kf"]["fixed_vs_float"]["max_lsb"]
+            .as_f64()
+            .unwrap()
+            <= 1.0
+    );
+    assert_eq!(manifest["config"]["kf"]["rounding"], "nearest");
+}
+
+/// SHA-256 through `sha256sum`, independent of the code under test.
+mod sha2_check {
+    pub fn hex_sha256(data: &[u8]) -> String {
+        use std::io::Write;
+        let mut child = std::process::Command::new("sha256sum")
+            .stdin(std::process::Stdio::piped())
+            .stdout(std::process::Stdio::piped())
+            .spawn()
+            .expect("sha256sum runs");
+        child.stdin.take().unwrap().write_all(data).unwrap();
+        let out = child.wait_with_output().unwrap();
+        String::from_utf8(out.stdout)
+            .unwrap()
+            .split_whitespace()
+            .next()
+            .unwrap()
+            .to_string()
+    }
+}
+
+#[test]
+fn filter_agrees_with_the_generated_vectors() {
+    // The package's CSV holds the quantized input in °/s; filtering it at the first bandwidth
+    // must reproduce the expected codes up to the first bw_sel switch.
+    let dir = tempfile::tempdir().unwrap();
+    let out = generate_default(dir.path(), "1200");
+    let csv = std::fs::read_to_string(dir.path().join("pkg/kf/kf_vectors.csv")).unwrap();
+    let rows: Vec<Vec<String>> = csv
+        .lines()
+        .skip(2)
+        .map(|l| l.split(',').map(str::to_string).collect::<Vec<String>>())
+        .take_while(|r| r[3] == "0" && r[2] == "0")
+        .collect();
+    assert!(rows.len() >= 100, "{}", rows.len());
+    let mut input = String::from("t,rate_dps\n");
+    for (k, r) in rows.iter().enumerate() {
+        input.push_str(&format!("{k},{}\n", r[5]));
+    }
+    let input_path = dir.path().join("in.csv");
+    std::fs::write(&input_path, input).unwrap();
+    let output_path = dir.path().join("out.csv");
+    ok(&[
+        "filter",
+        "--input",
+        input_path.to_str().unwrap(),
+        "--fs",
+        "200",
+        "--bandwidth",
+        "10",
+        "--output",
+        output_path.to_str().unwrap(),
+    ]);
+    let filtered = std::fs::read_to_string(&output_path).unwrap();
+    let codes: Vec<&str> = filtered
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(3).unwrap())
+        .collect();
+    assert_eq!(codes.len(), rows.len());
+    for (k, (got, row)) in codes.iter().zip(&rows).enumerate() {
+        assert_eq!(*got, row[7], "sample {k}");
+    }
+    let _ = out;
+}
+
+#[test]
+fn init_prints_the_default_config_which_generates_the_same_vectors() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = write_config(dir.path(), "default.toml", &ok(&["init"]));
+    let a = dir.path().join("a");
+    let b = dir.path().join("b");
+    ok(&[
+        "generate",
+        "--out",
+        a.to_str().unwrap(),
+        "--config",
+        &config,
+        "--samples",
+        "500",
+    ]);
+    ok(&["generate", "--out", b.to_str().unwrap(), "--samples", "500"]);
+    let body = |p: &std::path::Path| {
+        let text = std::fs::read_to_string(p.join("kf/kf_expected.hex")).unwrap();
+        text.lines().skip(1).collect::<Vec<_>>().join("\n")
+    };
+    assert_eq!(body(&a), body(&b));
+}
+
+#[test]
+fn design_json_has_the_documented_fields() {
+    let out = ok(&[
+        "design", "--qw", "26", "--qb", "3.1e-5", "--qn", "6.6e-3", "--fs", "200", "--json",
+    ]);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    for key in [
+        "k",
+        "g",
+        "bandwidth_hz",
+        "dc_gain",
+        "iterations",
+        "coefficients",
+    ] {
+        assert!(!v[key].is_null(), "{key} missing in {out}");
+    }
+    assert_eq!(v["k"], v["g"], "direct method: g = K");
+    let c = &v["coefficients"][0];
+    for key in ["name", "value", "format", "code", "quantized", "error"] {
+        assert!(!c[key].is_null(), "coefficient {key} missing");
+    }
+    let bw = ok(&[
+        "design",
+        "--bandwidth",
+        "20",
+        "--qb",
+        "3.1e-5",
+        "--qn",
+        "6.6e-3",
+        "--fs",
+        "200",
+        "--method",
+        "paper",
+        "--json",
+    ]);
+    let v: serde_json::Value = serde_json::from_str(&bw).unwrap();
+    assert!((v["bandwidth_hz"].as_f64().unwrap() - 20.0).abs() < 1e-6);
+    assert_ne!(v["k"], v["g"], "paper method: g = K (1 - e^-S)/S");
+}
