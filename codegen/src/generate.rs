@@ -150,7 +150,7 @@ pub fn build_package(
     let mut text = serde_json::to_string_pretty(&manifest).expect("manifest serializes");
     text.push('\n');
     package.add(MANIFEST, text);
-    let files = package.entries().into_iter().map(|e| e.path).collect();
+    let files = package.paths();
     Ok((
         package,
         Summary {

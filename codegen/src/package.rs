@@ -45,16 +45,33 @@ impl Package {
         self.files.push((path.into(), content.into()));
     }
 
-    /// Entries of every file so far, in the order added.
-    pub fn entries(&self) -> Vec<FileEntry> {
+    /// Relative paths of every file so far, `/`-separated, in the order added.
+    pub fn paths(&self) -> Vec<String> {
         self.files
             .iter()
-            .map(|(path, data)| FileEntry {
-                path: path.to_string_lossy().replace('\\', "/"),
-                sha256: sha256_hex(data),
-                bytes: data.len(),
-            })
+            .map(|(path, _)| path.to_string_lossy().replace('\\', "/"))
             .collect()
+    }
+
+    /// Entries of every file so far, in the order added (hashed on parallel threads).
+    pub fn entries(&self) -> Vec<FileEntry> {
+        std::thread::scope(|scope| {
+            let hashes: Vec<_> = self
+                .files
+                .iter()
+                .map(|(_, data)| scope.spawn(move || sha256_hex(data)))
+                .collect();
+            self.paths()
+                .into_iter()
+                .zip(hashes)
+                .zip(&self.files)
+                .map(|((path, hash), (_, data))| FileEntry {
+                    path,
+                    sha256: hash.join().expect("hashing does not panic"),
+                    bytes: data.len(),
+                })
+                .collect()
+        })
     }
 
     /// Writes the package to `out`, all or nothing: into a temporary folder beside `out`, then
@@ -96,13 +113,27 @@ impl Package {
                     parent.display()
                 ))
             })?;
-        for (path, data) in &self.files {
-            let target = staging.path().join(path);
-            if let Some(folder) = target.parent() {
+        for (path, _) in &self.files {
+            if let Some(folder) = staging.path().join(path).parent() {
                 std::fs::create_dir_all(folder).map_err(|e| Error::io(folder, e))?;
             }
-            std::fs::write(&target, data).map_err(|e| Error::io(&target, e))?;
         }
+        // One thread per file: the large vector files are written side by side.
+        std::thread::scope(|scope| {
+            let writers: Vec<_> = self
+                .files
+                .iter()
+                .map(|(path, data)| {
+                    let target = staging.path().join(path);
+                    scope.spawn(move || {
+                        std::fs::write(&target, data).map_err(|e| Error::io(&target, e))
+                    })
+                })
+                .collect();
+            writers
+                .into_iter()
+                .try_for_each(|w| w.join().expect("writing does not panic"))
+        })?;
         let staged = staging.keep();
         let replaced = if out.exists() {
             let old = parent.join(format!(

@@ -102,7 +102,7 @@ pub struct Vectors {
 /// Samples of the full-scale segment at each polarity.
 const FULL_SCALE_SAMPLES: usize = 64;
 /// Largest |z| searched for a tie case.
-const TIE_SEARCH_LIMIT: i64 = 1 << 20;
+const TIE_SEARCH_LIMIT: i64 = 1 << 16;
 
 /// Builds the schedule for `stimulus` and runs the models over it.
 pub fn build(plan: &Plan, stimulus: &Stimulus) -> Vectors {
@@ -225,25 +225,31 @@ pub fn build(plan: &Plan, stimulus: &Stimulus) -> Vectors {
     }
 }
 
-/// For each ROM entry, the smallest |z| (positive first) that from reset lands each
-/// quantization point exactly on a tie.
+/// For each ROM entry, an input that from reset lands each quantization point exactly on a
+/// tie. From reset a state update is `Q(g·z·2^a)`, which is a tie only when `z`'s lowest set
+/// bit sits at one particular position, so powers of two (both signs) are tried first; then
+/// every |z| up to [`TIE_SEARCH_LIMIT`] (positive first) for what is still missing.
 fn find_ties(plan: &Plan) -> Vec<TieCases> {
     let kf = FixedKf::new(plan);
-    let limit = TIE_SEARCH_LIMIT.min(plan.input.max_code() as i64);
+    let max = plan.input.max_code() as i64;
+    let limit = TIE_SEARCH_LIMIT.min(max);
+    let powers = (0..plan.input.width - 1).map(|bit| 1i64 << bit);
+    let candidates: Vec<i64> = powers
+        .chain(1..=limit)
+        .flat_map(|magnitude| [magnitude, -magnitude])
+        .collect();
     (0..plan.rom.len())
         .map(|bw_sel| {
             let mut found: [Option<i64>; 3] = [None; 3];
-            'search: for magnitude in 1..=limit {
-                for z in [magnitude, -magnitude] {
-                    let ties = kf.ties(z, bw_sel);
-                    for (slot, tie) in found.iter_mut().zip(ties) {
-                        if tie && slot.is_none() {
-                            *slot = Some(z);
-                        }
+            for z in &candidates {
+                let ties = kf.ties(*z, bw_sel);
+                for (slot, tie) in found.iter_mut().zip(ties) {
+                    if tie && slot.is_none() {
+                        *slot = Some(*z);
                     }
-                    if found.iter().all(Option::is_some) {
-                        break 'search;
-                    }
+                }
+                if found.iter().all(Option::is_some) {
+                    break;
                 }
             }
             TieCases {

@@ -62,11 +62,28 @@ impl Provenance {
 
 /// Zero-padded two's-complement hex of `code` in `format`.
 pub fn hex(code: i128, format: Format) -> String {
-    format!(
-        "{:0width$x}",
-        format.to_bits(code),
-        width = format.hex_digits()
-    )
+    let mut out = String::with_capacity(format.hex_digits());
+    push_hex(&mut out, code, format);
+    out
+}
+
+/// Appends the zero-padded two's-complement hex of `code` in `format` to `out`.
+pub fn push_hex(out: &mut String, code: i128, format: Format) {
+    const DIGITS: &[u8; 16] = b"0123456789abcdef";
+    let bits = format.to_bits(code);
+    for i in (0..format.hex_digits()).rev() {
+        out.push(DIGITS[((bits >> (4 * i)) & 0xf) as usize] as char);
+    }
+}
+
+/// Appends `value` in the shortest form that reads back exactly (ryu: the same digits on
+/// every platform).
+fn push_real(out: &mut String, buffer: &mut ryu::Buffer, value: f64) {
+    out.push_str(buffer.format(value));
+}
+
+fn push_integer(out: &mut String, buffer: &mut itoa::Buffer, value: impl itoa::Integer) {
+    out.push_str(buffer.format(value));
 }
 
 /// Width of a ROM word: `g1` and `g2` side by side.
@@ -187,57 +204,86 @@ fn field_header(fields: &[(&'static str, String)]) -> String {
     format!("// {}\n", parts.join(" "))
 }
 
-/// The stimulus and expected vector files (hex, one line per clock-enable), and the CSV.
+/// The stimulus and expected vector files (hex, one line per clock-enable), and the CSV. The
+/// CSV is built on a second thread while the hex files are built on this one.
 pub fn vector_files(
     plan: &Plan,
     vectors: &Vectors,
     provenance: &Provenance,
 ) -> (String, String, String) {
+    std::thread::scope(|scope| {
+        let csv = scope.spawn(|| vector_csv(plan, vectors, provenance));
+        let (stimulus, expected) = vector_hex(plan, vectors, provenance);
+        (
+            stimulus,
+            expected,
+            csv.join().expect("the CSV writer does not panic"),
+        )
+    })
+}
+
+fn vector_hex(plan: &Plan, vectors: &Vectors, provenance: &Provenance) -> (String, String) {
     let select = Format::new(false, plan.select_width(), 0).expect("select width is small");
     let bit = Format::new(false, 1, 0).expect("1 bit");
     let rows = &vectors.rows;
     let mut stimulus = String::with_capacity(rows.len() * (plan.input.hex_digits() + 6) + 256);
     let mut expected = String::with_capacity(rows.len() * (plan.output.hex_digits() + 4) + 256);
-    let mut csv = String::with_capacity(rows.len() * 120 + 256);
     stimulus.push_str(&provenance.line("//"));
     stimulus.push('\n');
     stimulus.push_str(&field_header(&stimulus_fields(plan)));
     expected.push_str(&provenance.line("//"));
     expected.push('\n');
     expected.push_str(&field_header(&expected_fields(plan)));
+    for row in rows {
+        push_hex(&mut stimulus, i128::from(row.rst), bit);
+        stimulus.push(' ');
+        push_hex(&mut stimulus, row.bw_sel as i128, select);
+        stimulus.push(' ');
+        push_hex(&mut stimulus, i128::from(row.z), plan.input);
+        stimulus.push('\n');
+        push_hex(&mut expected, i128::from(row.valid), bit);
+        expected.push(' ');
+        push_hex(&mut expected, i128::from(row.rate), plan.output);
+        expected.push('\n');
+    }
+    (stimulus, expected)
+}
+
+fn vector_csv(plan: &Plan, vectors: &Vectors, provenance: &Provenance) -> String {
+    let rows = &vectors.rows;
+    let mut csv = String::with_capacity(rows.len() * 120 + 256);
     csv.push_str(&provenance.line("#"));
     csv.push_str("\nsample,segment,rst,bw_sel,z_code,z_dps,valid,rate_code,rate_dps,float_rate_dps,ideal_rate_dps,true_rate_dps\n");
+    let (mut real, mut int) = (ryu::Buffer::new(), itoa::Buffer::new());
     for (index, row) in rows.iter().enumerate() {
-        let _ = writeln!(
-            stimulus,
-            "{} {} {}",
-            hex(i128::from(row.rst), bit),
-            hex(row.bw_sel as i128, select),
-            hex(i128::from(row.z), plan.input)
-        );
-        let _ = writeln!(
-            expected,
-            "{} {}",
-            hex(i128::from(row.valid), bit),
-            hex(i128::from(row.rate), plan.output)
-        );
-        let true_rate = row.true_rate.map(|t| t.to_string()).unwrap_or_default();
-        let _ = writeln!(
-            csv,
-            "{index},{},{},{},{},{},{},{},{},{},{},{true_rate}",
-            row.segment.name(),
-            u8::from(row.rst),
-            row.bw_sel,
-            row.z,
-            plan.input.to_f64(i128::from(row.z)),
-            u8::from(row.valid),
-            row.rate,
+        push_integer(&mut csv, &mut int, index);
+        csv.push(',');
+        csv.push_str(row.segment.name());
+        csv.push_str(if row.rst { ",1," } else { ",0," });
+        push_integer(&mut csv, &mut int, row.bw_sel);
+        csv.push(',');
+        push_integer(&mut csv, &mut int, row.z);
+        csv.push(',');
+        push_real(&mut csv, &mut real, plan.input.to_f64(i128::from(row.z)));
+        csv.push_str(if row.valid { ",1," } else { ",0," });
+        push_integer(&mut csv, &mut int, row.rate);
+        csv.push(',');
+        push_real(
+            &mut csv,
+            &mut real,
             plan.output.to_f64(i128::from(row.rate)),
-            row.float_rate,
-            row.ideal_rate,
         );
+        csv.push(',');
+        push_real(&mut csv, &mut real, row.float_rate);
+        csv.push(',');
+        push_real(&mut csv, &mut real, row.ideal_rate);
+        csv.push(',');
+        if let Some(t) = row.true_rate {
+            push_real(&mut csv, &mut real, t);
+        }
+        csv.push('\n');
     }
-    (stimulus, expected, csv)
+    csv
 }
 
 /// The self-checking testbench.

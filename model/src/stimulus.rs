@@ -2,7 +2,8 @@
 //!
 //! Every random number comes from ChaCha12 (`rand_chacha`, whose output is specified and the
 //! same on every platform) with one stream per noise source, and Gaussian samples come from
-//! Box–Muller with the pure-Rust `libm` — so one seed gives byte-identical vectors everywhere.
+//! Marsaglia's polar method with the pure-Rust `libm` — so one seed gives byte-identical
+//! vectors everywhere.
 //! Nothing here calls the platform's libm.
 
 use rand_chacha::ChaCha12Rng;
@@ -39,17 +40,27 @@ impl Gaussian {
         (self.rng.next_u64() >> 11) as f64 * crate::fx::pow2(-53)
     }
 
-    /// Standard normal sample (Box–Muller, pure-Rust libm).
+    /// Standard normal sample (Marsaglia's polar method: one `libm::log` per pair, no
+    /// trigonometry; `sqrt` is exactly rounded everywhere).
     pub fn sample(&mut self) -> f64 {
         if let Some(z) = self.spare.take() {
             return z;
         }
-        let u1 = 1.0 - self.uniform(); // (0, 1]: ln is finite
-        let u2 = self.uniform();
-        let radius = (-2.0 * libm::log(u1)).sqrt();
-        let angle = 2.0 * std::f64::consts::PI * u2;
-        self.spare = Some(radius * libm::sin(angle));
-        radius * libm::cos(angle)
+        loop {
+            let u = 2.0 * self.uniform() - 1.0;
+            let v = 2.0 * self.uniform() - 1.0;
+            let s = u * u + v * v;
+            if s > 0.0 && s < 1.0 {
+                let factor = (-2.0 * libm::log(s) / s).sqrt();
+                self.spare = Some(v * factor);
+                return u * factor;
+            }
+        }
+    }
+
+    /// `count` standard normal samples scaled by `sigma`.
+    pub fn samples(&mut self, count: usize, sigma: f64) -> Vec<f64> {
+        (0..count).map(|_| sigma * self.sample()).collect()
     }
 }
 
@@ -120,16 +131,24 @@ impl SingleGyro {
         let t = 1.0 / self.fs_hz;
         let white_sigma = self.arw_deg_per_sqrt_h / 60.0 / t.sqrt();
         let walk_sigma = self.rrw_deg_per_h_per_sqrt_h / 216_000.0 * t.sqrt();
-        let mut white = Gaussian::new(seed, Stream::AngleRandomWalk);
-        let mut walk = Gaussian::new(seed, Stream::RateRandomWalk);
+        // The streams are independent, so they are drawn on two threads.
+        let (white, steps) = std::thread::scope(|scope| {
+            let steps = scope
+                .spawn(|| Gaussian::new(seed, Stream::RateRandomWalk).samples(samples, walk_sigma));
+            let white = Gaussian::new(seed, Stream::AngleRandomWalk).samples(samples, white_sigma);
+            (
+                white,
+                steps.join().expect("the noise generator does not panic"),
+            )
+        });
         let mut bias = self.initial_bias_dps;
         let mut true_rate = Vec::with_capacity(samples);
         let mut analog = Vec::with_capacity(samples);
         for k in 0..samples {
             let omega = self.scenario.rate_at(k as f64 * t);
             true_rate.push(omega);
-            analog.push(omega + bias + white_sigma * white.sample());
-            bias += walk_sigma * walk.sample();
+            analog.push(omega + bias + white[k]);
+            bias += steps[k];
         }
         Record { true_rate, analog }
     }
