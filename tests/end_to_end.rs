@@ -81,6 +81,10 @@ fn a_vector_file_with_other_formats_or_missing_is_refused() {
     std::fs::remove_file(&stimulus).unwrap();
     let log = fails(&["verify", "--out", &out, "--sim", "iverilog"]);
     assert!(log.contains("cannot open kf_stimulus.hex"), "{log}");
+
+    std::fs::remove_file(dir.path().join("pkg/kf/kf_coefficients.mem")).unwrap();
+    let log = fails(&["verify", "--out", &out, "--sim", "iverilog"]);
+    assert!(log.contains("cannot open kf_coefficients.mem"), "{log}");
 }
 
 /// Every rounding mode, and wrap-around overflow, through the RTL: the quantizer's six modes

@@ -15,6 +15,9 @@ use gyrofx_model::stimulus::Scenario;
 
 use crate::error::{Error, Result};
 
+/// Largest `samples`: the vector set and its files are built in memory.
+pub const MAX_SAMPLES: usize = 20_000_000;
+
 /// The embedded, annotated default config (`gyrofx init` prints it).
 pub const DEFAULT_TOML: &str = include_str!("default.toml");
 
@@ -255,8 +258,9 @@ impl Config {
     /// # Errors
     /// [`Error::Config`] naming the first bad field.
     pub fn validate(&self) -> Result<(Source, KfSettings)> {
-        if self.samples == 0 || self.samples > 100_000_000 {
-            return Err(Error::config("samples", self.samples, "1..=100000000"));
+        // The vector set is built in memory (~300 bytes a sample with its text files).
+        if self.samples == 0 || self.samples > MAX_SAMPLES {
+            return Err(Error::config("samples", self.samples, format!("1..={MAX_SAMPLES}")));
         }
         let s = &self.stimulus;
         positive("stimulus.fs_hz", s.fs_hz)?;

@@ -25,7 +25,8 @@ module tb_gyrofx_kf;
 
 localparam integer KF_MAX_REPORTED = 10;
 localparam integer CLOCK_PERIOD_NS = 10;
-localparam integer TIMEOUT_NS = (KF_VECTOR_COUNT * 3 + 100) * CLOCK_PERIOD_NS;
+// 64-bit: long vector sets overflow a 32-bit integer.
+localparam [63:0] TIMEOUT_NS = (64'd3 * KF_VECTOR_COUNT + 64'd100) * CLOCK_PERIOD_NS;
 
 reg clk = 1'b0;
 always #(CLOCK_PERIOD_NS / 2) clk <= ~clk;
@@ -51,6 +52,7 @@ gyrofx_kf #(
     .rate_out(rate_out), .out_valid(out_valid)
 );
 
+integer rom_fd;
 integer stimulus_fd;
 integer expected_fd;
 integer fields;
@@ -107,6 +109,13 @@ initial begin
 end
 
 initial begin
+    // $readmemh in the DUT only warns about a missing file (Icarus): check it here.
+    rom_fd = $fopen(KF_ROM_FILE, "r");
+    if (rom_fd == 0) begin
+        $sformat(message, "cannot open %0s", KF_ROM_FILE);
+        fail_setup;
+    end
+    $fclose(rom_fd);
     stimulus_fd = $fopen(KF_STIMULUS_FILE, "r");
     if (stimulus_fd == 0) begin
         $sformat(message, "cannot open %0s", KF_STIMULUS_FILE);
