@@ -260,7 +260,11 @@ impl Config {
     pub fn validate(&self) -> Result<(Source, KfSettings)> {
         // The vector set is built in memory (~300 bytes a sample with its text files).
         if self.samples == 0 || self.samples > MAX_SAMPLES {
-            return Err(Error::config("samples", self.samples, format!("1..={MAX_SAMPLES}")));
+            return Err(Error::config(
+                "samples",
+                self.samples,
+                format!("1..={MAX_SAMPLES}"),
+            ));
         }
         let s = &self.stimulus;
         positive("stimulus.fs_hz", s.fs_hz)?;

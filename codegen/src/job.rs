@@ -139,3 +139,33 @@ impl Job {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The model's worked example (used by its tests and benchmarks) is the embedded default.
+    #[test]
+    fn the_embedded_default_is_the_models_example() {
+        let job = Job::new(Config::embedded()).unwrap();
+        let example = Plan::new(&gyrofx_model::examples::kf_spec()).unwrap();
+        assert_eq!(job.plan, example);
+        let gyro = gyrofx_model::examples::gyro();
+        let s = &job.config.stimulus;
+        assert_eq!(
+            (
+                s.fs_hz,
+                s.initial_bias_dps,
+                s.arw_deg_per_sqrt_h,
+                s.rrw_deg_per_h_per_sqrt_h
+            ),
+            (
+                gyro.fs_hz,
+                gyro.initial_bias_dps,
+                gyro.arw_deg_per_sqrt_h,
+                gyro.rrw_deg_per_h_per_sqrt_h
+            )
+        );
+        assert_eq!(job.source, Source::Synthetic(gyro.scenario));
+    }
+}

@@ -179,16 +179,7 @@ mod tests {
 
     #[test]
     fn same_seed_same_record_other_seed_other_record() {
-        let gyro = SingleGyro {
-            fs_hz: 200.0,
-            scenario: Scenario::Sine {
-                amplitude_dps: 20.0,
-                frequency_hz: 0.5,
-            },
-            initial_bias_dps: 0.5,
-            arw_deg_per_sqrt_h: 4.87,
-            rrw_deg_per_h_per_sqrt_h: 1200.0,
-        };
+        let gyro = crate::examples::gyro();
         let a = gyro.simulate(1000, 7);
         assert_eq!(a, gyro.simulate(1000, 7));
         assert_ne!(a.analog, gyro.simulate(1000, 8).analog);

@@ -1,49 +1,22 @@
-use super::design::{design_for_bandwidth, Convergence, Method, Noise};
 use super::*;
 use crate::fx::{Format, Overflow, Rounding};
-use crate::stimulus::{adc, Scenario, SingleGyro};
+use crate::stimulus::adc;
 use proptest::prelude::*;
 
 fn fmt(text: &str) -> Format {
     text.parse().unwrap()
 }
 
-/// The default design: paper 000's gyro (ARW 4.87 °/√h, RRW 1200 °/h^1.5) at 200 Hz,
-/// bandwidths 10/20/30 Hz, s24.14 in and out, s36.26 state, 18-bit coefficients.
 fn default_spec() -> Spec {
-    let noise = Noise::from_gyro_units(4.87, 1200.0, 0.0);
-    let gains = [10.0, 20.0, 30.0]
-        .iter()
-        .map(|bw| {
-            design_for_bandwidth(*bw, noise, 200.0, Method::Direct, Convergence::default())
-                .unwrap()
-                .g
-        })
-        .collect();
-    Spec {
-        input: fmt("s24.14"),
-        state: fmt("s36.26"),
-        output: fmt("s24.14"),
-        coefficients: [CoefficientFormat::Auto { width: 18 }; 2],
-        rounding: Rounding::Nearest,
-        overflow: Overflow::Saturate,
-        gains,
-        labels: vec!["10 Hz".into(), "20 Hz".into(), "30 Hz".into()],
-    }
+    crate::examples::kf_spec()
 }
 
 fn default_input(samples: usize, seed: u64) -> Vec<i64> {
-    let gyro = SingleGyro {
-        fs_hz: 200.0,
-        scenario: Scenario::Sine {
-            amplitude_dps: 20.0,
-            frequency_hz: 0.5,
-        },
-        initial_bias_dps: 0.5,
-        arw_deg_per_sqrt_h: 4.87,
-        rrw_deg_per_h_per_sqrt_h: 1200.0,
-    };
-    adc(&gyro.simulate(samples, seed).analog, fmt("s24.14")).0
+    adc(
+        &crate::examples::gyro().simulate(samples, seed).analog,
+        fmt("s24.14"),
+    )
+    .0
 }
 
 #[test]
