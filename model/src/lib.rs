@@ -5,7 +5,9 @@
 //! contents), and both the models here and the writers in `gyrofx-codegen` read that plan.
 #![warn(missing_docs)]
 
+pub mod estimator;
 pub mod examples;
 pub mod fx;
 pub mod kf;
+pub mod sequencer;
 pub mod stimulus;

@@ -69,6 +69,48 @@ pub enum FxError {
     },
 }
 
+/// How a coefficient's format is chosen.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CoefficientFormat {
+    /// Signed, this width, and the most fraction bits for which every value fits (see
+    /// [`fitting_format`]): each coefficient gets its own scaling.
+    Auto {
+        /// Word length in bits (e.g. 18 for a DSP48 multiplier port).
+        width: u32,
+    },
+    /// Exactly this format; values that do not fit are an error.
+    Fixed(Format),
+}
+
+/// Signed `width` bits and the most fraction bits for which every value fits after rounding to
+/// nearest (ties to even). Exact: uses the binary exponent of the largest magnitude
+/// (`libm::frexp`).
+///
+/// # Errors
+/// [`FxError::Width`] for a width outside 1..=64.
+pub fn fitting_format(values: &[f64], width: u32) -> Result<Format, FxError> {
+    Format::signed(width, 0)?;
+    let largest = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if largest == 0.0 || !largest.is_finite() {
+        return Format::signed(width, width as i32 - 1);
+    }
+    // largest = mantissa · 2^exponent with mantissa in [0.5, 1): |v| < 2^exponent.
+    let (_, exponent) = libm::frexp(largest);
+    let mut frac = width as i32 - 1 - exponent;
+    loop {
+        let format = Format::signed(width, frac)?;
+        let fits = values.iter().all(|v| {
+            from_f64(*v, format, Rounding::Convergent, Overflow::Saturate)
+                .map(|q| !q.overflowed)
+                .unwrap_or(false)
+        });
+        if fits {
+            return Ok(format);
+        }
+        frac -= 1;
+    }
+}
+
 /// `2^exp` as f64, exact for -1074 <= exp <= 1023 (pure bit construction: no libm).
 pub fn pow2(exp: i32) -> f64 {
     libm::ldexp(1.0, exp)

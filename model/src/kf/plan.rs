@@ -5,20 +5,8 @@
 
 use std::fmt;
 
+pub use crate::fx::CoefficientFormat;
 use crate::fx::{from_f64, Format, FxError, Overflow, Rounding};
-
-/// How a coefficient's format is chosen.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum CoefficientFormat {
-    /// Signed, this width, and the most fraction bits for which every ROM entry fits: each
-    /// coefficient gets its own scaling, because `g2` is typically ~10⁻⁶ of `g1`.
-    Auto {
-        /// Word length in bits (e.g. 18 for a DSP48 multiplier port).
-        width: u32,
-    },
-    /// Exactly this format; entries that do not fit are an error.
-    Fixed(Format),
-}
 
 /// What the user (or config) specifies; [`Plan::new`] validates and resolves it.
 #[derive(Clone, Debug, PartialEq)]
@@ -230,12 +218,11 @@ impl Plan {
             let values: Vec<f64> = spec.gains.iter().map(|g| g[i]).collect();
             coefficient[i] = match spec.coefficients[i] {
                 CoefficientFormat::Fixed(format) => format,
-                CoefficientFormat::Auto { width } => {
-                    auto_format(&values, width).map_err(|source| PlanError::Intermediate {
+                CoefficientFormat::Auto { width } => crate::fx::fitting_format(&values, width)
+                    .map_err(|source| PlanError::Intermediate {
                         node: COEFFICIENT_NAMES[i],
                         source,
-                    })?
-                }
+                    })?,
             };
             if coefficient[i].frac < 0 {
                 return Err(PlanError::Format {
@@ -345,31 +332,6 @@ impl fmt::Display for Plan {
             self.coefficient[0],
             self.coefficient[1]
         )
-    }
-}
-
-/// Signed `width` bits, and the most fraction bits for which every value fits after rounding
-/// to nearest. Exact: uses the binary exponent of the largest magnitude (`libm::frexp`).
-fn auto_format(values: &[f64], width: u32) -> Result<Format, FxError> {
-    Format::signed(width, 0)?;
-    let largest = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    if largest == 0.0 {
-        return Format::signed(width, width as i32 - 1);
-    }
-    // largest = mantissa · 2^exponent with mantissa in [0.5, 1): |v| < 2^exponent.
-    let (_, exponent) = libm::frexp(largest);
-    let mut frac = width as i32 - 1 - exponent;
-    loop {
-        let format = Format::signed(width, frac)?;
-        let fits = values.iter().all(|v| {
-            from_f64(*v, format, Rounding::Convergent, Overflow::Saturate)
-                .map(|q| !q.overflowed)
-                .unwrap_or(false)
-        });
-        if fits {
-            return Ok(format);
-        }
-        frac -= 1;
     }
 }
 
