@@ -9,5 +9,6 @@ pub mod estimator;
 pub mod examples;
 pub mod fx;
 pub mod kf;
+pub mod plant;
 pub mod sequencer;
 pub mod stimulus;

@@ -11,13 +11,27 @@ use rand_core::{RngCore, SeedableRng};
 
 use crate::fx::{from_f64, Format, Overflow, Rounding};
 
-/// Independent random streams, one per noise source.
+/// Independent random streams, one per noise source and gyro.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Stream {
-    /// White rate noise (ARW).
-    AngleRandomWalk = 1,
-    /// Bias random walk (RRW).
-    RateRandomWalk = 2,
+    /// White rate noise (ARW) of gyro `0` or `1`.
+    AngleRandomWalk(u8),
+    /// Bias random walk (RRW) of a gyro.
+    RateRandomWalk(u8),
+    /// Gauss–Markov process `index` of a gyro's bias instability.
+    BiasInstability(u8, u8),
+}
+
+impl Stream {
+    /// The ChaCha stream number: distinct for every source, gyro and process.
+    pub fn id(self) -> u64 {
+        let (source, gyro) = match self {
+            Stream::AngleRandomWalk(g) => (1, g),
+            Stream::RateRandomWalk(g) => (2, g),
+            Stream::BiasInstability(g, j) => (16 + u64::from(j), g),
+        };
+        source + 1024 * u64::from(gyro)
+    }
 }
 
 /// A seeded Gaussian source on its own ChaCha12 stream.
@@ -31,7 +45,7 @@ impl Gaussian {
     /// The stream `stream` of seed `seed`.
     pub fn new(seed: u64, stream: Stream) -> Self {
         let mut rng = ChaCha12Rng::seed_from_u64(seed);
-        rng.set_stream(stream as u64);
+        rng.set_stream(stream.id());
         Gaussian { rng, spare: None }
     }
 
@@ -67,6 +81,18 @@ impl Gaussian {
 /// The true input rate Ω(t), °/s.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Scenario {
+    /// Ω alternates between 0 and `rate_dps` every `period_s` (a turntable step test).
+    Steps {
+        /// Rate of the high steps, °/s.
+        rate_dps: f64,
+        /// Duration of each step, s.
+        period_s: f64,
+    },
+    /// Ω = `slope_dps_per_s · t`.
+    Ramp {
+        /// Slope, °/s per s.
+        slope_dps_per_s: f64,
+    },
     /// Ω = 0 (gyro at rest).
     Static,
     /// Ω = `rate_dps`.
@@ -87,6 +113,14 @@ impl Scenario {
     /// Ω at time `t_s` seconds (pure-Rust `libm::sin`).
     pub fn rate_at(&self, t_s: f64) -> f64 {
         match *self {
+            Scenario::Steps { rate_dps, period_s } => {
+                if (t_s / period_s) as u64 % 2 == 1 {
+                    rate_dps
+                } else {
+                    0.0
+                }
+            }
+            Scenario::Ramp { slope_dps_per_s } => slope_dps_per_s * t_s,
             Scenario::Static => 0.0,
             Scenario::Constant { rate_dps } => rate_dps,
             Scenario::Sine {
@@ -133,9 +167,11 @@ impl SingleGyro {
         let walk_sigma = self.rrw_deg_per_h_per_sqrt_h / 216_000.0 * t.sqrt();
         // The streams are independent, so they are drawn on two threads.
         let (white, steps) = std::thread::scope(|scope| {
-            let steps = scope
-                .spawn(|| Gaussian::new(seed, Stream::RateRandomWalk).samples(samples, walk_sigma));
-            let white = Gaussian::new(seed, Stream::AngleRandomWalk).samples(samples, white_sigma);
+            let steps = scope.spawn(|| {
+                Gaussian::new(seed, Stream::RateRandomWalk(0)).samples(samples, walk_sigma)
+            });
+            let white =
+                Gaussian::new(seed, Stream::AngleRandomWalk(0)).samples(samples, white_sigma);
             (
                 white,
                 steps.join().expect("the noise generator does not panic"),
