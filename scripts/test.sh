@@ -33,6 +33,6 @@ cargo fmt --all -- --check
 echo "== cargo clippy --all-targets -D warnings"
 cargo clippy --workspace --all-targets --quiet -- -D warnings
 echo "== verilator --lint-only -Wall (hdl/)"
-verilator --lint-only -Wall --top-module gyrofx_kf hdl/gyrofx_quantize.v hdl/gyrofx_kf.v
+verilator --lint-only -Wall --top-module gyrofx_top hdl/*.v
 echo "== cargo test"
 cargo test --workspace

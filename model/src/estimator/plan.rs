@@ -227,6 +227,36 @@ impl Plan {
         let reciprocal = resolve(spec.reciprocal, &[inverse], "recip")?;
         let reciprocal_code = quantize("1/(L-M)".into(), inverse, reciprocal)?;
 
+        // Every quantization point only drops fraction bits (as the RTL's requantizer does).
+        let checks = [
+            (
+                "mean_format",
+                spec.mean,
+                spec.input.frac + reciprocal.frac,
+                "at most input + reciprocal fraction bits",
+            ),
+            (
+                "bias_format",
+                spec.bias,
+                gain.frac + spec.mean.frac,
+                "at most gain + mean fraction bits",
+            ),
+            (
+                "calibrated_format",
+                spec.calibrated,
+                spec.input.frac.max(spec.bias.frac),
+                "at most max(input, bias) fraction bits",
+            ),
+        ];
+        for (field, format, limit, reason) in checks {
+            if format.frac > limit {
+                return Err(PlanError::Field {
+                    field,
+                    value: format.to_string(),
+                    reason,
+                });
+            }
+        }
         let node = |node: &'static str| move |source| PlanError::Intermediate { node, source };
         let count_bits = usize::BITS - (spec.schedule.interval_length).leading_zeros();
         let accumulator =
