@@ -92,8 +92,15 @@ assign interval_a = interval_a_reg;
 assign interval_b = interval_b_reg;
 assign mode_a = PATTERN[interval_a_reg];
 assign mode_b = ~PATTERN[interval_b_reg];
-assign blank_a = phase_a_reg < BLANK_PHASES;
-assign blank_b = phase_b_reg < BLANK_PHASES;
+generate
+    if (BLANK == 0) begin : g_no_blanking
+        assign blank_a = 1'b0;
+        assign blank_b = 1'b0;
+    end else begin : g_blanking
+        assign blank_a = phase_a_reg < BLANK_PHASES;
+        assign blank_b = phase_b_reg < BLANK_PHASES;
+    end
+endgenerate
 assign done_a = phase_a_reg == LAST_PHASE;
 assign done_b = phase_b_reg == LAST_PHASE;
 assign window_done = done_b && interval_b_reg == LAST_INTERVAL && b_started_reg;

@@ -7,7 +7,7 @@ use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
 
 use gyrofx_codegen::config::{Config, DEFAULT_TOML};
-use gyrofx_codegen::generate::generate;
+use gyrofx_codegen::generate::{generate, provenance};
 use gyrofx_codegen::input::read_column;
 use gyrofx_codegen::job::{design_bandwidths, plan_for, Job};
 use gyrofx_codegen::report;
@@ -29,8 +29,12 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Print the annotated default config (a starting point for --config).
-    Init,
+    /// Print the annotated default config, or a preset (an overlay of it).
+    Init {
+        /// gu2019 (paper 004), xue2015 (paper 000) or mpu6050.
+        #[arg(long)]
+        preset: Option<String>,
+    },
     /// Design the steady-state KF gain and quantize it.
     Design {
         /// Random-walk intensity of the true rate, (°/s)²/s (sets the bandwidth).
@@ -63,10 +67,13 @@ enum Command {
         /// Output folder (replaced only if empty or a previous gyrofx output).
         #[arg(long)]
         out: PathBuf,
-        /// Config file (TOML, overlays the embedded default).
+        /// Config file (TOML, overlays the embedded default and the preset).
         #[arg(long)]
         config: Option<PathBuf>,
-        /// Stimulus samples (overrides the config).
+        /// Start from a preset: gu2019, xue2015, mpu6050.
+        #[arg(long)]
+        preset: Option<String>,
+        /// Samples of the chain run (overrides the config).
         #[arg(long)]
         samples: Option<usize>,
         /// Seed (overrides the config).
@@ -118,8 +125,11 @@ fn main() -> ExitCode {
 
 fn run(cli: Cli) -> Result<ExitCode> {
     match cli.command {
-        Command::Init => {
-            print!("{DEFAULT_TOML}");
+        Command::Init { preset } => {
+            match preset {
+                Some(name) => print!("{}", gyrofx_codegen::config::preset(&name)?),
+                None => print!("{DEFAULT_TOML}"),
+            }
             Ok(ExitCode::SUCCESS)
         }
         Command::Design {
@@ -135,9 +145,10 @@ fn run(cli: Cli) -> Result<ExitCode> {
         Command::Generate {
             out,
             config,
+            preset,
             samples,
             seed,
-        } => run_generate(&out, config.as_deref(), samples, seed),
+        } => run_generate(&out, preset.as_deref(), config.as_deref(), samples, seed),
         Command::Verify { out, sim } => run_verify(&out, &sim),
         Command::Filter {
             input,
@@ -246,11 +257,12 @@ fn run_design(
 
 fn run_generate(
     out: &Path,
+    preset: Option<&str>,
     config_path: Option<&Path>,
     samples: Option<usize>,
     seed: Option<u64>,
 ) -> Result<ExitCode> {
-    let mut config = load_config(config_path)?;
+    let mut config = Config::from_preset_and_file(preset, config_path)?;
     if let Some(n) = samples {
         config.samples = n;
     }
@@ -260,31 +272,65 @@ fn run_generate(
     let job = Job::new(config)?;
     let bar = indicatif::ProgressBar::new_spinner();
     let long = job.config.samples >= 1_000_000;
-    let summary = generate(&job, out, config_path, &mut |phase| {
+    let provenance = provenance(&job, preset, config_path);
+    let summary = generate(&job, out, &provenance, &mut |phase| {
         if long {
             bar.set_message(format!("generate: {phase}"));
             bar.tick();
         }
     })?;
     bar.finish_and_clear();
-    let stats = &summary.vectors.stats;
+    let run = &summary.run;
     println!(
-        "wrote {} files to {}: {} vectors ({} stimulus samples)",
+        "wrote {} files to {}: {} chain samples; vectors: {}",
         summary.files.len(),
         out.display(),
-        summary.vectors.rows.len(),
-        stats.samples
+        run.samples,
+        run.blocks
+            .iter()
+            .map(|b| format!("{} {}", b.name, b.len()))
+            .collect::<Vec<_>>()
+            .join(", ")
     );
-    println!("kf plan: {}", job.plan);
+    println!("kf plan: {}", job.kf());
+    for (what, s) in [
+        ("kf", &run.kf_stats),
+        ("chain", &run.chain_stats),
+        ("bias", &run.bias_stats),
+    ] {
+        println!(
+            "{what} fixed vs float: max {:.3} LSB, rms {:.3} LSB, bound {:.3} LSB; vs ideal: max {:.3} LSB, SQNR {:.1} dB",
+            s.max_lsb, s.rms_lsb, s.bound_lsb, s.ideal_max_lsb, s.sqnr_db
+        );
+    }
+    let o = &run.overflows;
     println!(
-        "fixed vs float: max {:.3} LSB, rms {:.3} LSB, bound {:.3} LSB; vs ideal gains: max {:.3} LSB, SQNR {:.1} dB",
-        stats.max_lsb, stats.rms_lsb, stats.bound_lsb, stats.ideal_max_lsb, stats.sqnr_db
+        "overflows: ADC {:?}, means {:?}, biases {:?}, calibrated {:?}, combined {}, KF x1 {} x2 {} rate_hat {} (directed segment: x1 {} x2 {} rate_hat {})",
+        o.adc, o.estimator.mean, o.estimator.bias, o.estimator.calibrated, o.estimator.combined,
+        o.kf_chain.x1, o.kf_chain.x2, o.kf_chain.rate_hat, o.kf_directed.x1, o.kf_directed.x2, o.kf_directed.rate_hat
     );
-    let o = summary.vectors.overflow;
     println!(
-        "overflows: x1 {}, x2 {}, rate_hat {}; ADC saturations {}",
-        o.x1, o.x2, o.rate_hat, summary.adc_saturations
+        "report ({} s):",
+        run.report
+            .tau_s
+            .iter()
+            .map(|t| t.to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
     );
+    for line in &run.report.lines {
+        let adev: Vec<String> = line
+            .adev_dps
+            .iter()
+            .map(|a| a.map(|v| format!("{v:.3e}")).unwrap_or_else(|| "-".into()))
+            .collect();
+        println!(
+            "  {:<26} bias error {:>+10.3e} °/s, ADEV {}",
+            line.signal,
+            line.bias_error_dps,
+            adev.join(" ")
+        );
+    }
     Ok(ExitCode::SUCCESS)
 }
 
@@ -319,7 +365,7 @@ fn run_filter(
     if let Some(bw) = bandwidth {
         config.kf.bandwidths_hz = vec![bw];
     }
-    let (_, settings) = config.validate()?;
+    let settings = config.validate()?.kf;
     let designs = design_bandwidths(
         &settings,
         fs,

@@ -113,6 +113,41 @@ fn negative_or_zero_variances_and_sample_rates() {
 }
 
 #[test]
+fn bad_mode_reversal_settings() {
+    refused(
+        "[sequencer]\nblank = 150\n",
+        &["sequencer.blank = 150", "less than interval_length = 150"],
+    );
+    refused(
+        "[sequencer]\nstagger = 150\n",
+        &["sequencer.stagger = 150", "less than interval_length = 150"],
+    );
+    refused(
+        "[sequencer]\ninterval_length = 0\n",
+        &["sequencer.interval_length = 0", "at least 1"],
+    );
+    refused(
+        "[sequencer]\nintervals = 1\n",
+        &["sequencer.intervals = 1", "2..=256"],
+    );
+    refused(
+        "[sequencer]\nintervals = 2\n[estimator]\nrate_order = 1\n",
+        &["rank-deficient", "intervals = 2, rate_order = 1"],
+    );
+    refused(
+        "[sequencer]\npattern = \"abba\"\nintervals = 6\n",
+        &["sequencer.intervals = 6", "multiple of 4"],
+    );
+    refused(
+        "[estimator]\ngain_width = 1\n",
+        &[
+            "estimator: coefficient gA[mA0]",
+            "quantizes to zero in s1.1",
+        ],
+    );
+}
+
+#[test]
 fn a_coefficient_that_does_not_fit() {
     // g1 of the 30 Hz entry is about 0.58: s18.18 holds only [-0.5, 0.5).
     refused(

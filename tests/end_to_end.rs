@@ -16,32 +16,51 @@ fn generate_default(dir: &std::path::Path, samples: &str) -> String {
     out.to_string_lossy().into_owned()
 }
 
+fn pass_lines(log: &str) -> Vec<String> {
+    log.lines()
+        .filter(|l| l.starts_with("== ") || l.starts_with("PASS"))
+        .map(str::to_string)
+        .collect()
+}
+
 #[test]
-fn default_package_passes_in_icarus_and_verilator_and_a_flipped_bit_fails_both() {
+fn default_package_passes_in_icarus_and_verilator_and_a_flipped_bit_fails_every_block() {
     let dir = tempfile::tempdir().unwrap();
-    let out = generate_default(dir.path(), "10000");
+    let out = generate_default(dir.path(), "6000");
+    let root = std::path::Path::new(&out);
     for sim in ["iverilog", "verilator"] {
         let log = ok(&["verify", "--out", &out, "--sim", sim]);
-        assert!(log.contains("PASS n=10166"), "{sim}: {log}");
+        let lines = pass_lines(&log);
+        assert_eq!(lines.len(), 8, "{sim}: {log}");
+        for (pair, block) in lines.chunks(2).zip(BLOCKS) {
+            assert_eq!(pair[0], format!("== {block}"), "{sim}: {log}");
+            assert!(pair[1].starts_with("PASS n="), "{sim} {block}: {log}");
+        }
     }
-    let build_log = std::fs::read_to_string(dir.path().join("pkg/kf/verilator_build.log")).unwrap();
-    assert!(
-        !build_log.contains("%Warning"),
-        "Verilator warns on the testbench:\n{build_log}"
-    );
+    for block in BLOCKS {
+        let build_log =
+            std::fs::read_to_string(root.join(block).join("verilator_build.log")).unwrap();
+        assert!(
+            !build_log.contains("%Warning"),
+            "Verilator warns on the {block} testbench:\n{build_log}"
+        );
+    }
 
-    flip_expected_bit(std::path::Path::new(&out), 4321);
-    for sim in ["iverilog", "verilator"] {
-        let log = fails(&["verify", "--out", &out, "--sim", sim]);
-        assert!(
-            log.contains("MISMATCH sample 4321 signal rate_out"),
-            "{sim}: {log}"
-        );
-        assert!(
-            log.contains("FAIL mismatches=1 n=10166 first=4321"),
-            "{sim}: {log}"
-        );
+    for block in BLOCKS {
+        let signal = flip_expected_bit(root, block, 1234);
+        for sim in ["iverilog", "verilator"] {
+            let log = fails(&["verify", "--out", &out, "--sim", sim]);
+            assert!(
+                log.contains(&format!("MISMATCH sample 1234 signal {signal}")),
+                "{sim} {block}: {log}"
+            );
+            assert!(log.contains("FAIL mismatches=1 n="), "{sim} {block}: {log}");
+            // The other blocks still pass: -k runs them all.
+            assert_eq!(log.matches("PASS n=").count(), 3, "{sim} {block}: {log}");
+        }
+        flip_expected_bit(root, block, 1234);
     }
+    ok(&["verify", "--out", &out, "--sim", "iverilog"]);
 }
 
 #[test]
@@ -65,7 +84,7 @@ fn a_vector_file_with_other_formats_or_missing_is_refused() {
     std::fs::write(&stimulus, original.replacen("z:s24.14", "z:s24.13", 1)).unwrap();
     let log = fails(&["verify", "--out", &out, "--sim", "iverilog"]);
     assert!(
-        log.contains("declares formats rst:u1.0 bw_sel:u2.0 z:s24.13"),
+        log.contains("kf_stimulus.hex declares rst:u1.0 bw_sel:u2.0 z:s24.13; the testbench expects rst:u1.0 bw_sel:u2.0 z:s24.14"),
         "{log}"
     );
 
@@ -97,14 +116,14 @@ fn every_rounding_mode_and_wrapping_overflow_pass_in_icarus() {
         .map(|mode| {
             (
                 mode.to_string(),
-                format!("samples = 1500\n[kf]\nrounding = \"{mode}\"\nstate_format = \"s30.22\"\ncoefficient_width = 16\n"),
+                format!("samples = 1500\nrounding = \"{mode}\"\n[kf]\nstate_format = \"s30.22\"\ncoefficient_width = 16\n"),
             )
         })
         .collect();
     // A state with only ±2 °/s of range: the full-scale segment overflows and wraps.
     cases.push((
         "wrap".into(),
-        "samples = 1500\n[stimulus]\nrate_dps = 1.0\n[kf]\noverflow = \"wrap\"\nstate_format = \"s24.22\"\noutput_format = \"s20.14\"\n".into(),
+        "samples = 1500\noverflow = \"wrap\"\n[stimulus]\nrate_dps = 1.0\n[kf]\nstate_format = \"s24.22\"\noutput_format = \"s20.14\"\n".into(),
     ));
     for (name, toml) in cases {
         let config = write_config(dir.path(), &format!("{name}.toml"), &toml);
@@ -207,14 +226,25 @@ fn the_manifest_lists_every_file_with_its_sha256() {
     }
     assert_eq!(manifest["seed"], 1);
     assert_eq!(manifest["kf"]["formats"]["state"], "s36.26");
-    assert_eq!(manifest["kf"]["overflow_counts"]["x1"], 0);
+    assert_eq!(manifest["overflow_counts"]["kf_chain"]["x1"], 0);
+    for what in [
+        &manifest["kf"]["fixed_vs_float"],
+        &manifest["chain"]["fixed_vs_float"],
+        &manifest["estimator"]["fixed_vs_float_bias"],
+    ] {
+        assert!(
+            what["max_lsb"].as_f64().unwrap() <= what["bound_lsb"].as_f64().unwrap(),
+            "{what}"
+        );
+    }
+    assert_eq!(manifest["blocks"]["top"]["module"], "gyrofx_top");
     assert!(
         manifest["kf"]["fixed_vs_float"]["max_lsb"]
             .as_f64()
             .unwrap()
             <= 1.0
     );
-    assert_eq!(manifest["config"]["kf"]["rounding"], "nearest");
+    assert_eq!(manifest["config"]["rounding"], "nearest");
 }
 
 /// SHA-256 through `sha256sum`, independent of the code under test.
@@ -239,8 +269,8 @@ mod sha2_check {
 
 #[test]
 fn filter_agrees_with_the_generated_vectors() {
-    // The package's CSV holds the quantized input in °/s; filtering it at the first bandwidth
-    // must reproduce the expected codes up to the first bw_sel switch.
+    // The KF block's CSV holds its input (the chain's combined output) in °/s; filtering it
+    // at the first bandwidth must reproduce the expected codes up to the first bw_sel switch.
     let dir = tempfile::tempdir().unwrap();
     let out = generate_default(dir.path(), "1200");
     let csv = std::fs::read_to_string(dir.path().join("pkg/kf/kf_vectors.csv")).unwrap();
@@ -248,12 +278,12 @@ fn filter_agrees_with_the_generated_vectors() {
         .lines()
         .skip(2)
         .map(|l| l.split(',').map(str::to_string).collect::<Vec<String>>())
-        .take_while(|r| r[3] == "0" && r[2] == "0")
+        .take_while(|r| r[2] == "0" && r[1] == "0")
         .collect();
     assert!(rows.len() >= 100, "{}", rows.len());
     let mut input = String::from("t,rate_dps\n");
     for (k, r) in rows.iter().enumerate() {
-        input.push_str(&format!("{k},{}\n", r[5]));
+        input.push_str(&format!("{k},{}\n", r[4]));
     }
     let input_path = dir.path().join("in.csv");
     std::fs::write(&input_path, input).unwrap();
@@ -277,7 +307,7 @@ fn filter_agrees_with_the_generated_vectors() {
         .collect();
     assert_eq!(codes.len(), rows.len());
     for (k, (got, row)) in codes.iter().zip(&rows).enumerate() {
-        assert_eq!(*got, row[7], "sample {k}");
+        assert_eq!(*got, row[6], "sample {k}");
     }
     let _ = out;
 }
@@ -343,4 +373,38 @@ fn design_json_has_the_documented_fields() {
     let v: serde_json::Value = serde_json::from_str(&bw).unwrap();
     assert!((v["bandwidth_hz"].as_f64().unwrap() - 20.0).abs() < 1e-6);
     assert_ne!(v["k"], v["g"], "paper method: g = K (1 - e^-S)/S");
+}
+
+#[test]
+fn every_preset_generates_and_passes_in_icarus() {
+    let dir = tempfile::tempdir().unwrap();
+    for preset in ["gu2019", "xue2015", "mpu6050"] {
+        let text = ok(&["init", "--preset", preset]);
+        assert!(text.contains(&format!("Preset {preset}")), "{text}");
+        let out = dir.path().join(preset);
+        ok(&[
+            "generate",
+            "--preset",
+            preset,
+            "--samples",
+            "2500",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let log = ok(&[
+            "verify",
+            "--out",
+            out.to_str().unwrap(),
+            "--sim",
+            "iverilog",
+        ]);
+        assert_eq!(log.matches("PASS n=").count(), 4, "{preset}: {log}");
+        let manifest = std::fs::read_to_string(out.join("manifest.json")).unwrap();
+        assert!(manifest.contains(&format!("--preset {preset}")), "{preset}");
+    }
+    let log = fails(&["init", "--preset", "adxrs300"]);
+    assert!(
+        log.contains("preset = \"adxrs300\"") && log.contains("gu2019"),
+        "{log}"
+    );
 }

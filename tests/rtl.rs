@@ -63,6 +63,55 @@ fn verilator_lint_is_clean_for_several_parameter_sets() {
     }
 }
 
+const ALL_RTL: [&str; 6] = [
+    "gyrofx_quantize.v",
+    "gyrofx_kf.v",
+    "gyrofx_sequencer.v",
+    "gyrofx_bias_estimator.v",
+    "gyrofx_calibration.v",
+    "gyrofx_top.v",
+];
+
+#[test]
+fn the_whole_chain_lints_clean_for_several_parameter_sets() {
+    let dir = tempfile::tempdir().unwrap();
+    let sources: Vec<String> = ALL_RTL
+        .iter()
+        .map(|n| hdl(n).to_string_lossy().into_owned())
+        .collect();
+    let parameter_sets: [&[&str]; 3] = [
+        &[],
+        // ABBA over 8 intervals with stagger, smoothing and convergent rounding.
+        &[
+            "-GINTERVALS=8",
+            "-GINTERVAL_W=3",
+            "-GPATTERN=8'b10011001",
+            "-GSTAGGER=20",
+            "-GSMOOTH=3",
+            "-GROUNDING=5",
+        ],
+        // Two intervals, no blanking, floor rounding and wrapping.
+        &[
+            "-GINTERVALS=2",
+            "-GINTERVAL_W=1",
+            "-GPATTERN=2'b01",
+            "-GBLANK=0",
+            "-GROUNDING=0",
+            "-GSATURATE=0",
+        ],
+    ];
+    for params in parameter_sets {
+        let mut args = vec!["--lint-only", "-Wall", "--top-module", "gyrofx_top"];
+        args.extend_from_slice(params);
+        args.extend(sources.iter().map(String::as_str));
+        let (ok, text) = run("verilator", &args, dir.path());
+        assert!(
+            ok && text.trim().is_empty(),
+            "verilator -Wall {params:?}:\n{text}"
+        );
+    }
+}
+
 #[test]
 fn icarus_compiles_without_warnings() {
     let dir = tempfile::tempdir().unwrap();
@@ -75,6 +124,10 @@ fn icarus_compiles_without_warnings() {
             "kf.vvp",
             hdl("gyrofx_quantize.v").to_str().unwrap(),
             hdl("gyrofx_kf.v").to_str().unwrap(),
+            hdl("gyrofx_sequencer.v").to_str().unwrap(),
+            hdl("gyrofx_bias_estimator.v").to_str().unwrap(),
+            hdl("gyrofx_calibration.v").to_str().unwrap(),
+            hdl("gyrofx_top.v").to_str().unwrap(),
         ],
         dir.path(),
     );

@@ -8,9 +8,11 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use gyrofx_model::fx::{Format, Overflow, Rounding};
+use gyrofx_model::estimator::Spec as EstimatorSpec;
+use gyrofx_model::fx::{CoefficientFormat, Format, Overflow, Rounding};
 use gyrofx_model::kf::design::{Convergence, Method};
-use gyrofx_model::kf::CoefficientFormat;
+use gyrofx_model::plant::{GyroErrors, Plant};
+use gyrofx_model::sequencer::{Pattern, Schedule, ScheduleError};
 use gyrofx_model::stimulus::Scenario;
 
 use crate::error::{Error, Result};
@@ -27,15 +29,29 @@ pub const DEFAULT_TOML: &str = include_str!("default.toml");
 pub struct Config {
     /// Seed of every random stream.
     pub seed: u64,
-    /// Stimulus samples in the vector set.
+    /// Samples of the chain run.
     pub samples: usize,
-    /// The stimulus source.
+    /// Rounding mode name of every quantization point.
+    pub rounding: String,
+    /// Overflow mode name of every quantization point.
+    pub overflow: String,
+    /// The true rate.
     pub stimulus: StimulusConfig,
+    /// Gyro A's errors.
+    pub gyro_a: GyroConfig,
+    /// Gyro B's errors.
+    pub gyro_b: GyroConfig,
+    /// Plant-wide settings.
+    pub plant: PlantConfig,
+    /// The sequencer.
+    pub sequencer: SequencerConfig,
+    /// The bias estimator.
+    pub estimator: EstimatorConfig,
     /// The Kalman filter.
     pub kf: KfConfig,
 }
 
-/// `[stimulus]`.
+/// `[stimulus]`: the true rate Ω.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct StimulusConfig {
@@ -43,24 +59,90 @@ pub struct StimulusConfig {
     pub source: String,
     /// Sample rate, Hz.
     pub fs_hz: f64,
-    /// `static`, `constant` or `sine`.
+    /// `static`, `constant`, `sine`, `steps` or `ramp`.
     pub scenario: String,
-    /// Constant rate or sine amplitude, °/s.
+    /// Constant rate, sine amplitude or step height, °/s.
     pub rate_dps: f64,
     /// Sine frequency, Hz.
     pub frequency_hz: f64,
-    /// Bias at t = 0, °/s.
-    pub initial_bias_dps: f64,
-    /// Angle random walk, °/√h.
-    pub arw_deg_per_sqrt_h: f64,
-    /// Rate random walk, °/h/√h.
-    pub rrw_deg_per_h_per_sqrt_h: f64,
-    /// CSV file of rates (°/s), relative to the config file.
+    /// Step duration, s.
+    pub period_s: f64,
+    /// Ramp slope, °/s per s.
+    pub slope_dps_per_s: f64,
+    /// CSV file of the true rate (°/s), relative to the config file.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub csv_path: Option<PathBuf>,
     /// Column of the CSV file.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub csv_column: Option<String>,
+}
+
+/// `[gyro_a]`, `[gyro_b]`: one gyro's errors (see `gyrofx_model::plant`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GyroConfig {
+    /// Scale-factor error in normal mode, ppm.
+    pub sf_ppm: f64,
+    /// Reverse minus normal scale factor, ppm.
+    pub sf_mode_mismatch_ppm: f64,
+    /// Bias at t = 0, °/s.
+    pub bias_dps: f64,
+    /// Bias part that does not flip with the mode, °/s.
+    pub bias_mode_mismatch_dps: f64,
+    /// ARW, °/√h.
+    pub arw_deg_per_sqrt_h: f64,
+    /// Bias instability B, °/h.
+    pub bias_instability_deg_per_h: f64,
+    /// RRW, °/h/√h.
+    pub rrw_deg_per_h_per_sqrt_h: f64,
+    /// Rate ramp, °/h².
+    pub rate_ramp_deg_per_h2: f64,
+    /// Settling time constant after a switch, s.
+    pub settle_tau_s: f64,
+}
+
+/// `[plant]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlantConfig {
+    /// Shortest bias-instability correlation time, s.
+    pub bi_tau_min_s: f64,
+    /// Longest, s.
+    pub bi_tau_max_s: f64,
+}
+
+/// `[sequencer]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SequencerConfig {
+    /// L.
+    pub interval_length: usize,
+    /// W.
+    pub intervals: usize,
+    /// `alternating` or `abba`.
+    pub pattern: String,
+    /// M.
+    pub blank: usize,
+    /// S.
+    pub stagger: usize,
+}
+
+/// `[estimator]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EstimatorConfig {
+    /// r.
+    pub rate_order: usize,
+    /// Mean format.
+    pub mean_format: String,
+    /// Bias format.
+    pub bias_format: String,
+    /// Gain width.
+    pub gain_width: u32,
+    /// Reciprocal width.
+    pub reciprocal_width: u32,
+    /// Smoothing shift.
+    pub smoothing_shift: u32,
 }
 
 /// `[kf]`.
@@ -79,7 +161,7 @@ pub struct KfConfig {
     pub tolerance: f64,
     /// Riccati iteration limit.
     pub max_iterations: u64,
-    /// Input format.
+    /// Input format (ADC, gyro samples, calibrated outputs).
     pub input_format: String,
     /// State format.
     pub state_format: String,
@@ -93,16 +175,12 @@ pub struct KfConfig {
     /// Explicit g2 format.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub g2_format: Option<String>,
-    /// Rounding mode name.
-    pub rounding: String,
-    /// Overflow mode name.
-    pub overflow: String,
 }
 
-/// Where the stimulus comes from, validated.
+/// Where the true rate comes from, validated.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Source {
-    /// The single-gyro simulation.
+    /// A scenario.
     Synthetic(Scenario),
     /// A CSV file and column.
     Csv {
@@ -122,7 +200,7 @@ pub struct KfSettings {
     pub bandwidths_hz: Vec<f64>,
     /// Riccati stopping rule.
     pub convergence: Convergence,
-    /// Input, state, output formats.
+    /// Input format.
     pub input: Format,
     /// State format.
     pub state: Format,
@@ -134,6 +212,45 @@ pub struct KfSettings {
     pub rounding: Rounding,
     /// Overflow.
     pub overflow: Overflow,
+}
+
+/// Everything the config says, validated and typed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Settings {
+    /// The true rate.
+    pub source: Source,
+    /// The plant.
+    pub plant: Plant,
+    /// The estimator (with the sequencer's schedule).
+    pub estimator: EstimatorSpec,
+    /// The KF.
+    pub kf: KfSettings,
+}
+
+/// The names of the presets, in the order `gyrofx init --preset` lists them.
+pub const PRESETS: [(&str, &str); 3] = [
+    ("gu2019", include_str!("presets/gu2019.toml")),
+    ("xue2015", include_str!("presets/xue2015.toml")),
+    ("mpu6050", include_str!("presets/mpu6050.toml")),
+];
+
+/// The text of preset `name`.
+///
+/// # Errors
+/// [`Error::Config`] for an unknown name, listing the known ones.
+pub fn preset(name: &str) -> Result<&'static str> {
+    PRESETS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, text)| *text)
+        .ok_or_else(|| {
+            let names: Vec<&str> = PRESETS.iter().map(|(n, _)| *n).collect();
+            Error::config(
+                "preset",
+                format!("{name:?}"),
+                format!("one of {}", names.join(", ")),
+            )
+        })
 }
 
 /// Optional keys that the default leaves commented out.
@@ -219,16 +336,32 @@ impl Config {
     /// # Errors
     /// [`Error::ConfigSyntax`] for bad TOML, unknown keys or wrong types.
     pub fn from_toml(text: &str, origin: &str) -> Result<Config> {
-        let syntax = |e: toml::de::Error| Error::ConfigSyntax {
+        Config::from_overlays(&[(text, origin)])
+    }
+
+    /// Parses partial config texts over the embedded default, later ones over earlier ones
+    /// (a preset, then a file). Each `(text, origin)`; `origin` names it in errors.
+    ///
+    /// # Errors
+    /// [`Error::ConfigSyntax`] for bad TOML, unknown keys or wrong types.
+    pub fn from_overlays(overlays: &[(&str, &str)]) -> Result<Config> {
+        let mut merged: toml::Table = toml::from_str(DEFAULT_TOML).expect("default parses");
+        let default = merged.clone();
+        for (text, origin) in overlays {
+            let syntax = |e: toml::de::Error| Error::ConfigSyntax {
+                origin: origin.to_string(),
+                message: e.to_string().trim_end().to_string(),
+            };
+            let user: toml::Table = toml::from_str(text).map_err(syntax)?;
+            check_known_keys(&user, &default, "", text, origin)?;
+            merge(&mut merged, user);
+        }
+        let merged_text = toml::to_string(&merged).expect("a table serializes");
+        let origin = overlays.last().map(|o| o.1).unwrap_or("embedded default");
+        toml::from_str(&merged_text).map_err(|e| Error::ConfigSyntax {
             origin: origin.to_string(),
             message: e.to_string().trim_end().to_string(),
-        };
-        let user: toml::Table = toml::from_str(text).map_err(syntax)?;
-        let mut merged: toml::Table = toml::from_str(DEFAULT_TOML).expect("default parses");
-        check_known_keys(&user, &merged, "", text, origin)?;
-        merge(&mut merged, user);
-        let merged_text = toml::to_string(&merged).expect("a table serializes");
-        toml::from_str(&merged_text).map_err(syntax)
+        })
     }
 
     /// Reads a config file over the embedded default; a relative `csv_path` is resolved against
@@ -237,8 +370,30 @@ impl Config {
     /// # Errors
     /// [`Error::Io`] when the file cannot be read, and those of [`Config::from_toml`].
     pub fn from_file(path: &Path) -> Result<Config> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-        let mut config = Config::from_toml(&text, &path.display().to_string())?;
+        Config::from_preset_and_file(None, Some(path))
+    }
+
+    /// The embedded default, overlaid by a preset and then by a config file (either optional).
+    ///
+    /// # Errors
+    /// An unknown preset, and those of [`Config::from_overlays`] and reading the file.
+    pub fn from_preset_and_file(preset_name: Option<&str>, path: Option<&Path>) -> Result<Config> {
+        let mut overlays: Vec<(String, String)> = Vec::new();
+        if let Some(name) = preset_name {
+            overlays.push((preset(name)?.to_string(), format!("preset {name}")));
+        }
+        if let Some(path) = path {
+            let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+            overlays.push((text, path.display().to_string()));
+        }
+        let refs: Vec<(&str, &str)> = overlays
+            .iter()
+            .map(|(t, o)| (t.as_str(), o.as_str()))
+            .collect();
+        let mut config = Config::from_overlays(&refs)?;
+        let Some(path) = path else {
+            return Ok(config);
+        };
         if let Some(csv) = &config.stimulus.csv_path {
             if csv.is_relative() {
                 let folder = path.parent().unwrap_or(Path::new("."));
@@ -253,12 +408,11 @@ impl Config {
         toml::to_string(self).expect("config serializes")
     }
 
-    /// Checks every value and returns the typed source and KF settings.
+    /// Checks every value and returns the typed settings of every block.
     ///
     /// # Errors
     /// [`Error::Config`] naming the first bad field.
-    pub fn validate(&self) -> Result<(Source, KfSettings)> {
-        // The vector set is built in memory (~300 bytes a sample with its text files).
+    pub fn validate(&self) -> Result<Settings> {
         if self.samples == 0 || self.samples > MAX_SAMPLES {
             return Err(Error::config(
                 "samples",
@@ -266,16 +420,26 @@ impl Config {
                 format!("1..={MAX_SAMPLES}"),
             ));
         }
+        let rounding: Rounding = self.rounding.parse().map_err(|_| {
+            Error::config(
+                "rounding",
+                format!("{:?}", self.rounding),
+                "one of floor, ceil, zero, nearest, round, convergent",
+            )
+        })?;
+        let overflow: Overflow = self.overflow.parse().map_err(|_| {
+            Error::config(
+                "overflow",
+                format!("{:?}", self.overflow),
+                "wrap or saturate",
+            )
+        })?;
         let s = &self.stimulus;
         positive("stimulus.fs_hz", s.fs_hz)?;
         finite("stimulus.rate_dps", s.rate_dps)?;
-        finite("stimulus.initial_bias_dps", s.initial_bias_dps)?;
         non_negative("stimulus.frequency_hz", s.frequency_hz)?;
-        non_negative("stimulus.arw_deg_per_sqrt_h", s.arw_deg_per_sqrt_h)?;
-        non_negative(
-            "stimulus.rrw_deg_per_h_per_sqrt_h",
-            s.rrw_deg_per_h_per_sqrt_h,
-        )?;
+        positive("stimulus.period_s", s.period_s)?;
+        finite("stimulus.slope_dps_per_s", s.slope_dps_per_s)?;
         let scenario = match s.scenario.as_str() {
             "static" => Scenario::Static,
             "constant" => Scenario::Constant {
@@ -285,11 +449,18 @@ impl Config {
                 amplitude_dps: s.rate_dps,
                 frequency_hz: s.frequency_hz,
             },
+            "steps" => Scenario::Steps {
+                rate_dps: s.rate_dps,
+                period_s: s.period_s,
+            },
+            "ramp" => Scenario::Ramp {
+                slope_dps_per_s: s.slope_dps_per_s,
+            },
             other => {
                 return Err(Error::config(
                     "stimulus.scenario",
                     format!("{other:?}"),
-                    "one of \"static\", \"constant\", \"sine\"",
+                    "one of \"static\", \"constant\", \"sine\", \"steps\", \"ramp\"",
                 ))
             }
         };
@@ -316,6 +487,47 @@ impl Config {
                 ))
             }
         };
+        let plant = Plant {
+            fs_hz: s.fs_hz,
+            gyros: [gyro("gyro_a", &self.gyro_a)?, gyro("gyro_b", &self.gyro_b)?],
+            bi_tau_min_s: self.plant.bi_tau_min_s,
+            bi_tau_max_s: self.plant.bi_tau_max_s,
+        };
+        positive("plant.bi_tau_min_s", plant.bi_tau_min_s)?;
+        if !(plant.bi_tau_max_s.is_finite() && plant.bi_tau_max_s > plant.bi_tau_min_s) {
+            return Err(Error::config(
+                "plant.bi_tau_max_s",
+                plant.bi_tau_max_s,
+                format!("a finite number > bi_tau_min_s = {}", plant.bi_tau_min_s),
+            ));
+        }
+
+        let q = &self.sequencer;
+        let pattern = match q.pattern.as_str() {
+            "alternating" => Pattern::Alternating,
+            "abba" => Pattern::Abba,
+            other => {
+                return Err(Error::config(
+                    "sequencer.pattern",
+                    format!("{other:?}"),
+                    "\"alternating\" or \"abba\"",
+                ))
+            }
+        };
+        let schedule = Schedule {
+            interval_length: q.interval_length,
+            intervals: q.intervals,
+            pattern,
+            blank: q.blank,
+            stagger: q.stagger,
+        };
+        schedule.validate().map_err(|e| match e {
+            ScheduleError::Range {
+                name,
+                value,
+                allowed,
+            } => Error::config(format!("sequencer.{name}"), value, allowed),
+        })?;
 
         let k = &self.kf;
         let method = k.method.parse().map_err(|_| {
@@ -350,51 +562,98 @@ impl Config {
         let coefficient = |field: &str, explicit: &Option<String>| -> Result<CoefficientFormat> {
             match explicit {
                 Some(text) => Ok(CoefficientFormat::Fixed(parse_format(field, text)?)),
-                None => {
-                    if !(1..=64).contains(&k.coefficient_width) {
-                        return Err(Error::config(
-                            "kf.coefficient_width",
-                            k.coefficient_width,
-                            "1..=64 bits",
-                        ));
-                    }
-                    Ok(CoefficientFormat::Auto {
-                        width: k.coefficient_width,
-                    })
-                }
+                None => width("kf.coefficient_width", k.coefficient_width),
             }
         };
-        let settings = KfSettings {
+        let input = parse_format("kf.input_format", &k.input_format)?;
+        let kf = KfSettings {
             method,
             bandwidths_hz: k.bandwidths_hz.clone(),
             convergence: Convergence {
                 tolerance: k.tolerance,
                 max_iterations: k.max_iterations,
             },
-            input: parse_format("kf.input_format", &k.input_format)?,
+            input,
             state: parse_format("kf.state_format", &k.state_format)?,
             output: parse_format("kf.output_format", &k.output_format)?,
             coefficients: [
                 coefficient("kf.g1_format", &k.g1_format)?,
                 coefficient("kf.g2_format", &k.g2_format)?,
             ],
-            rounding: k.rounding.parse().map_err(|_| {
-                Error::config(
-                    "kf.rounding",
-                    format!("{:?}", k.rounding),
-                    "one of floor, ceil, zero, nearest, round, convergent",
-                )
-            })?,
-            overflow: k.overflow.parse().map_err(|_| {
-                Error::config(
-                    "kf.overflow",
-                    format!("{:?}", k.overflow),
-                    "wrap or saturate",
-                )
-            })?,
+            rounding,
+            overflow,
         };
-        Ok((source, settings))
+        let e = &self.estimator;
+        let estimator = EstimatorSpec {
+            schedule,
+            rate_order: e.rate_order,
+            input,
+            mean: parse_format("estimator.mean_format", &e.mean_format)?,
+            bias: parse_format("estimator.bias_format", &e.bias_format)?,
+            calibrated: input,
+            gain: width("estimator.gain_width", e.gain_width)?,
+            reciprocal: width("estimator.reciprocal_width", e.reciprocal_width)?,
+            smoothing_shift: e.smoothing_shift,
+            rounding,
+            overflow,
+        };
+        if e.rate_order > 8 {
+            return Err(Error::config("estimator.rate_order", e.rate_order, "0..=8"));
+        }
+        if e.smoothing_shift > 32 {
+            return Err(Error::config(
+                "estimator.smoothing_shift",
+                e.smoothing_shift,
+                "0..=32",
+            ));
+        }
+        Ok(Settings {
+            source,
+            plant,
+            estimator,
+            kf,
+        })
     }
+}
+
+fn width(field: &str, width: u32) -> Result<CoefficientFormat> {
+    if (1..=64).contains(&width) {
+        Ok(CoefficientFormat::Auto { width })
+    } else {
+        Err(Error::config(field, width, "1..=64 bits"))
+    }
+}
+
+fn gyro(section: &str, g: &GyroConfig) -> Result<GyroErrors> {
+    let field = |name: &str| format!("{section}.{name}");
+    for (name, value) in [
+        ("sf_ppm", g.sf_ppm),
+        ("sf_mode_mismatch_ppm", g.sf_mode_mismatch_ppm),
+        ("bias_dps", g.bias_dps),
+        ("bias_mode_mismatch_dps", g.bias_mode_mismatch_dps),
+        ("rate_ramp_deg_per_h2", g.rate_ramp_deg_per_h2),
+    ] {
+        finite(&field(name), value)?;
+    }
+    for (name, value) in [
+        ("arw_deg_per_sqrt_h", g.arw_deg_per_sqrt_h),
+        ("bias_instability_deg_per_h", g.bias_instability_deg_per_h),
+        ("rrw_deg_per_h_per_sqrt_h", g.rrw_deg_per_h_per_sqrt_h),
+        ("settle_tau_s", g.settle_tau_s),
+    ] {
+        non_negative(&field(name), value)?;
+    }
+    Ok(GyroErrors {
+        sf_ppm: g.sf_ppm,
+        sf_mode_mismatch_ppm: g.sf_mode_mismatch_ppm,
+        bias_dps: g.bias_dps,
+        bias_mode_mismatch_dps: g.bias_mode_mismatch_dps,
+        arw_deg_per_sqrt_h: g.arw_deg_per_sqrt_h,
+        bias_instability_deg_per_h: g.bias_instability_deg_per_h,
+        rrw_deg_per_h_per_sqrt_h: g.rrw_deg_per_h_per_sqrt_h,
+        rate_ramp_deg_per_h2: g.rate_ramp_deg_per_h2,
+        settle_tau_s: g.settle_tau_s,
+    })
 }
 
 fn parse_format(field: &str, text: &str) -> Result<Format> {
@@ -443,10 +702,32 @@ mod tests {
 
     #[test]
     fn a_partial_config_overlays_the_default() {
-        let config = Config::from_toml("seed = 9\n[kf]\nrounding = \"convergent\"\n", "t").unwrap();
+        let config = Config::from_toml("seed = 9\nrounding = \"convergent\"\n", "t").unwrap();
         assert_eq!(config.seed, 9);
-        assert_eq!(config.kf.rounding, "convergent");
+        assert_eq!(config.rounding, "convergent");
         assert_eq!(config.kf.state_format, "s36.26");
+    }
+
+    #[test]
+    fn presets_overlay_the_default_and_are_valid() {
+        for (name, _) in PRESETS {
+            let config = Config::from_preset_and_file(Some(name), None).unwrap();
+            config
+                .validate()
+                .unwrap_or_else(|e| panic!("preset {name}: {e}"));
+        }
+        let gu = Config::from_preset_and_file(Some("gu2019"), None).unwrap();
+        assert_eq!(
+            (gu.stimulus.fs_hz, gu.sequencer.interval_length),
+            (50.0, 150)
+        );
+        let err = Config::from_preset_and_file(Some("nope"), None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("preset = \"nope\"") && err.contains("gu2019"),
+            "{err}"
+        );
     }
 
     #[test]
@@ -500,9 +781,44 @@ mod tests {
                 "fs/2 = 100",
             ),
             (
-                "[kf]\nrounding = \"half_up\"",
-                "kf.rounding = \"half_up\"",
+                "rounding = \"half_up\"",
+                "rounding = \"half_up\"",
                 "convergent",
+            ),
+            (
+                "[sequencer]\nblank = 150",
+                "sequencer.blank = 150",
+                "less than interval_length = 150",
+            ),
+            (
+                "[sequencer]\nstagger = 200",
+                "sequencer.stagger = 200",
+                "less than interval_length",
+            ),
+            (
+                "[sequencer]\ninterval_length = 0",
+                "sequencer.interval_length = 0",
+                "at least 1",
+            ),
+            (
+                "[sequencer]\nintervals = 1",
+                "sequencer.intervals = 1",
+                "2..=256",
+            ),
+            (
+                "[sequencer]\npattern = \"abab\"",
+                "sequencer.pattern = \"abab\"",
+                "abba",
+            ),
+            (
+                "[gyro_b]\narw_deg_per_sqrt_h = -1.0",
+                "gyro_b.arw_deg_per_sqrt_h = -1",
+                ">= 0",
+            ),
+            (
+                "[estimator]\nmean_format = \"x\"",
+                "estimator.mean_format = \"x\"",
+                "s18.16",
             ),
             (
                 "[kf]\ncoefficient_width = 0",
@@ -510,9 +826,9 @@ mod tests {
                 "1..=64",
             ),
             (
-                "[stimulus]\nscenario = \"ramp\"",
-                "stimulus.scenario = \"ramp\"",
-                "sine",
+                "[stimulus]\nscenario = \"chirp\"",
+                "stimulus.scenario = \"chirp\"",
+                "ramp",
             ),
             (
                 "[stimulus]\nsource = \"csv\"",

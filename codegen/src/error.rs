@@ -38,6 +38,9 @@ pub enum Error {
     /// The fixed-point plan is refused.
     #[error("kf plan: {0}")]
     Plan(#[from] PlanError),
+    /// The estimator's plan is refused.
+    #[error("estimator: {0}")]
+    Estimator(gyrofx_model::estimator::PlanError),
     /// A bad input file (CSV).
     #[error("{path}: {message}")]
     Input {

@@ -1,35 +1,35 @@
-//! `generate`: a job → a complete verification package (vectors, ROM, testbench, RTL,
-//! Makefile, manifest), written atomically.
+//! `generate`: a job → a complete verification package (every block's vectors, ROMs and
+//! testbench, the RTL, a Makefile, the report and the manifest), written atomically.
 
 use std::path::Path;
 
-use serde::Serialize;
 use serde_json::json;
 
-use gyrofx_model::kf::OverflowCounts;
-
+use crate::block::{Block, Timing};
 use crate::error::Result;
 use crate::job::Job;
 use crate::package::{sha256_hex, Package, MANIFEST};
 use crate::report;
-use crate::vectors::{self, Vectors};
-use crate::writers::{self, names, Provenance};
+use crate::testbench::testbench;
+use crate::vectors::{self, Run};
+use crate::writers::{self, Provenance, ESTIMATOR_ROM, KF_ROM};
 
 /// What `generate` reports back.
 #[derive(Clone, Debug)]
 pub struct Summary {
-    /// The vector set.
-    pub vectors: Vectors,
-    /// ADC saturations in the stimulus.
-    pub adc_saturations: u64,
+    /// The run.
+    pub run: Run,
     /// Files written, relative paths.
     pub files: Vec<String>,
 }
 
-/// The regenerate command for a job from the embedded default or a config file.
-pub fn provenance(job: &Job, config_file: Option<&Path>) -> Provenance {
+/// The regenerate command for a job from the embedded default, a preset and/or a config file.
+pub fn provenance(job: &Job, preset: Option<&str>, config_file: Option<&Path>) -> Provenance {
     let config_text = job.config.to_toml();
     let mut command = "gyrofx generate --out <folder>".to_string();
+    if let Some(name) = preset {
+        command.push_str(&format!(" --preset {name}"));
+    }
     if let Some(path) = config_file {
         command.push_str(&format!(" --config {}", path.display()));
     }
@@ -44,12 +44,67 @@ pub fn provenance(job: &Job, config_file: Option<&Path>) -> Provenance {
     }
 }
 
-#[derive(Serialize)]
-struct OverflowReport {
-    x1: u64,
-    x2: u64,
-    rate_hat: u64,
-    adc_saturations: u64,
+/// Every file of one block's folder.
+fn block_files(block: &Block, provenance: &Provenance) -> Vec<(String, String)> {
+    let (stimulus, expected) = writers::vector_hex(block, provenance);
+    let mut files = vec![
+        (
+            block.file("params.vh"),
+            writers::params_vh(block, provenance),
+        ),
+        (block.file("stimulus.hex"), stimulus),
+        (block.file("expected.hex"), expected),
+        (
+            block.file("vectors.csv"),
+            writers::vector_csv(block, provenance),
+        ),
+        (block.file("tb"), testbench(block, provenance)),
+    ];
+    files.extend(
+        block
+            .roms
+            .iter()
+            .map(|(name, text)| (name.to_string(), text.clone())),
+    );
+    files
+        .into_iter()
+        .map(|(name, text)| (format!("{}/{name}", block.name), text))
+        .collect()
+}
+
+fn block_manifest(block: &Block) -> serde_json::Value {
+    let fields = |signals: Vec<(&str, String)>| -> Vec<serde_json::Value> {
+        signals
+            .into_iter()
+            .map(|(n, f)| json!({"name": n, "format": f}))
+            .collect()
+    };
+    let mut inputs = vec![("rst", "u1.0".to_string())];
+    inputs.extend(block.inputs.iter().map(|s| (s.name, s.format.to_string())));
+    let outputs: Vec<serde_json::Value> = block
+        .outputs
+        .iter()
+        .map(|o| {
+            json!({
+                "name": o.signal.name,
+                "format": o.signal.format.to_string(),
+                "checked": match o.timing {
+                    Timing::Combinational => "before the clock edge that takes the sample (not on resets)",
+                    Timing::Registered => "1 clock after the sample's ce",
+                },
+                "only_where": o.gate.map(|g| format!("{g} = 1")),
+                "pulse": o.pulse,
+            })
+        })
+        .collect();
+    json!({
+        "module": block.module,
+        "vectors": block.len(),
+        "params": block.params.iter().map(|p| json!({"name": p.name, "value": p.value, "what": p.comment})).collect::<Vec<_>>(),
+        "stimulus": {"file": format!("{}/{}", block.name, block.file("stimulus.hex")), "fields": fields(inputs)},
+        "expected": {"file": format!("{}/{}", block.name, block.file("expected.hex")), "fields": outputs},
+        "roms": block.roms.iter().map(|(n, _)| format!("{}/{n}", block.name)).collect::<Vec<_>>(),
+    })
 }
 
 /// Builds every file of the package for `job`, in memory. `progress` is told the phase.
@@ -61,45 +116,44 @@ pub fn build_package(
     provenance: &Provenance,
     progress: &mut dyn FnMut(&str),
 ) -> Result<(Package, Summary)> {
-    progress("stimulus");
-    let stimulus = job.stimulus()?;
-    progress("models");
-    let vectors = vectors::build(&job.plan, &stimulus);
+    progress("chain run");
+    let kf = job.kf();
+    let est = &job.chain.estimator;
+    let run = vectors::run(
+        job,
+        (KF_ROM, writers::kf_rom(kf, provenance)),
+        (ESTIMATOR_ROM, writers::estimator_rom(est, provenance)),
+    )?;
     progress("files");
-    let plan = &job.plan;
-    let (stimulus_hex, expected_hex, csv) = writers::vector_files(plan, &vectors, provenance);
     let mut package = Package::new();
-    package.add(
-        "README.md",
-        writers::package_readme(plan, &vectors, provenance),
-    );
-    package.add("Makefile", writers::makefile(provenance));
+    package.add("README.md", writers::package_readme(&run, provenance));
+    package.add("Makefile", writers::makefile(&run.blocks, provenance));
+    package.add("report.md", writers::report_md(&run, provenance));
     for (name, source) in writers::RTL_SOURCES {
         package.add(format!("hdl/{name}"), source);
     }
-    package.add(
-        format!("kf/{}", names::ROM),
-        writers::rom_mem(plan, provenance),
-    );
-    package.add(
-        format!("kf/{}", names::PARAMS),
-        writers::params_vh(plan, vectors.rows.len(), provenance),
-    );
-    package.add(format!("kf/{}", names::STIMULUS), stimulus_hex);
-    package.add(format!("kf/{}", names::EXPECTED), expected_hex);
-    package.add(format!("kf/{}", names::CSV), csv);
-    package.add(
-        format!("kf/{}", names::TESTBENCH),
-        writers::testbench(provenance),
-    );
-
-    let OverflowCounts { x1, x2, rate_hat } = vectors.overflow;
-    let field_list = |fields: &[(&str, String)]| -> Vec<serde_json::Value> {
-        fields
+    let per_block: Vec<Vec<(String, String)>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = run
+            .blocks
             .iter()
-            .map(|(n, f)| json!({"name": n, "format": f}))
+            .map(|b| scope.spawn(move || block_files(b, provenance)))
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("writers do not panic"))
             .collect()
-    };
+    });
+    for files in per_block {
+        for (path, text) in files {
+            package.add(path, text);
+        }
+    }
+
+    let blocks: serde_json::Map<String, serde_json::Value> = run
+        .blocks
+        .iter()
+        .map(|b| (b.name.to_string(), block_manifest(b)))
+        .collect();
     let manifest = json!({
         "tool": "gyrofx",
         "version": provenance.version,
@@ -107,58 +161,70 @@ pub fn build_package(
         "seed": job.config.seed,
         "config_sha256": provenance.config_sha256,
         "config": job.config,
+        "samples": run.samples,
+        "encoding": "vector files: one line per clock-enable; fields separated by one space, each a zero-padded two's-complement hex word of its format's width; line 1 is a generated-by comment, line 2 names the fields and formats",
+        "blocks": blocks,
         "kf": {
             "formats": {
-                "input": plan.input.to_string(),
-                "state": plan.state.to_string(),
-                "output": plan.output.to_string(),
-                "g1": plan.coefficient[0].to_string(),
-                "g2": plan.coefficient[1].to_string(),
-                "error": plan.error.to_string(),
-                "product_g1": plan.product[0].to_string(),
-                "product_g2": plan.product[1].to_string(),
-                "sum_x1": plan.sum[0].to_string(),
-                "sum_x2": plan.sum[1].to_string(),
+                "input": kf.input.to_string(),
+                "state": kf.state.to_string(),
+                "output": kf.output.to_string(),
+                "g1": kf.coefficient[0].to_string(),
+                "g2": kf.coefficient[1].to_string(),
+                "error": kf.error.to_string(),
+                "product_g1": kf.product[0].to_string(),
+                "product_g2": kf.product[1].to_string(),
+                "sum_x1": kf.sum[0].to_string(),
+                "sum_x2": kf.sum[1].to_string(),
             },
-            "guard_bits": plan.guard_bits(),
-            "rounding": plan.rounding.name(),
-            "overflow": plan.overflow.name(),
+            "guard_bits": kf.guard_bits(),
             "latency_clocks": 1,
-            "designs": report::designs(&job.designs, plan),
-            "coefficients": report::coefficients(plan),
-            "rom": {
-                "file": format!("kf/{}", names::ROM),
-                "depth": plan.rom.len(),
-                "word_bits": writers::rom_word_width(plan),
-                "packing": "word = {g1, g2}: g1 in the high bits; address = bw_sel",
-            },
-            "overflow_counts": OverflowReport { x1, x2, rate_hat, adc_saturations: stimulus.adc_saturations },
-            "fixed_vs_float": vectors.stats,
-            "tie_cases": vectors.ties,
-            "vectors": {
-                "count": vectors.rows.len(),
-                "stimulus_samples": stimulus.z.len(),
-                "encoding": "one line per clock-enable; fields separated by one space, each a zero-padded two's-complement hex word of its format's width; line 1 is a generated-by comment, line 2 names the fields and formats",
-                "stimulus": {"file": format!("kf/{}", names::STIMULUS), "fields": field_list(&writers::stimulus_fields(plan))},
-                "expected": {"file": format!("kf/{}", names::EXPECTED), "fields": field_list(&writers::expected_fields(plan)),
-                             "timing": "compared 1 clock after each ce; rate_out only where valid = 1"},
-                "csv": format!("kf/{}", names::CSV),
-            },
+            "designs": report::designs(&job.designs, kf),
+            "coefficients": report::coefficients(kf),
+            "rom": {"file": KF_ROM, "depth": kf.rom.len(), "word_bits": writers::rom_word_width(kf),
+                    "packing": "word = {g1, g2}: g1 in the high bits; address = bw_sel"},
+            "tie_cases": run.ties,
+            "fixed_vs_float": run.kf_stats,
         },
+        "estimator": {
+            "schedule": {
+                "interval_length": est.schedule.interval_length,
+                "intervals": est.schedule.intervals,
+                "pattern": est.schedule.pattern.name(),
+                "blank": est.schedule.blank,
+                "stagger": est.schedule.stagger,
+            },
+            "rate_order": est.rate_order,
+            "formats": {
+                "input": est.input.to_string(),
+                "accumulator": est.accumulator.to_string(),
+                "reciprocal": est.reciprocal.to_string(),
+                "mean": est.mean.to_string(),
+                "gain": est.gain.to_string(),
+                "dot": est.dot.to_string(),
+                "bias": est.bias.to_string(),
+                "calibrated": est.calibrated.to_string(),
+            },
+            "reciprocal": {"value": 1.0 / est.schedule.valid_count() as f64, "quantized": est.quantized_reciprocal(), "code": est.reciprocal_code as i64},
+            "gains": {"designed": est.gains, "quantized": est.quantized_gains(), "all_shifts": est.gains_are_shifts(),
+                      "rom": {"file": ESTIMATOR_ROM, "order": "bias_a row over [mA0, mB0, mA1, ...], then bias_b row"}},
+            "smoothing_shift": est.smoothing_shift,
+            "fixed_vs_float_bias": run.bias_stats,
+        },
+        "chain": {
+            "rounding": est.rounding.name(),
+            "overflow": est.overflow.name(),
+            "fixed_vs_float": run.chain_stats,
+        },
+        "overflow_counts": run.overflows,
+        "report": run.report,
         "files": package.entries(),
     });
     let mut text = serde_json::to_string_pretty(&manifest).expect("manifest serializes");
     text.push('\n');
     package.add(MANIFEST, text);
     let files = package.paths();
-    Ok((
-        package,
-        Summary {
-            vectors,
-            adc_saturations: stimulus.adc_saturations,
-            files,
-        },
-    ))
+    Ok((package, Summary { run, files }))
 }
 
 /// Builds the package for `job` and writes it to `out` atomically.
@@ -169,11 +235,10 @@ pub fn build_package(
 pub fn generate(
     job: &Job,
     out: &Path,
-    config_file: Option<&Path>,
+    provenance: &Provenance,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Summary> {
-    let provenance = provenance(job, config_file);
-    let (package, summary) = build_package(job, &provenance, progress)?;
+    let (package, summary) = build_package(job, provenance, progress)?;
     progress("writing");
     package.write_atomically(out)?;
     Ok(summary)

@@ -1,12 +1,13 @@
-//! [`Job`]: a validated config resolved into designs, the fixed-point plan and the stimulus.
+//! [`Job`]: a validated config resolved into designs and the plans of every block.
 //!
-//! config → design → plan → (models, writers): everything downstream reads the job.
+//! config → design → plans → (models, writers): everything downstream reads the job.
 
+use gyrofx_model::chain;
+use gyrofx_model::estimator;
 use gyrofx_model::kf::design::{design_for_bandwidth, Design, Noise};
 use gyrofx_model::kf::{Plan, Spec};
-use gyrofx_model::stimulus::{adc, SingleGyro};
 
-use crate::config::{Config, KfSettings, Source};
+use crate::config::{Config, KfSettings, Settings, Source};
 use crate::error::{Error, Result};
 use crate::input::read_column;
 
@@ -15,25 +16,12 @@ use crate::input::read_column;
 pub struct Job {
     /// The config as read.
     pub config: Config,
-    /// The stimulus source.
-    pub source: Source,
-    /// The KF settings.
-    pub settings: KfSettings,
-    /// One design per bandwidth, in ROM order.
+    /// Its typed settings.
+    pub settings: Settings,
+    /// One KF design per bandwidth, in ROM order.
     pub designs: Vec<Design>,
-    /// The fixed-point plan.
-    pub plan: Plan,
-}
-
-/// The stimulus of the vector set.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Stimulus {
-    /// ADC codes (input format).
-    pub z: Vec<i64>,
-    /// True rate, °/s, where known (synthetic source).
-    pub true_rate: Option<Vec<f64>>,
-    /// Samples the ADC saturated.
-    pub adc_saturations: u64,
+    /// The chain's plans (estimator with the sequencer's schedule, and the KF).
+    pub chain: chain::Plan,
 }
 
 /// Designs one filter per bandwidth of `settings` at `fs_hz` for the noise model (°/√h, °/h/√h).
@@ -62,7 +50,7 @@ pub fn design_bandwidths(
         .collect()
 }
 
-/// The plan for these designs under `settings`.
+/// The KF plan for these designs under `settings`.
 ///
 /// # Errors
 /// [`Error::Plan`] when a format or coefficient is refused.
@@ -89,53 +77,51 @@ impl Job {
     /// # Errors
     /// The first config, design or plan error.
     pub fn new(config: Config) -> Result<Job> {
-        let (source, settings) = config.validate()?;
+        let settings = config.validate()?;
         let designs = design_bandwidths(
-            &settings,
+            &settings.kf,
             config.stimulus.fs_hz,
             config.kf.arw_deg_per_sqrt_h,
             config.kf.rrw_deg_per_h_per_sqrt_h,
         )?;
-        let plan = plan_for(&settings, &designs)?;
+        let kf = plan_for(&settings.kf, &designs)?;
+        let estimator = estimator::Plan::new(&settings.estimator).map_err(Error::Estimator)?;
+        let chain = chain::Plan::new(estimator, kf).map_err(|e| Error::Config {
+            field: "estimator / kf formats".into(),
+            value: String::new(),
+            allowed: e.to_string(),
+        })?;
         Ok(Job {
             config,
-            source,
             settings,
             designs,
-            plan,
+            chain,
         })
     }
 
-    /// Simulates (or reads) the stimulus and quantizes it with the ADC into the input format.
-    /// A CSV longer than `samples` is cut; a shorter one sets the count.
+    /// The KF's plan.
+    pub fn kf(&self) -> &Plan {
+        &self.chain.kf
+    }
+
+    /// The true rate Ω for `samples` samples, °/s: the scenario, or the CSV (cut to
+    /// `samples`; a shorter file sets the count).
     ///
     /// # Errors
     /// [`Error::Input`] / [`Error::Io`] for a bad CSV file.
-    pub fn stimulus(&self) -> Result<Stimulus> {
-        let s = &self.config.stimulus;
-        let (analog, true_rate) = match &self.source {
+    pub fn true_rate(&self, samples: usize) -> Result<Vec<f64>> {
+        Ok(match &self.settings.source {
             Source::Synthetic(scenario) => {
-                let gyro = SingleGyro {
-                    fs_hz: s.fs_hz,
-                    scenario: *scenario,
-                    initial_bias_dps: s.initial_bias_dps,
-                    arw_deg_per_sqrt_h: s.arw_deg_per_sqrt_h,
-                    rrw_deg_per_h_per_sqrt_h: s.rrw_deg_per_h_per_sqrt_h,
-                };
-                let record = gyro.simulate(self.config.samples, self.config.seed);
-                (record.analog, Some(record.true_rate))
+                let t = 1.0 / self.config.stimulus.fs_hz;
+                (0..samples)
+                    .map(|k| scenario.rate_at(k as f64 * t))
+                    .collect()
             }
             Source::Csv { path, column } => {
                 let mut values = read_column(path, column)?;
-                values.truncate(self.config.samples);
-                (values, None)
+                values.truncate(samples);
+                values
             }
-        };
-        let (z, adc_saturations) = adc(&analog, self.plan.input);
-        Ok(Stimulus {
-            z,
-            true_rate,
-            adc_saturations,
         })
     }
 }
@@ -144,28 +130,13 @@ impl Job {
 mod tests {
     use super::*;
 
-    /// The model's worked example (used by its tests and benchmarks) is the embedded default.
+    /// The model's worked example (used by its tests and benchmarks) is the embedded default's
+    /// KF.
     #[test]
-    fn the_embedded_default_is_the_models_example() {
+    fn the_embedded_default_kf_is_the_models_example() {
         let job = Job::new(Config::embedded()).unwrap();
         let example = Plan::new(&gyrofx_model::examples::kf_spec()).unwrap();
-        assert_eq!(job.plan, example);
-        let gyro = gyrofx_model::examples::gyro();
-        let s = &job.config.stimulus;
-        assert_eq!(
-            (
-                s.fs_hz,
-                s.initial_bias_dps,
-                s.arw_deg_per_sqrt_h,
-                s.rrw_deg_per_h_per_sqrt_h
-            ),
-            (
-                gyro.fs_hz,
-                gyro.initial_bias_dps,
-                gyro.arw_deg_per_sqrt_h,
-                gyro.rrw_deg_per_h_per_sqrt_h
-            )
-        );
-        assert_eq!(job.source, Source::Synthetic(gyro.scenario));
+        assert_eq!(job.kf(), &example);
+        assert_eq!(job.config.stimulus.fs_hz, gyrofx_model::examples::FS_HZ);
     }
 }

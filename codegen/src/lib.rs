@@ -1,11 +1,13 @@
 //! gyrofx-codegen: config, the vector / ROM / testbench writers, the output package and the
 //! simulator runner.
 //!
-//! Data flows one way: [`config::Config`] → [`job::Job`] (designs and the fixed-point plan)
-//! → [`vectors`] (the models run over the schedule) → [`writers`] → [`package::Package`],
-//! written atomically by [`generate::generate`]. [`simulate`] runs a written package.
+//! Data flows one way: [`config::Config`] → [`job::Job`] (designs and every block's plan) →
+//! [`vectors`] (one run of the chain fills every [`block::Block`]) → [`writers`] and
+//! [`testbench`] → [`package::Package`], written atomically by [`generate::generate`].
+//! [`simulate`] runs a written package.
 #![warn(missing_docs)]
 
+pub mod block;
 pub mod config;
 pub mod error;
 pub mod generate;
@@ -14,6 +16,7 @@ pub mod job;
 pub mod package;
 pub mod report;
 pub mod simulate;
+pub mod testbench;
 pub mod vectors;
 pub mod writers;
 

@@ -57,9 +57,10 @@ impl std::str::FromStr for Simulator {
 /// The outcome of one simulation.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Outcome {
-    /// Whether the testbench passed (exit 0 and a `PASS` line).
+    /// Whether every block's testbench passed (exit 0 and a `PASS` line for each).
     pub passed: bool,
-    /// The testbench's report: its `PASS`, `FAIL` and `MISMATCH` lines.
+    /// The testbenches' report: `== <block>` headers and their `PASS`, `FAIL` and `MISMATCH`
+    /// lines.
     pub report: Vec<String>,
     /// Everything it printed (stdout then stderr).
     pub log: String,
@@ -92,8 +93,10 @@ pub fn run(out: &Path, simulator: Simulator) -> Result<Outcome> {
             )));
         }
     }
+    // -k: a failing block does not hide the others.
     let output = Command::new("make")
         .arg("--no-print-directory")
+        .arg("-k")
         .arg("-C")
         .arg(out)
         .arg(simulator.target())
@@ -103,10 +106,17 @@ pub fn run(out: &Path, simulator: Simulator) -> Result<Outcome> {
     log.push_str(&String::from_utf8_lossy(&output.stderr));
     let report: Vec<String> = log
         .lines()
-        .filter(|l| l.starts_with("PASS") || l.starts_with("FAIL") || l.starts_with("MISMATCH"))
+        .filter(|l| {
+            l.starts_with("== ")
+                || l.starts_with("PASS")
+                || l.starts_with("FAIL")
+                || l.starts_with("MISMATCH")
+        })
         .map(str::to_string)
         .collect();
-    let passed = output.status.success() && report.iter().any(|l| l.starts_with("PASS "));
+    let blocks = report.iter().filter(|l| l.starts_with("== ")).count();
+    let passes = report.iter().filter(|l| l.starts_with("PASS ")).count();
+    let passed = output.status.success() && blocks > 0 && passes == blocks;
     Ok(Outcome {
         passed,
         report,

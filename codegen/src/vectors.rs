@@ -1,84 +1,95 @@
-//! The KF vector set: the schedule of samples (stimulus, `bw_sel` switches, resets, rounding
-//! ties, full scale), the expected response of the fixed model, and the float comparisons.
+//! The vector set: one run of the whole chain (plant, sequencer, estimator, KF) fills the
+//! vectors of every block, and a directed segment (resets, rounding ties, full scale) is
+//! appended to the KF's. The float golden chain runs beside it.
+//!
+//! Schedule of the run: `samples` samples of the configured stimulus, `bw_sel` cycling through
+//! every ROM entry (each for `samples / (2·entries)` samples), and one reset of the whole chain
+//! half-way. The gyros are simulated in the modes the sequencer asks for, resets included.
 
+use gyrofx_model::analysis::overlapping_adev;
+use gyrofx_model::chain::{FixedChain, FloatChain};
+use gyrofx_model::estimator::OverflowCounts as EstimatorOverflows;
 use gyrofx_model::kf::bound::rate_error_bound_lsb;
 use gyrofx_model::kf::{FixedKf, FloatKf, OverflowCounts, Plan};
+use gyrofx_model::sequencer::Sequencer;
+use gyrofx_model::stimulus::adc;
 use serde::Serialize;
 
-use crate::job::Stimulus;
+use crate::block::{Block, Output, Param, Signal};
+use crate::error::Result;
+use crate::job::Job;
 
-/// Which part of the vector set a row belongs to.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Segment {
-    /// The configured stimulus (with `bw_sel` switches and one reset half-way).
-    Stimulus,
-    /// A reset followed by one input that lands exactly on a rounding tie.
-    Tie,
-    /// Full-scale positive and negative inputs.
-    FullScale,
+/// Fixed-vs-float error of a signal, in LSB of its format.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ErrorStats {
+    /// Samples compared.
+    pub samples: u64,
+    /// Largest `|fixed − float|` (same quantized coefficients).
+    pub max_lsb: f64,
+    /// Rms of the same.
+    pub rms_lsb: f64,
+    /// The derived worst-case bound.
+    pub bound_lsb: f64,
+    /// Largest `|fixed − ideal|` (ideal: designed coefficients, f64).
+    pub ideal_max_lsb: f64,
+    /// Rms of the same.
+    pub ideal_rms_lsb: f64,
+    /// Signal-to-quantization-noise ratio against the ideal model, dB.
+    pub sqnr_db: f64,
 }
 
-impl Segment {
-    /// Name in the CSV.
-    pub fn name(self) -> &'static str {
-        match self {
-            Segment::Stimulus => "stimulus",
-            Segment::Tie => "tie",
-            Segment::FullScale => "full_scale",
+#[derive(Default)]
+struct Accumulator {
+    count: u64,
+    max: f64,
+    sum_sq: f64,
+    ideal_max: f64,
+    ideal_sq: f64,
+    signal_sq: f64,
+}
+
+impl Accumulator {
+    fn add(&mut self, fixed: f64, float: f64, ideal: f64, lsb: f64) {
+        let err = (fixed - float) / lsb;
+        let ideal_err = (fixed - ideal) / lsb;
+        self.count += 1;
+        self.max = self.max.max(err.abs());
+        self.sum_sq += err * err;
+        self.ideal_max = self.ideal_max.max(ideal_err.abs());
+        self.ideal_sq += ideal_err * ideal_err;
+        self.signal_sq += (ideal / lsb) * (ideal / lsb);
+    }
+
+    fn finish(self, bound_lsb: f64) -> ErrorStats {
+        let rms = |s: f64| {
+            if self.count == 0 {
+                0.0
+            } else {
+                (s / self.count as f64).sqrt()
+            }
+        };
+        ErrorStats {
+            samples: self.count,
+            max_lsb: self.max,
+            rms_lsb: rms(self.sum_sq),
+            bound_lsb,
+            ideal_max_lsb: self.ideal_max,
+            ideal_rms_lsb: rms(self.ideal_sq),
+            sqnr_db: if self.ideal_sq > 0.0 {
+                10.0 * libm::log10(self.signal_sq / self.ideal_sq)
+            } else {
+                f64::INFINITY
+            },
         }
     }
 }
 
-/// One clock-enable of the vector set.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Row {
-    /// Part of the set.
-    pub segment: Segment,
-    /// Reset this sample (no output).
-    pub rst: bool,
-    /// ROM address.
-    pub bw_sel: usize,
-    /// Input code (input format).
-    pub z: i64,
-    /// The DUT must flag a valid output.
-    pub valid: bool,
-    /// Expected `rate_out` code (output format); 0 when not valid.
-    pub rate: i64,
-    /// Float model with the quantized gains, °/s.
-    pub float_rate: f64,
-    /// Float model with the designed (unquantized) gains, °/s.
-    pub ideal_rate: f64,
-    /// True rate, °/s, where known.
-    pub true_rate: Option<f64>,
-}
-
-/// Fixed-vs-float error over the stimulus rows, in output LSB.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct ErrorStats {
-    /// Valid stimulus rows compared.
-    pub samples: u64,
-    /// Largest `|fixed − float|` with the same quantized gains.
-    pub max_lsb: f64,
-    /// Rms of the same.
-    pub rms_lsb: f64,
-    /// The derived worst-case bound for this many samples and switches.
-    pub bound_lsb: f64,
-    /// Largest `|fixed − ideal|` (ideal: unquantized gains): what the coefficients' and the
-    /// states' word lengths cost together.
-    pub ideal_max_lsb: f64,
-    /// Rms of the same.
-    pub ideal_rms_lsb: f64,
-    /// Signal-to-quantization-noise ratio of `rate_hat` against the ideal model, dB.
-    pub sqnr_db: f64,
-}
-
-/// Tie-case inputs found for one ROM entry.
+/// Tie-case inputs found for one KF ROM entry.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct TieCases {
     /// ROM address.
     pub bw_sel: usize,
-    /// Input code that puts the `x1` update on a tie from reset, if one exists in range.
+    /// Input that puts the `x1` update on a tie from reset, if one exists in range.
     pub x1: Option<i64>,
     /// Same for `x2`.
     pub x2: Option<i64>,
@@ -86,17 +97,104 @@ pub struct TieCases {
     pub rate_hat: Option<i64>,
 }
 
-/// The vector set.
+/// Overflow counts of every quantization point.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Overflows {
+    /// ADC saturations of gyro A and B.
+    pub adc: [u64; 2],
+    /// Estimator and calibration.
+    pub estimator: EstimatorCounts,
+    /// The KF in the chain run.
+    pub kf_chain: KfCounts,
+    /// The KF's directed segment (full scale included).
+    pub kf_directed: KfCounts,
+}
+
+/// Estimator overflow counts (serializable mirror).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct EstimatorCounts {
+    /// Means of A and B.
+    pub mean: [u64; 2],
+    /// Bias estimates of A and B.
+    pub bias: [u64; 2],
+    /// Calibrated outputs of A and B.
+    pub calibrated: [u64; 2],
+    /// Combined output.
+    pub combined: u64,
+}
+
+/// KF overflow counts (serializable mirror).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct KfCounts {
+    /// State x1.
+    pub x1: u64,
+    /// State x2.
+    pub x2: u64,
+    /// Output.
+    pub rate_hat: u64,
+}
+
+impl From<OverflowCounts> for KfCounts {
+    fn from(c: OverflowCounts) -> Self {
+        KfCounts {
+            x1: c.x1,
+            x2: c.x2,
+            rate_hat: c.rate_hat,
+        }
+    }
+}
+
+impl From<EstimatorOverflows> for EstimatorCounts {
+    fn from(c: EstimatorOverflows) -> Self {
+        EstimatorCounts {
+            mean: c.mean,
+            bias: c.bias,
+            calibrated: c.calibrated,
+            combined: c.combined,
+        }
+    }
+}
+
+/// One line of the report: a signal's bias error and Allan deviation.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ReportLine {
+    /// What the signal is.
+    pub signal: String,
+    /// Mean of (signal − true rate), °/s.
+    pub bias_error_dps: f64,
+    /// Allan deviation at each of [`Report::tau_s`], °/s (null where the record is too short).
+    pub adev_dps: Vec<Option<f64>>,
+}
+
+/// What mode reversal and the KF did: raw gyros (run without reversal, same noise), the
+/// calibrated combined output, and the filtered output.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Report {
+    /// Averaging times, s.
+    pub tau_s: Vec<f64>,
+    /// One line per signal.
+    pub lines: Vec<ReportLine>,
+}
+
+/// Everything the run produced.
 #[derive(Clone, Debug)]
-pub struct Vectors {
-    /// One row per clock-enable.
-    pub rows: Vec<Row>,
-    /// Overflow counts of the fixed model over the whole set.
-    pub overflow: OverflowCounts,
-    /// Error statistics over the stimulus rows.
-    pub stats: ErrorStats,
-    /// Tie cases per ROM entry.
+pub struct Run {
+    /// The blocks' vectors: sequencer, estimator, kf, top.
+    pub blocks: Vec<Block>,
+    /// KF block: fixed vs float on its own inputs (chain part), in output LSB.
+    pub kf_stats: ErrorStats,
+    /// Chain output: fixed vs the float chain, in output LSB.
+    pub chain_stats: ErrorStats,
+    /// Bias estimates: fixed vs float, in LSB of the bias format.
+    pub bias_stats: ErrorStats,
+    /// Overflow counts.
+    pub overflows: Overflows,
+    /// KF tie cases found.
     pub ties: Vec<TieCases>,
+    /// The Allan report.
+    pub report: Report,
+    /// Chain samples (excluding resets).
+    pub samples: usize,
 }
 
 /// Samples of the full-scale segment at each polarity.
@@ -104,125 +202,480 @@ const FULL_SCALE_SAMPLES: usize = 64;
 /// Largest |z| searched for a tie case.
 const TIE_SEARCH_LIMIT: i64 = 1 << 16;
 
-/// Builds the schedule for `stimulus` and runs the models over it.
-pub fn build(plan: &Plan, stimulus: &Stimulus) -> Vectors {
-    let entries = plan.rom.len();
-    let n = stimulus.z.len();
+fn flag(b: bool) -> i128 {
+    i128::from(b)
+}
+
+fn mode_bit(p: i8) -> i128 {
+    i128::from(p > 0)
+}
+
+/// The blocks, their parameters and ROMs, without rows.
+fn empty_blocks(job: &Job, rom_kf: &str, rom_estimator: &str) -> [Block; 4] {
+    let est = &job.chain.estimator;
+    let kf = job.kf();
+    let schedule = &est.schedule;
+    let interval_bits = schedule.interval_bits();
+    let phase_bits = (usize::BITS - (schedule.interval_length - 1).leading_zeros()).max(1);
+    let pattern: u128 = schedule
+        .pattern
+        .modes(schedule.intervals)
+        .iter()
+        .enumerate()
+        .map(|(i, m)| u128::from(*m > 0) << i)
+        .sum();
+    let sequencer_params = vec![
+        Param::integer(
+            "INTERVAL_LENGTH",
+            schedule.interval_length as i64,
+            "L: samples per interval",
+        ),
+        Param::integer(
+            "INTERVALS",
+            schedule.intervals as i64,
+            "W: intervals per window",
+        ),
+        Param::bits(
+            "PATTERN",
+            schedule.intervals as u32,
+            pattern,
+            format!(
+                "A's modes, bit i = interval i ({})",
+                schedule.pattern.name()
+            ),
+        ),
+        Param::integer(
+            "BLANK",
+            schedule.blank as i64,
+            "M: blanked samples per interval",
+        ),
+        Param::integer("STAGGER", schedule.stagger as i64, "S: B's delay, samples"),
+        Param::integer("PHASE_W", phase_bits.into(), "phase counter width"),
+        Param::integer("INTERVAL_W", interval_bits.into(), "interval index width"),
+    ];
+    let mut estimator_params = Vec::new();
+    estimator_params.extend(Param::format("IN", est.input, "gyro samples"));
+    estimator_params.push(Param::integer(
+        "ACC_W",
+        est.accumulator.width.into(),
+        format!("accumulator: {}", est.accumulator),
+    ));
+    estimator_params.extend(Param::format("RECIP", est.reciprocal, "reciprocal 1/(L-M)"));
+    estimator_params.push(Param::bits(
+        "RECIP",
+        est.reciprocal.width,
+        est.reciprocal.to_bits(est.reciprocal_code),
+        format!("1/{}", schedule.valid_count()),
+    ));
+    estimator_params.extend(Param::format("MEAN", est.mean, "interval means"));
+    estimator_params.extend(Param::format("GAIN", est.gain, "least-squares gains"));
+    estimator_params.push(Param::integer(
+        "DOT_W",
+        est.dot.width.into(),
+        format!("dot product: {}", est.dot),
+    ));
+    estimator_params.extend(Param::format("BIAS", est.bias, "bias estimates"));
+    estimator_params.push(Param::integer("INTERVALS", schedule.intervals as i64, "W"));
+    estimator_params.push(Param::integer(
+        "INTERVAL_W",
+        interval_bits.into(),
+        "interval index width",
+    ));
+    estimator_params.push(Param::integer(
+        "SMOOTH",
+        est.smoothing_shift.into(),
+        "smoothing shift",
+    ));
+    let modes = [
+        Param::integer(
+            "ROUNDING",
+            est.rounding.rtl_code().into(),
+            est.rounding.name(),
+        ),
+        Param::integer(
+            "SATURATE",
+            est.overflow.rtl_code().into(),
+            est.overflow.name(),
+        ),
+    ];
+    let mut kf_params = Vec::new();
+    kf_params.extend(Param::format("IN", kf.input, "input z"));
+    kf_params.extend(Param::format("STATE", kf.state, "states x1, x2"));
+    kf_params.extend(Param::format("OUT", kf.output, "output rate_out"));
+    kf_params.extend(Param::format("G1", kf.coefficient[0], "coefficient g1"));
+    kf_params.extend(Param::format("G2", kf.coefficient[1], "coefficient g2"));
+    kf_params.push(Param::integer(
+        "SEL_W",
+        kf.select_width().into(),
+        "bw_sel width",
+    ));
+    kf_params.push(Param::integer(
+        "ROM_DEPTH",
+        kf.rom.len() as i64,
+        "coefficient sets",
+    ));
+
+    let bias = Signal::new("bias_a", est.bias);
+    let bias_b = Signal::new("bias_b", est.bias);
+    let slot_inputs = |v: &mut Vec<Signal>| {
+        v.extend([
+            Signal::flag("blank_a"),
+            Signal::flag("blank_b"),
+            Signal::flag("done_a"),
+            Signal::flag("done_b"),
+            Signal::index("interval_a", interval_bits),
+            Signal::index("interval_b", interval_bits),
+            Signal::flag("window_done"),
+        ])
+    };
+
+    let mut sequencer = Block::new(
+        "sequencer",
+        "gyrofx_sequencer",
+        "state-machine sequencer",
+        vec![],
+        vec![
+            Output::combinational(Signal::flag("mode_a")),
+            Output::combinational(Signal::flag("mode_b")),
+            Output::combinational(Signal::flag("blank_a")),
+            Output::combinational(Signal::flag("blank_b")),
+            Output::combinational(Signal::index("interval_a", interval_bits)),
+            Output::combinational(Signal::index("interval_b", interval_bits)),
+            Output::combinational(Signal::flag("done_a")),
+            Output::combinational(Signal::flag("done_b")),
+            Output::combinational(Signal::flag("window_done")),
+        ],
+    );
+    sequencer.params = sequencer_params.clone();
+
+    let mut est_inputs = vec![Signal::new("y_a", est.input), Signal::new("y_b", est.input)];
+    slot_inputs(&mut est_inputs);
+    let mut estimator = Block::new(
+        "estimator",
+        "gyrofx_bias_estimator",
+        "least-squares bias estimator",
+        est_inputs,
+        vec![
+            Output::registered(bias.clone()),
+            Output::registered(bias_b.clone()),
+            Output::registered(Signal::flag("estimated")),
+        ],
+    );
+    estimator.params = estimator_params.clone();
+    estimator.params.extend(modes.clone());
+    estimator
+        .params
+        .push(Param::string("ROM_FILE", rom_estimator, "gain ROM"));
+
+    let select = Signal::index("bw_sel", kf.select_width());
+    let mut kf_block = Block::new(
+        "kf",
+        "gyrofx_kf",
+        "steady-state Kalman filter",
+        vec![select.clone(), Signal::new("z", kf.input)],
+        vec![
+            Output::pulse(Signal::flag("out_valid")),
+            Output::gated(Signal::new("rate_out", kf.output), "out_valid"),
+        ],
+    );
+    kf_block.params = kf_params.clone();
+    kf_block.params.extend(modes.clone());
+    kf_block
+        .params
+        .push(Param::string("ROM_FILE", rom_kf, "coefficient ROM"));
+
+    let mut top = Block::new(
+        "top",
+        "gyrofx_top",
+        "the whole mode-reversal chain",
+        vec![
+            select,
+            Signal::new("y_a", est.input),
+            Signal::new("y_b", est.input),
+        ],
+        vec![
+            Output::combinational(Signal::flag("mode_a")),
+            Output::combinational(Signal::flag("mode_b")),
+            Output::pulse(Signal::flag("out_valid")),
+            Output::gated(Signal::new("rate_out", kf.output), "out_valid"),
+            Output::registered(bias),
+            Output::registered(bias_b),
+            Output::registered(Signal::flag("estimated")),
+        ],
+    );
+    top.params = sequencer_params;
+    top.params.extend(
+        estimator_params
+            .into_iter()
+            .filter(|p| p.name != "INTERVALS" && p.name != "INTERVAL_W"),
+    );
+    top.params.push(Param::string(
+        "GAIN_ROM_FILE",
+        rom_estimator,
+        "estimator gain ROM",
+    ));
+    top.params.extend(
+        kf_params
+            .into_iter()
+            .filter(|p| p.name != "IN_W" && p.name != "IN_F"),
+    );
+    top.params
+        .push(Param::string("KF_ROM_FILE", rom_kf, "KF coefficient ROM"));
+    top.params.extend(modes);
+    [sequencer, estimator, kf_block, top]
+}
+
+/// Runs the chain for `job` and builds every block's vectors. `rom_kf` / `rom_estimator` are
+/// the ROM image names and contents.
+///
+/// # Errors
+/// Stimulus errors (a bad CSV file).
+pub fn run(
+    job: &Job,
+    rom_kf: (&'static str, String),
+    rom_estimator: (&'static str, String),
+) -> Result<Run> {
+    let plan = &job.chain;
+    let kf = job.kf();
+    let est = &plan.estimator;
+    let rate = job.true_rate(job.config.samples)?;
+    let n = rate.len();
+    let entries = kf.rom.len();
     let chunk = (n / (2 * entries)).max(1);
-    let mut schedule: Vec<(Segment, bool, usize, i64, Option<f64>)> = Vec::with_capacity(n + 256);
-    for (k, z) in stimulus.z.iter().enumerate() {
-        if n >= 4 && k == n / 2 {
-            schedule.push((Segment::Stimulus, true, 0, 0, None));
-        }
-        let truth = stimulus.true_rate.as_ref().map(|t| t[k]);
-        schedule.push((Segment::Stimulus, false, (k / chunk) % entries, *z, truth));
-    }
+    let reset_at = if n >= 4 { Some(n / 2) } else { None };
 
-    let ties = find_ties(plan);
-    for tie in &ties {
-        for z in [tie.x1, tie.x2, tie.rate_hat].into_iter().flatten() {
-            schedule.push((Segment::Tie, true, tie.bw_sel, 0, None));
-            schedule.push((Segment::Tie, false, tie.bw_sel, z, None));
+    // The modes the sequencer asks for, resets included: the plant runs in them.
+    let mut sequencer = Sequencer::new(&est.schedule);
+    let mut modes = Vec::with_capacity(n);
+    for k in 0..n {
+        if reset_at == Some(k) {
+            sequencer.reset();
         }
+        let slot = sequencer.advance();
+        modes.push([slot.mode_a, slot.mode_b]);
     }
-    let widest = entries - 1;
-    let (max, min) = (plan.input.max_code() as i64, plan.input.min_code() as i64);
-    schedule.push((Segment::FullScale, true, widest, 0, None));
-    for (z, count) in [
-        (max, FULL_SCALE_SAMPLES),
-        (min, FULL_SCALE_SAMPLES),
-        (max, 8),
-        (0, 16),
-    ] {
-        for _ in 0..count {
-            schedule.push((Segment::FullScale, false, widest, z, None));
-        }
-    }
+    let plant = &job.settings.plant;
+    let seed = job.config.seed;
+    let record = plant.simulate(&rate, &modes, seed);
+    let (ya, sat_a) = adc(&record.y[0], est.input);
+    let (yb, sat_b) = adc(&record.y[1], est.input);
 
-    let mut fixed = FixedKf::new(plan);
-    let mut float = FloatKf::new(plan.quantized_gains());
-    let mut ideal = FloatKf::new(plan.gains.clone());
-    let lsb = plan.output.lsb();
-    let mut rows = Vec::with_capacity(schedule.len());
-    let (mut count, mut max_err, mut sum_sq, mut ideal_max, mut ideal_sq, mut signal_sq) =
-        (0u64, 0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64);
-    let mut switches = 0u64;
+    let [mut seq_block, mut est_block, mut kf_block, mut top_block] =
+        empty_blocks(job, rom_kf.0, rom_estimator.0);
+    est_block.roms.push(rom_estimator.clone());
+    kf_block.roms.push(rom_kf.clone());
+    top_block.roms.push(rom_estimator);
+    top_block.roms.push(rom_kf);
+
+    let mut fixed = FixedChain::new(plan);
+    let mut float = FloatChain::quantized(plan);
+    let mut ideal = FloatChain::ideal(plan);
+    let mut kf_float = FloatKf::new(kf.quantized_gains());
+    let mut kf_ideal = FloatKf::new(kf.gains.clone());
+    let (mut kf_acc, mut chain_acc, mut bias_acc) = (
+        Accumulator::default(),
+        Accumulator::default(),
+        Accumulator::default(),
+    );
+    let mut chain_switches = 0u64;
     let mut previous_sel = None;
-    for (segment, rst, bw_sel, z, true_rate) in schedule {
-        if rst {
+    let out_lsb = kf.output.lsb();
+    let bias_lsb = est.bias.lsb();
+    let (mut combined_series, mut filtered_series) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    let mut true_series = Vec::with_capacity(n);
+    let mut extra_float = Vec::with_capacity(n + 2);
+    let mut extra_ideal = Vec::with_capacity(n + 2);
+    let mut extra_true = Vec::with_capacity(n + 2);
+    let zero_outputs_top = [0i128; 7];
+
+    for k in 0..n {
+        if reset_at == Some(k) {
             fixed.reset();
             float.reset();
             ideal.reset();
-            rows.push(Row {
-                segment,
-                rst,
-                bw_sel,
-                z,
-                valid: false,
-                rate: 0,
-                float_rate: 0.0,
-                ideal_rate: 0.0,
-                true_rate,
-            });
-            continue;
+            kf_float.reset();
+            kf_ideal.reset();
+            seq_block.push(true, &[], &[0; 9]);
+            est_block.push(true, &[0; 9], &[0, 0, 0]);
+            kf_block.push(true, &[0, 0], &[0, 0]);
+            top_block.push(true, &[0, 0, 0], &zero_outputs_top);
+            for extra in [&mut extra_float, &mut extra_ideal, &mut extra_true] {
+                extra.push(f64::NAN);
+            }
         }
-        let rate = fixed.step(z, bw_sel);
-        let z_real = plan.input.to_f64(i128::from(z));
-        let float_rate = float.step(z_real, bw_sel);
-        let ideal_rate = ideal.step(z_real, bw_sel);
-        if segment == Segment::Stimulus {
+        let bw_sel = (k / chunk) % entries;
+        let y = [ya[k], yb[k]];
+        let y_real = [
+            est.input.to_f64(i128::from(y[0])),
+            est.input.to_f64(i128::from(y[1])),
+        ];
+        let a = fixed.step(y, bw_sel);
+        let b = float.step(y_real, bw_sel);
+        let c = ideal.step(y_real, bw_sel);
+        let s = a.slot;
+        let slot_codes = [
+            flag(s.blank_a),
+            flag(s.blank_b),
+            flag(s.done_a),
+            flag(s.done_b),
+            s.interval_a as i128,
+            s.interval_b as i128,
+            flag(s.window_done),
+        ];
+        seq_block.push(
+            false,
+            &[],
+            &[
+                mode_bit(s.mode_a),
+                mode_bit(s.mode_b),
+                flag(s.blank_a),
+                flag(s.blank_b),
+                s.interval_a as i128,
+                s.interval_b as i128,
+                flag(s.done_a),
+                flag(s.done_b),
+                flag(s.window_done),
+            ],
+        );
+        let bias_after = fixed.estimator().bias();
+        let estimated = flag(fixed.estimator().estimated());
+        let mut est_inputs = vec![i128::from(y[0]), i128::from(y[1])];
+        est_inputs.extend(slot_codes);
+        est_block.push(
+            false,
+            &est_inputs,
+            &[bias_after[0], bias_after[1], estimated],
+        );
+        let rate_code = a.rate.map(i128::from).unwrap_or(0);
+        top_block.push(
+            false,
+            &[bw_sel as i128, i128::from(y[0]), i128::from(y[1])],
+            &[
+                mode_bit(s.mode_a),
+                mode_bit(s.mode_b),
+                flag(a.rate.is_some()),
+                rate_code,
+                bias_after[0],
+                bias_after[1],
+                estimated,
+            ],
+        );
+        extra_float.push(b.rate.unwrap_or(f64::NAN));
+        extra_ideal.push(c.rate.unwrap_or(f64::NAN));
+        extra_true.push(rate[k]);
+
+        // Bias estimates: fixed vs float, every sample (the ones in use).
+        for g in 0..2 {
+            bias_acc.add(
+                est.bias.to_f64(i128::from(a.estimator.bias[g])),
+                b.estimator.bias[g],
+                c.estimator.bias[g],
+                bias_lsb,
+            );
+        }
+        if let Some(code) = a.rate {
             if previous_sel.is_some_and(|p| p != bw_sel) {
-                switches += 1;
+                chain_switches += 1;
             }
             previous_sel = Some(bw_sel);
-            let fixed_real = plan.output.to_f64(i128::from(rate));
-            let err = (fixed_real - float_rate) / lsb;
-            let ideal_err = (fixed_real - ideal_rate) / lsb;
-            count += 1;
-            max_err = max_err.max(err.abs());
-            sum_sq += err * err;
-            ideal_max = ideal_max.max(ideal_err.abs());
-            ideal_sq += ideal_err * ideal_err;
-            signal_sq += (ideal_rate / lsb) * (ideal_rate / lsb);
+            let fixed_real = kf.output.to_f64(i128::from(code));
+            chain_acc.add(
+                fixed_real,
+                b.rate.unwrap_or(f64::NAN),
+                c.rate.unwrap_or(f64::NAN),
+                out_lsb,
+            );
+            // The KF block sees exactly the chain's KF inputs.
+            let z = a.estimator.combined;
+            kf_block.push(
+                false,
+                &[bw_sel as i128, i128::from(z)],
+                &[1, i128::from(code)],
+            );
+            let z_real = kf.input.to_f64(i128::from(z));
+            let kf_b = kf_float.step(z_real, bw_sel);
+            let kf_c = kf_ideal.step(z_real, bw_sel);
+            kf_acc.add(fixed_real, kf_b, kf_c, out_lsb);
+            filtered_series.push(fixed_real);
+        } else {
+            filtered_series.push(*filtered_series.last().unwrap_or(&0.0));
         }
-        rows.push(Row {
-            segment,
-            rst,
-            bw_sel,
-            z,
-            valid: true,
-            rate,
-            float_rate,
-            ideal_rate,
-            true_rate,
-        });
+        let combined = if a.estimator.combined_valid {
+            est.calibrated.to_f64(i128::from(a.estimator.combined))
+        } else {
+            *combined_series.last().unwrap_or(&0.0)
+        };
+        combined_series.push(combined);
+        true_series.push(rate[k]);
     }
-    let mean = |s: f64| {
-        if count == 0 {
-            0.0
-        } else {
-            (s / count as f64).sqrt()
-        }
-    };
-    let stats = ErrorStats {
-        samples: count,
-        max_lsb: max_err,
-        rms_lsb: mean(sum_sq),
-        bound_lsb: rate_error_bound_lsb(plan, count, switches),
-        ideal_max_lsb: ideal_max,
-        ideal_rms_lsb: mean(ideal_sq),
-        sqnr_db: if ideal_sq > 0.0 {
-            10.0 * libm::log10(signal_sq / ideal_sq)
-        } else {
-            f64::INFINITY
+    let kf_chain_overflows = fixed.kf().overflow_counts();
+    let estimator_overflows = fixed.estimator().overflow_counts();
+    let kf_steps = kf_acc.count;
+    let kf_stats = kf_acc.finish(rate_error_bound_lsb(kf, kf_steps, chain_switches));
+    let chain_stats = chain_acc.finish(plan.rate_error_bound_lsb(kf_steps, chain_switches));
+    let bias_stats = bias_acc.finish(est.bias_error_bound() / bias_lsb);
+
+    // The KF's directed segment: ties and full scale, each from reset.
+    let ties = find_ties(kf);
+    let directed_overflows = directed_segment(kf, &ties, &mut kf_block);
+    top_block.extra = vec![
+        ("float_rate_dps", extra_float),
+        ("ideal_rate_dps", extra_ideal),
+        ("true_rate_dps", extra_true),
+    ];
+
+    // Report: raw gyros run without reversal (same noise streams), calibrated, filtered.
+    let raw = plant.simulate(&rate, &vec![[1i8, 1i8]; n], seed);
+    let fs = job.config.stimulus.fs_hz;
+    let report = report(
+        fs,
+        &rate,
+        [&raw.y[0], &raw.y[1], &combined_series, &filtered_series],
+    );
+    Ok(Run {
+        blocks: vec![seq_block, est_block, kf_block, top_block],
+        kf_stats,
+        chain_stats,
+        bias_stats,
+        overflows: Overflows {
+            adc: [sat_a, sat_b],
+            estimator: estimator_overflows.into(),
+            kf_chain: kf_chain_overflows.into(),
+            kf_directed: directed_overflows.into(),
         },
-    };
-    Vectors {
-        rows,
-        overflow: fixed.overflow_counts(),
-        stats,
         ties,
-    }
+        report,
+        samples: n,
+    })
+}
+
+fn report(fs: f64, rate: &[f64], signals: [&[f64]; 4]) -> Report {
+    let names = [
+        "raw gyro A (no reversal)",
+        "raw gyro B (no reversal)",
+        "calibrated, combined",
+        "filtered (KF output)",
+    ];
+    let tau_s: Vec<f64> = [0.1, 1.0, 10.0, 100.0, 1000.0]
+        .into_iter()
+        .filter(|tau| ((tau * fs).round() as usize) * 3 <= rate.len() && tau * fs >= 1.0)
+        .collect();
+    let lines = names
+        .iter()
+        .zip(signals)
+        .map(|(name, signal)| {
+            let errors: Vec<f64> = signal.iter().zip(rate).map(|(s, r)| s - r).collect();
+            ReportLine {
+                signal: name.to_string(),
+                bias_error_dps: errors.iter().sum::<f64>() / errors.len().max(1) as f64,
+                adev_dps: tau_s
+                    .iter()
+                    .map(|tau| overlapping_adev(&errors, (tau * fs).round() as usize))
+                    .collect(),
+            }
+        })
+        .collect();
+    Report { tau_s, lines }
 }
 
 /// For each ROM entry, an input that from reset lands each quantization point exactly on a
@@ -262,44 +715,71 @@ fn find_ties(plan: &Plan) -> Vec<TieCases> {
         .collect()
 }
 
+/// Appends the directed rows to the KF block: per ROM entry a reset and each tie input, then a
+/// reset and full-scale inputs at the widest bandwidth. Returns that segment's overflows.
+fn directed_segment(plan: &Plan, ties: &[TieCases], block: &mut Block) -> OverflowCounts {
+    let mut kf = FixedKf::new(plan);
+    let mut push = |kf: &mut FixedKf, rst: bool, sel: usize, z: i64| {
+        if rst {
+            kf.reset();
+            block.push(true, &[sel as i128, 0], &[0, 0]);
+        } else {
+            let rate = kf.step(z, sel);
+            block.push(false, &[sel as i128, i128::from(z)], &[1, i128::from(rate)]);
+        }
+    };
+    for tie in ties {
+        for z in [tie.x1, tie.x2, tie.rate_hat].into_iter().flatten() {
+            push(&mut kf, true, tie.bw_sel, 0);
+            push(&mut kf, false, tie.bw_sel, z);
+        }
+    }
+    let widest = plan.rom.len() - 1;
+    let (max, min) = (plan.input.max_code() as i64, plan.input.min_code() as i64);
+    push(&mut kf, true, widest, 0);
+    for (z, count) in [
+        (max, FULL_SCALE_SAMPLES),
+        (min, FULL_SCALE_SAMPLES),
+        (max, 8),
+        (0, 16),
+    ] {
+        for _ in 0..count {
+            push(&mut kf, false, widest, z);
+        }
+    }
+    kf.overflow_counts()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::config::Config;
-    use crate::job::Job;
 
     #[test]
-    fn the_default_set_has_switches_a_reset_ties_and_full_scale() {
+    fn the_default_run_fills_every_block_and_stays_within_the_bounds() {
         let mut config = Config::embedded();
-        config.samples = 2000;
+        config.samples = 4000;
         let job = Job::new(config).unwrap();
-        let vectors = build(&job.plan, &job.stimulus().unwrap());
-        let stimulus_resets = vectors
-            .rows
-            .iter()
-            .filter(|r| r.segment == Segment::Stimulus && r.rst)
-            .count();
-        assert_eq!(stimulus_resets, 1);
-        let sels: std::collections::BTreeSet<usize> =
-            vectors.rows.iter().map(|r| r.bw_sel).collect();
-        assert_eq!(sels.len(), 3);
-        // Each tie input really is a tie from reset, and one exists for x1 and the output.
-        let kf = FixedKf::new(&job.plan);
-        for tie in &vectors.ties {
-            let z = tie.x1.expect("an x1 tie exists in range");
-            assert!(kf.ties(z, tie.bw_sel)[0]);
-            let z = tie.rate_hat.expect("an output tie exists in range");
-            assert!(kf.ties(z, tie.bw_sel)[2]);
+        let run = run(&job, ("kf.mem", String::new()), ("est.mem", String::new())).unwrap();
+        let names: Vec<&str> = run.blocks.iter().map(|b| b.name).collect();
+        assert_eq!(names, ["sequencer", "estimator", "kf", "top"]);
+        // One row per sample plus the reset, in every chain block.
+        for b in [&run.blocks[0], &run.blocks[1], &run.blocks[3]] {
+            assert_eq!(b.len(), 4001, "{}", b.name);
         }
-        let max = job.plan.input.max_code() as i64;
-        assert!(vectors
-            .rows
-            .iter()
-            .any(|r| r.segment == Segment::FullScale && r.z == max));
-        assert!(vectors.stats.max_lsb <= 1.0);
-        assert!(vectors.stats.max_lsb <= vectors.stats.bound_lsb);
-        assert!(vectors.stats.sqnr_db > 60.0, "{}", vectors.stats.sqnr_db);
-        // Invalid rows are exactly the resets.
-        assert!(vectors.rows.iter().all(|r| r.valid != r.rst));
+        assert!(run.kf_stats.max_lsb <= run.kf_stats.bound_lsb);
+        assert!(run.chain_stats.max_lsb <= run.chain_stats.bound_lsb);
+        assert!(run.bias_stats.max_lsb <= run.bias_stats.bound_lsb);
+        // Each tie input really is a tie from reset, for x1 and the output.
+        let kf = FixedKf::new(job.kf());
+        for tie in &run.ties {
+            assert!(kf.ties(tie.x1.expect("x1 tie"), tie.bw_sel)[0]);
+            assert!(kf.ties(tie.rate_hat.expect("output tie"), tie.bw_sel)[2]);
+        }
+        // Every bw_sel value occurs in the top vectors.
+        let sels: std::collections::BTreeSet<i128> = (0..run.blocks[3].len())
+            .map(|k| run.blocks[3].row(k)[1])
+            .collect();
+        assert_eq!(sels.len(), 3);
     }
 }

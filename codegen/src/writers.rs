@@ -1,41 +1,44 @@
-//! Text writers of the verification package: the coefficient ROM, the parameter include, the
-//! vector files, the testbench, the Makefile and the package README.
+//! Text writers of the verification package: coefficient ROMs, each block's parameter include,
+//! vector files and testbench, the Makefile, the README and the report.
 //!
 //! Every file starts with a line saying it is generated and how to regenerate it.
 
 use std::fmt::Write as _;
 
+use gyrofx_model::estimator;
 use gyrofx_model::fx::Format;
 use gyrofx_model::kf::{Plan, COEFFICIENT_NAMES};
 
-use crate::vectors::Vectors;
+use crate::block::Block;
+use crate::testbench::header;
+use crate::vectors::Run;
 
 /// The reference RTL, embedded so that every package is self-contained.
-pub const RTL_SOURCES: [(&str, &str); 2] = [
+pub const RTL_SOURCES: [(&str, &str); 6] = [
     (
         "gyrofx_quantize.v",
         include_str!("../../hdl/gyrofx_quantize.v"),
     ),
     ("gyrofx_kf.v", include_str!("../../hdl/gyrofx_kf.v")),
+    (
+        "gyrofx_sequencer.v",
+        include_str!("../../hdl/gyrofx_sequencer.v"),
+    ),
+    (
+        "gyrofx_bias_estimator.v",
+        include_str!("../../hdl/gyrofx_bias_estimator.v"),
+    ),
+    (
+        "gyrofx_calibration.v",
+        include_str!("../../hdl/gyrofx_calibration.v"),
+    ),
+    ("gyrofx_top.v", include_str!("../../hdl/gyrofx_top.v")),
 ];
 
-const TESTBENCH_TEMPLATE: &str = include_str!("templates/tb_gyrofx_kf.v");
-
-/// Names of the KF files inside the package's `kf/` folder.
-pub mod names {
-    /// Coefficient ROM image.
-    pub const ROM: &str = "kf_coefficients.mem";
-    /// Parameter include.
-    pub const PARAMS: &str = "gyrofx_kf_params.vh";
-    /// Stimulus vectors.
-    pub const STIMULUS: &str = "kf_stimulus.hex";
-    /// Expected vectors.
-    pub const EXPECTED: &str = "kf_expected.hex";
-    /// Vectors as CSV.
-    pub const CSV: &str = "kf_vectors.csv";
-    /// Testbench.
-    pub const TESTBENCH: &str = "tb_gyrofx_kf.v";
-}
+/// File name of the KF coefficient ROM.
+pub const KF_ROM: &str = "kf_coefficients.mem";
+/// File name of the estimator's gain ROM.
+pub const ESTIMATOR_ROM: &str = "estimator_gains.mem";
 
 /// Where generated files come from: printed at the top of each.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -77,22 +80,20 @@ pub fn push_hex(out: &mut String, code: i128, format: Format) {
 }
 
 /// Appends `value` in the shortest form that reads back exactly (ryu: the same digits on
-/// every platform).
+/// every platform); NaN as an empty cell.
 fn push_real(out: &mut String, buffer: &mut ryu::Buffer, value: f64) {
-    out.push_str(buffer.format(value));
+    if !value.is_nan() {
+        out.push_str(buffer.format(value));
+    }
 }
 
-fn push_integer(out: &mut String, buffer: &mut itoa::Buffer, value: impl itoa::Integer) {
-    out.push_str(buffer.format(value));
-}
-
-/// Width of a ROM word: `g1` and `g2` side by side.
+/// Width of a KF ROM word: `g1` and `g2` side by side.
 pub fn rom_word_width(plan: &Plan) -> u32 {
     plan.coefficient[0].width + plan.coefficient[1].width
 }
 
-/// The coefficient ROM for `$readmemh`: one word `{g1, g2}` per `bw_sel` address.
-pub fn rom_mem(plan: &Plan, provenance: &Provenance) -> String {
+/// The KF coefficient ROM for `$readmemh`: one word `{g1, g2}` per `bw_sel` address.
+pub fn kf_rom(plan: &Plan, provenance: &Provenance) -> String {
     let word =
         Format::intermediate(false, rom_word_width(plan), 0).expect("two declared widths fit");
     let mut out = provenance.line("//");
@@ -122,250 +123,306 @@ pub fn rom_mem(plan: &Plan, provenance: &Provenance) -> String {
     out
 }
 
-/// The Verilog include with the formats and file names as localparams (include it inside a
-/// module).
-pub fn params_vh(plan: &Plan, vector_count: usize, provenance: &Provenance) -> String {
+/// The estimator's gain ROM: A's row over `[mA0, mB0, mA1, …]`, then B's.
+pub fn estimator_rom(plan: &estimator::Plan, provenance: &Provenance) -> String {
     let mut out = provenance.line("//");
-    out.push_str(
-        "\n// KF formats as localparams: <NAME>_W = word width, <NAME>_F = fraction bits.\n",
+    let _ = writeln!(
+        out,
+        "\n// bias-estimator gains G ({}): {} words, A's row over [mA0, mB0, mA1, ...] then B's",
+        plan.gain,
+        2 * plan.rom[0].len()
     );
-    let mut param = |name: &str, value: i64, comment: &str| {
-        let _ = writeln!(out, "localparam integer KF_{name} = {value}; // {comment}");
-    };
-    let formats = [
-        ("IN", plan.input, "input z"),
-        ("STATE", plan.state, "states x1, x2"),
-        ("OUT", plan.output, "output rate_out"),
-        ("G1", plan.coefficient[0], "coefficient g1"),
-        ("G2", plan.coefficient[1], "coefficient g2"),
-    ];
-    for (name, format, what) in formats {
-        param(
-            &format!("{name}_W"),
-            format.width.into(),
-            &format!("{what}: {format}"),
-        );
-        param(
-            &format!("{name}_F"),
-            format.frac.into(),
-            &format!("{what}: {format}"),
+    let quantized = plan.quantized_gains();
+    for (row, name) in ["bias_a", "bias_b"].iter().enumerate() {
+        for (j, code) in plan.rom[row].iter().enumerate() {
+            let mean = if j % 2 == 0 { "mA" } else { "mB" };
+            let _ = writeln!(
+                out,
+                "// {name} <- {mean}{}: {}\n{}",
+                j / 2,
+                quantized[row][j],
+                hex(*code, plan.gain)
+            );
+        }
+    }
+    out
+}
+
+/// The block's parameter include: the DUT's parameters as `P_<NAME>` localparams, the vector
+/// count and the vector file names.
+pub fn params_vh(block: &Block, provenance: &Provenance) -> String {
+    let mut out = provenance.line("//");
+    let _ = writeln!(
+        out,
+        "\n// {} parameters of {} (include inside a module).",
+        block.name, block.module
+    );
+    for p in &block.params {
+        let kind = if p.kind.is_empty() {
+            String::new()
+        } else {
+            format!("{} ", p.kind)
+        };
+        let _ = writeln!(
+            out,
+            "localparam {kind}P_{} = {}; // {}",
+            p.name, p.value, p.comment
         );
     }
-    param("SEL_W", plan.select_width().into(), "bw_sel width");
-    param("ROM_DEPTH", plan.rom.len() as i64, "coefficient sets");
-    param(
-        "ROUNDING",
-        plan.rounding.rtl_code().into(),
-        plan.rounding.name(),
-    );
-    param(
-        "SATURATE",
-        plan.overflow.rtl_code().into(),
-        plan.overflow.name(),
-    );
-    param(
-        "VECTOR_COUNT",
-        vector_count as i64,
-        "lines of the vector files",
-    );
-    let _ = writeln!(out, "localparam KF_ROM_FILE = \"{}\";", names::ROM);
+    let _ = writeln!(out, "localparam integer VECTOR_COUNT = {};", block.len());
     let _ = writeln!(
         out,
-        "localparam KF_STIMULUS_FILE = \"{}\";",
-        names::STIMULUS
+        "localparam STIMULUS_FILE = \"{}\";",
+        block.file("stimulus.hex")
     );
     let _ = writeln!(
         out,
-        "localparam KF_EXPECTED_FILE = \"{}\";",
-        names::EXPECTED
+        "localparam EXPECTED_FILE = \"{}\";",
+        block.file("expected.hex")
     );
     out
 }
 
-/// Formats of the stimulus fields, in file order.
-pub fn stimulus_fields(plan: &Plan) -> [(&'static str, String); 3] {
-    [
-        ("rst", "u1.0".to_string()),
-        ("bw_sel", format!("u{}.0", plan.select_width())),
-        ("z", plan.input.to_string()),
-    ]
-}
-
-/// Formats of the expected fields, in file order.
-pub fn expected_fields(plan: &Plan) -> [(&'static str, String); 2] {
-    [
-        ("valid", "u1.0".to_string()),
-        ("rate_out", plan.output.to_string()),
-    ]
-}
-
-fn field_header(fields: &[(&'static str, String)]) -> String {
-    let parts: Vec<String> = fields.iter().map(|(n, f)| format!("{n}:{f}")).collect();
-    format!("// {}\n", parts.join(" "))
-}
-
-/// The stimulus and expected vector files (hex, one line per clock-enable), and the CSV. The
-/// CSV is built on a second thread while the hex files are built on this one.
-pub fn vector_files(
-    plan: &Plan,
-    vectors: &Vectors,
-    provenance: &Provenance,
-) -> (String, String, String) {
-    std::thread::scope(|scope| {
-        let csv = scope.spawn(|| vector_csv(plan, vectors, provenance));
-        let (stimulus, expected) = vector_hex(plan, vectors, provenance);
-        (
-            stimulus,
-            expected,
-            csv.join().expect("the CSV writer does not panic"),
-        )
-    })
-}
-
-fn vector_hex(plan: &Plan, vectors: &Vectors, provenance: &Provenance) -> (String, String) {
-    let select = Format::new(false, plan.select_width(), 0).expect("select width is small");
+/// The block's stimulus and expected vector files (hex, one line per clock-enable).
+pub fn vector_hex(block: &Block, provenance: &Provenance) -> (String, String) {
     let bit = Format::new(false, 1, 0).expect("1 bit");
-    let rows = &vectors.rows;
-    let mut stimulus = String::with_capacity(rows.len() * (plan.input.hex_digits() + 6) + 256);
-    let mut expected = String::with_capacity(rows.len() * (plan.output.hex_digits() + 4) + 256);
-    stimulus.push_str(&provenance.line("//"));
-    stimulus.push('\n');
-    stimulus.push_str(&field_header(&stimulus_fields(plan)));
-    expected.push_str(&provenance.line("//"));
-    expected.push('\n');
-    expected.push_str(&field_header(&expected_fields(plan)));
-    for row in rows {
-        push_hex(&mut stimulus, i128::from(row.rst), bit);
-        stimulus.push(' ');
-        push_hex(&mut stimulus, row.bw_sel as i128, select);
-        stimulus.push(' ');
-        push_hex(&mut stimulus, i128::from(row.z), plan.input);
+    let n = block.len();
+    let mut stimulus = String::with_capacity(n * (2 + 8 * block.inputs.len()) + 256);
+    let mut expected = String::with_capacity(n * (2 + 8 * block.outputs.len()) + 256);
+    let inputs: Vec<_> = block.inputs.iter().collect();
+    let outputs: Vec<_> = block.outputs.iter().map(|o| &o.signal).collect();
+    for (text, fields, rst) in [
+        (&mut stimulus, &inputs, true),
+        (&mut expected, &outputs, false),
+    ] {
+        text.push_str(&provenance.line("//"));
+        text.push('\n');
+        text.push_str(&header(fields, rst));
+        text.push('\n');
+    }
+    let ni = block.inputs.len();
+    for k in 0..n {
+        let row = block.row(k);
+        push_hex(&mut stimulus, row[0], bit);
+        for (code, s) in row[1..=ni].iter().zip(&block.inputs) {
+            stimulus.push(' ');
+            push_hex(&mut stimulus, *code, s.format);
+        }
         stimulus.push('\n');
-        push_hex(&mut expected, i128::from(row.valid), bit);
-        expected.push(' ');
-        push_hex(&mut expected, i128::from(row.rate), plan.output);
+        for (i, (code, o)) in row[1 + ni..].iter().zip(&block.outputs).enumerate() {
+            if i > 0 {
+                expected.push(' ');
+            }
+            push_hex(&mut expected, *code, o.signal.format);
+        }
         expected.push('\n');
     }
     (stimulus, expected)
 }
 
-fn vector_csv(plan: &Plan, vectors: &Vectors, provenance: &Provenance) -> String {
-    let rows = &vectors.rows;
-    let mut csv = String::with_capacity(rows.len() * 120 + 256);
+/// The block's vectors as CSV: sample, rst, then per signal its code (and its real value in
+/// °/s for signed signals), then the block's extra columns.
+pub fn vector_csv(block: &Block, provenance: &Provenance) -> String {
+    let n = block.len();
+    let mut csv = String::with_capacity(n * 16 * block.stride() + 256);
     csv.push_str(&provenance.line("#"));
-    csv.push_str("\nsample,segment,rst,bw_sel,z_code,z_dps,valid,rate_code,rate_dps,float_rate_dps,ideal_rate_dps,true_rate_dps\n");
+    csv.push_str("\nsample,rst");
+    let signals: Vec<_> = block
+        .inputs
+        .iter()
+        .chain(block.outputs.iter().map(|o| &o.signal))
+        .collect();
+    for s in &signals {
+        let _ = write!(csv, ",{}", s.name);
+        if s.is_real() {
+            let _ = write!(csv, ",{}_dps", s.name);
+        }
+    }
+    for (name, _) in &block.extra {
+        let _ = write!(csv, ",{name}");
+    }
+    csv.push('\n');
     let (mut real, mut int) = (ryu::Buffer::new(), itoa::Buffer::new());
-    for (index, row) in rows.iter().enumerate() {
-        push_integer(&mut csv, &mut int, index);
+    for k in 0..n {
+        let row = block.row(k);
+        csv.push_str(int.format(k));
         csv.push(',');
-        csv.push_str(row.segment.name());
-        csv.push_str(if row.rst { ",1," } else { ",0," });
-        push_integer(&mut csv, &mut int, row.bw_sel);
-        csv.push(',');
-        push_integer(&mut csv, &mut int, row.z);
-        csv.push(',');
-        push_real(&mut csv, &mut real, plan.input.to_f64(i128::from(row.z)));
-        csv.push_str(if row.valid { ",1," } else { ",0," });
-        push_integer(&mut csv, &mut int, row.rate);
-        csv.push(',');
-        push_real(
-            &mut csv,
-            &mut real,
-            plan.output.to_f64(i128::from(row.rate)),
-        );
-        csv.push(',');
-        push_real(&mut csv, &mut real, row.float_rate);
-        csv.push(',');
-        push_real(&mut csv, &mut real, row.ideal_rate);
-        csv.push(',');
-        if let Some(t) = row.true_rate {
-            push_real(&mut csv, &mut real, t);
+        csv.push_str(int.format(row[0]));
+        for (code, s) in row[1..].iter().zip(&signals) {
+            csv.push(',');
+            csv.push_str(int.format(*code));
+            if s.is_real() {
+                csv.push(',');
+                push_real(&mut csv, &mut real, s.format.to_f64(*code));
+            }
+        }
+        for (_, values) in &block.extra {
+            csv.push(',');
+            push_real(&mut csv, &mut real, values[k]);
         }
         csv.push('\n');
     }
     csv
 }
 
-/// The self-checking testbench.
-pub fn testbench(provenance: &Provenance) -> String {
-    TESTBENCH_TEMPLATE.replace("{{HEADER}}", &provenance.line("//"))
-}
-
-/// Simulator commands of the package, run from its `kf/` folder. One source for the Makefile
-/// and for `gyrofx verify`'s messages.
-pub fn makefile(provenance: &Provenance) -> String {
+/// The Makefile: `sim-iverilog` / `sim-verilator` run every block's testbench, and
+/// `iverilog-<block>` / `verilator-<block>` one. Each recipe runs in the block's folder.
+pub fn makefile(blocks: &[Block], provenance: &Provenance) -> String {
     let rtl: Vec<String> = RTL_SOURCES
         .iter()
         .map(|(n, _)| format!("../hdl/{n}"))
         .collect();
-    format!(
+    let names: Vec<&str> = blocks.iter().map(|b| b.name).collect();
+    let mut out = format!(
         "{header}
-# Runs the KF testbench in each simulator, without gyrofx: make sim-iverilog, make sim-verilator.
+# Runs the testbenches in each simulator, without gyrofx: make sim-iverilog, make sim-verilator
+# (every block), or make iverilog-<block> / verilator-<block>. Blocks: {list}.
 IVERILOG ?= iverilog
 VVP ?= vvp
 VERILATOR ?= verilator
 RTL := {rtl}
 
-.PHONY: all sim-iverilog sim-verilator clean
+.PHONY: all sim-iverilog sim-verilator clean{phony}
 all: sim-iverilog sim-verilator
-
-sim-iverilog:
-\tcd kf && $(IVERILOG) -g2005 -Wall -o tb_gyrofx_kf.vvp $(RTL) {tb} && $(VVP) -n tb_gyrofx_kf.vvp $(PLUSARGS)
-
-sim-verilator:
-\tcd kf && $(VERILATOR) --binary --timing -Wall -Wno-DECLFILENAME -Wno-UNUSEDSIGNAL -Wno-fatal -j 2 --top-module tb_gyrofx_kf -Mdir obj_verilator $(RTL) {tb} >verilator_build.log 2>&1 || (cat verilator_build.log; exit 1)
-\tcd kf && ./obj_verilator/Vtb_gyrofx_kf $(PLUSARGS)
-
-clean:
-\trm -rf kf/tb_gyrofx_kf.vvp kf/obj_verilator kf/verilator_build.log kf/tb_gyrofx_kf.vcd
+sim-iverilog:{iverilog}
+sim-verilator:{verilator}
 ",
         header = provenance.line("#"),
+        list = names.join(", "),
         rtl = rtl.join(" "),
-        tb = names::TESTBENCH,
-    )
+        phony = names
+            .iter()
+            .map(|n| format!(" iverilog-{n} verilator-{n}"))
+            .collect::<String>(),
+        iverilog = names
+            .iter()
+            .map(|n| format!(" iverilog-{n}"))
+            .collect::<String>(),
+        verilator = names
+            .iter()
+            .map(|n| format!(" verilator-{n}"))
+            .collect::<String>(),
+    );
+    for b in blocks {
+        let tb = format!("tb_{}", b.module);
+        let _ = write!(
+            out,
+            "
+iverilog-{name}:
+\t@echo \"== {name}\"
+\tcd {name} && $(IVERILOG) -g2005 -Wall -o {tb}.vvp $(RTL) {tb}.v && $(VVP) -n {tb}.vvp $(PLUSARGS)
+
+verilator-{name}:
+\t@echo \"== {name}\"
+\tcd {name} && $(VERILATOR) --binary --timing -Wall -Wno-DECLFILENAME -Wno-UNUSEDSIGNAL -Wno-fatal -j 2 --top-module {tb} -Mdir obj_verilator $(RTL) {tb}.v >verilator_build.log 2>&1 || (cat verilator_build.log; exit 1)
+\tcd {name} && ./obj_verilator/V{tb} $(PLUSARGS)
+",
+            name = b.name,
+        );
+    }
+    let _ = write!(
+        out,
+        "
+clean:
+\trm -rf {}
+",
+        names
+            .iter()
+            .map(|n| format!("{n}/*.vvp {n}/obj_verilator {n}/verilator_build.log {n}/*.vcd"))
+            .collect::<Vec<_>>()
+            .join(" ")
+    );
+    out
 }
 
 /// The package's README.
-pub fn package_readme(plan: &Plan, vectors: &Vectors, provenance: &Provenance) -> String {
-    format!(
+pub fn package_readme(run: &Run, provenance: &Provenance) -> String {
+    let mut out = format!(
         "<!-- {line} -->
 # gyrofx verification package
 
-Self-contained: the reference RTL, the vectors, the coefficient ROM and a self-checking
-testbench. Run it without gyrofx:
+Self-contained: the reference RTL, the vectors, the coefficient ROMs and a self-checking
+testbench per block. Run it without gyrofx:
 
-    make sim-iverilog      # Icarus Verilog
-    make sim-verilator     # Verilator (--binary --timing)
+    make sim-iverilog      # Icarus Verilog, every block
+    make sim-verilator     # Verilator (--binary --timing), every block
+    make iverilog-top      # one block
 
-Each prints `PASS n=<N>` or the first mismatches and `FAIL ...`, and exits non-zero on any
-mismatch, timeout or unreadable vector file. `make PLUSARGS=+dump sim-iverilog` writes a VCD.
+Each testbench prints `PASS n=<N>` or the first mismatches and `FAIL ...`, and exits non-zero on
+any mismatch, timeout or unreadable vector file. `make PLUSARGS=+dump iverilog-kf` writes a VCD.
 
-| file | what |
-|------|------|
-| `hdl/` | reference RTL (Verilog-2001) |
-| `kf/{rom}` | coefficient ROM, `$readmemh`, word = {{g1 {g1}, g2 {g2}}}, address = bw_sel |
-| `kf/{params}` | formats and file names as localparams |
-| `kf/{stimulus}` | stimulus: `rst bw_sel z` per line (hex; z in {input}) |
-| `kf/{expected}` | expected: `valid rate_out` per line (hex; rate_out in {output}) |
-| `kf/{csv}` | the same with integer codes and real values (°/s) |
-| `kf/{tb}` | the testbench |
-| `manifest.json` | config, formats, SHA-256 of every file, overflow counts, error statistics |
-
-{rows} vectors; fixed vs float (same quantized gains): max {max:.3} LSB, bound {bound:.3} LSB.
+| folder | DUT | vectors |
+|--------|-----|---------|
 ",
         line = provenance.line("").trim_start(),
-        rom = names::ROM,
-        params = names::PARAMS,
-        stimulus = names::STIMULUS,
-        expected = names::EXPECTED,
-        csv = names::CSV,
-        tb = names::TESTBENCH,
-        g1 = plan.coefficient[0],
-        g2 = plan.coefficient[1],
-        input = plan.input,
-        output = plan.output,
-        rows = vectors.rows.len(),
-        max = vectors.stats.max_lsb,
-        bound = vectors.stats.bound_lsb,
-    )
+    );
+    for b in &run.blocks {
+        let _ = writeln!(
+            out,
+            "| `{}/` | `{}` ({}) | {} |",
+            b.name,
+            b.module,
+            b.title,
+            b.len()
+        );
+    }
+    let _ = write!(
+        out,
+        "
+In each folder: `<block>_params.vh` (the DUT's parameters, the vector count and file names),
+`<block>_stimulus.hex` (`rst` and the inputs per line), `<block>_expected.hex` (the outputs per
+line), `<block>_vectors.csv` (the same with integer codes and real values in °/s) and the
+testbench `tb_<module>.v`; the ROM images the DUT reads. Line 2 of each hex file names every
+field and its format. `report.md` has the Allan table; `manifest.json` the config, formats,
+SHA-256 of every file, overflow counts and fixed-vs-float error statistics.
+
+Fixed vs float (same quantized coefficients): KF max {kf:.3} LSB (bound {kfb:.3}), chain max
+{ch:.3} LSB (bound {chb:.3}), bias estimates max {bi:.3} LSB (bound {bib:.3}).
+",
+        kf = run.kf_stats.max_lsb,
+        kfb = run.kf_stats.bound_lsb,
+        ch = run.chain_stats.max_lsb,
+        chb = run.chain_stats.bound_lsb,
+        bi = run.bias_stats.max_lsb,
+        bib = run.bias_stats.bound_lsb,
+    );
+    out
+}
+
+/// The report: bias error and Allan deviation of the raw, calibrated and filtered outputs.
+pub fn report_md(run: &Run, provenance: &Provenance) -> String {
+    let r = &run.report;
+    let mut out = format!(
+        "<!-- {} -->
+# gyrofx report
+
+{} samples. Error = signal − true rate. \"Raw\" gyros are the same gyros, with the same noise,
+run without mode reversal; the calibrated output is the mean of the valid calibrated outputs
+(held over blanked samples); the filtered output is the KF's (bw_sel as scheduled).
+
+| signal | bias error (°/s) |",
+        provenance.line("").trim_start(),
+        run.samples
+    );
+    for tau in &r.tau_s {
+        let _ = write!(out, " ADEV τ={tau} s (°/s) |");
+    }
+    out.push_str("\n|---|---:|");
+    for _ in &r.tau_s {
+        out.push_str("---:|");
+    }
+    out.push('\n');
+    for line in &r.lines {
+        let _ = write!(out, "| {} | {:.3e} |", line.signal, line.bias_error_dps);
+        for a in &line.adev_dps {
+            match a {
+                Some(v) => {
+                    let _ = write!(out, " {v:.3e} |");
+                }
+                None => out.push_str(" – |"),
+            }
+        }
+        out.push('\n');
+    }
+    out
 }

@@ -5,6 +5,7 @@
 //! contents), and both the models here and the writers in `gyrofx-codegen` read that plan.
 #![warn(missing_docs)]
 
+pub mod analysis;
 pub mod chain;
 pub mod estimator;
 pub mod examples;

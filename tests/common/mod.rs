@@ -68,15 +68,30 @@ pub fn files_below(root: &Path) -> Vec<PathBuf> {
     out
 }
 
-/// Flips the lowest bit of the `rate_out` field on the line of `sample` in an expected file.
-pub fn flip_expected_bit(package: &Path, sample: usize) {
-    let path = package.join("kf/kf_expected.hex");
+/// Flips the lowest bit of the last field on the line of `sample` in a block's expected file,
+/// and returns that field's name (from the file's header line).
+pub fn flip_expected_bit(package: &Path, block: &str, sample: usize) -> String {
+    let path = package.join(block).join(format!("{block}_expected.hex"));
     let content = std::fs::read_to_string(&path).unwrap();
     let mut lines: Vec<String> = content.lines().map(str::to_string).collect();
+    let signal = lines[1]
+        .rsplit(' ')
+        .next()
+        .unwrap()
+        .split(':')
+        .next()
+        .unwrap()
+        .to_string();
     let line = &mut lines[2 + sample];
-    let (valid, rate) = line.split_once(' ').unwrap();
-    assert_eq!(valid, "1", "sample {sample} must be a valid output");
-    let flipped = u64::from_str_radix(rate, 16).unwrap() ^ 1;
-    *line = format!("{valid} {flipped:0width$x}", width = rate.len());
+    let (head, last) = line
+        .rsplit_once(' ')
+        .map(|(h, l)| (format!("{h} "), l.to_string()))
+        .unwrap_or((String::new(), line.clone()));
+    let flipped = u64::from_str_radix(&last, 16).unwrap() ^ 1;
+    *line = format!("{head}{flipped:0width$x}", width = last.len());
     std::fs::write(&path, lines.join("\n") + "\n").unwrap();
+    signal
 }
+
+/// The blocks of a package, in Makefile order.
+pub const BLOCKS: [&str; 4] = ["sequencer", "estimator", "kf", "top"];

@@ -158,6 +158,11 @@ impl FixedEstimator {
         self.bias
     }
 
+    /// Whether a window has produced an estimate since reset.
+    pub fn estimated(&self) -> bool {
+        self.estimated
+    }
+
     /// Overflow counts since construction.
     pub fn overflow_counts(&self) -> OverflowCounts {
         let c = |q: &[Quantizer; 2]| [q[0].overflow_count, q[1].overflow_count];
