@@ -7,12 +7,16 @@
 //! valid 1 clock after `ce`, like the KF's.
 
 use crate::estimator::{self, FixedEstimator, FloatEstimator};
+use crate::fx::{mode, Rounding};
 use crate::kf::{self, FixedKf, FloatKf};
 use crate::sequencer::{Sequencer, Slot};
 
 /// Errors of planning the chain.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ChainError {
+    /// The blocks' rounding or overflow modes differ (the chain has one of each).
+    #[error("the estimator and the KF must share one rounding and one overflow mode")]
+    Modes,
     /// The estimator's output and the KF's input formats differ.
     #[error("the KF's input_format ({kf}) must equal the estimator's calibrated_format ({calibrated}): the combined output feeds the KF")]
     Formats {
@@ -36,8 +40,12 @@ impl Plan {
     /// Joins the block plans, checking that they connect.
     ///
     /// # Errors
-    /// [`ChainError::Formats`] when the combined output's format is not the KF's input.
+    /// [`ChainError::Formats`] when the combined output's format is not the KF's input, and
+    /// [`ChainError::Modes`] when the blocks round or overflow differently.
     pub fn new(estimator: estimator::Plan, kf: kf::Plan) -> Result<Plan, ChainError> {
+        if estimator.rounding != kf.rounding || estimator.overflow != kf.overflow {
+            return Err(ChainError::Modes);
+        }
         if estimator.calibrated != kf.input {
             return Err(ChainError::Formats {
                 kf: kf.input.to_string(),
@@ -81,6 +89,7 @@ pub struct Sample {
 /// The bit-accurate chain.
 #[derive(Clone, Debug)]
 pub struct FixedChain {
+    rounding: Rounding,
     sequencer: Sequencer,
     estimator: FixedEstimator,
     kf: FixedKf,
@@ -90,6 +99,7 @@ impl FixedChain {
     /// The chain of `plan`, reset.
     pub fn new(plan: &Plan) -> Self {
         FixedChain {
+            rounding: plan.kf.rounding,
             sequencer: Sequencer::new(&plan.estimator.schedule),
             estimator: FixedEstimator::new(&plan.estimator),
             kf: FixedKf::new(&plan.kf),
@@ -112,11 +122,24 @@ impl FixedChain {
     /// One sample: gyro codes `y` (input format) at KF bandwidth `bw_sel`.
     #[inline]
     pub fn step(&mut self, y: [i64; 2], bw_sel: usize) -> Sample {
+        match self.rounding {
+            Rounding::Floor => self.step_mode::<{ mode::FLOOR }>(y, bw_sel),
+            Rounding::Ceil => self.step_mode::<{ mode::CEIL }>(y, bw_sel),
+            Rounding::Zero => self.step_mode::<{ mode::ZERO }>(y, bw_sel),
+            Rounding::Nearest => self.step_mode::<{ mode::NEAREST }>(y, bw_sel),
+            Rounding::Round => self.step_mode::<{ mode::ROUND }>(y, bw_sel),
+            Rounding::Convergent => self.step_mode::<{ mode::CONVERGENT }>(y, bw_sel),
+        }
+    }
+
+    /// One sample with the rounding mode fixed at compile time (every block shares it).
+    #[inline(always)]
+    fn step_mode<const MODE: u8>(&mut self, y: [i64; 2], bw_sel: usize) -> Sample {
         let slot = self.sequencer.advance();
-        let estimator = self.estimator.step(&slot, y);
+        let estimator = self.estimator.step_mode::<MODE>(&slot, y);
         let rate = estimator
             .combined_valid
-            .then(|| self.kf.step(estimator.combined, bw_sel));
+            .then(|| self.kf.step_mode::<MODE>(estimator.combined, bw_sel));
         Sample {
             slot,
             estimator,

@@ -26,7 +26,7 @@
 //!
 //! Units in: ARW °/√h, B °/h, RRW °/h/√h, R °/h², biases °/s, converted once
 //! (`N = ARW/60`, `B/3600`, `K = RRW/216000`, `R/3600²`). Every noise source of every gyro has
-//! its own ChaCha12 stream ([`crate::stimulus::Stream`]).
+//! its own ChaCha8 stream ([`crate::stimulus::Stream`]).
 
 use crate::stimulus::{Gaussian, Stream};
 
@@ -153,7 +153,6 @@ impl Plant {
         bi_times: &[f64],
     ) -> (Vec<f64>, Vec<f64>) {
         let e = self.gyros[usize::from(g)];
-        let n = rate.len();
         let white_sigma = e.arw_deg_per_sqrt_h / 60.0 / t.sqrt();
         let walk_sigma = e.rrw_deg_per_h_per_sqrt_h / 216_000.0 * t.sqrt();
         let ramp_per_sample = e.rate_ramp_deg_per_h2 / (3600.0 * 3600.0) * t;
@@ -165,39 +164,48 @@ impl Plant {
             0.0
         };
 
-        let mut white = Gaussian::new(seed, Stream::AngleRandomWalk(g));
-        let mut walk = Gaussian::new(seed, Stream::RateRandomWalk(g));
+        // Each noise source over the whole record in its own loop: one RNG state at a time.
+        let n = rate.len();
         let b_dps = e.bias_instability_deg_per_h / 3600.0;
         let q = if b_dps > 0.0 {
             self.bias_instability_variance(b_dps)
         } else {
             0.0
         };
-        let mut processes: Vec<(Gaussian, f64, f64, f64)> = bi_times
-            .iter()
-            .enumerate()
-            .map(|(j, tc)| {
+        // Slow part of the bias: instability, random walk, ramp.
+        let mut drift = vec![e.bias_dps; n];
+        if q > 0.0 {
+            for (j, tc) in bi_times.iter().enumerate() {
                 let mut source = Gaussian::new(seed, Stream::BiasInstability(g, j as u8));
                 let a = libm::exp(-t / tc);
                 let drive = (q * (1.0 - a * a)).sqrt();
-                let start = q.sqrt() * source.sample(); // stationary from the first sample
-                (source, a, drive, start)
-            })
-            .collect();
+                let mut x = q.sqrt() * source.sample(); // stationary from the first sample
+                for d in &mut drift {
+                    *d += x;
+                    x = a * x + drive * source.sample();
+                }
+            }
+        }
+        if walk_sigma > 0.0 {
+            let mut walk = Gaussian::new(seed, Stream::RateRandomWalk(g));
+            let mut random_walk = 0.0;
+            for d in &mut drift {
+                *d += random_walk;
+                random_walk += walk_sigma * walk.sample();
+            }
+        }
+        if ramp_per_sample != 0.0 {
+            for (k, d) in drift.iter_mut().enumerate() {
+                *d += ramp_per_sample * k as f64;
+            }
+        }
 
+        let mut white = Gaussian::new(seed, Stream::AngleRandomWalk(g));
         let mut y = Vec::with_capacity(n);
-        let mut bias = Vec::with_capacity(n);
-        let mut random_walk = 0.0;
         let mut transient = 0.0;
-        let mut previous_term: Option<f64> = None;
-        let mut previous_mode = 0i8;
+        let mut previous: Option<(i8, f64)> = None;
         for k in 0..n {
-            let instability: f64 = if q > 0.0 {
-                processes.iter().map(|p| p.3).sum()
-            } else {
-                0.0
-            };
-            let b = e.bias_dps + instability + random_walk + ramp_per_sample * k as f64;
+            let b = drift[k];
             let p = modes[k][usize::from(g)];
             let (sf, offset) = if p > 0 {
                 (sf_normal, 0.0)
@@ -206,23 +214,15 @@ impl Plant {
             };
             let term = f64::from(p) * (b + offset);
             transient *= settle;
-            if let Some(prev) = previous_term {
+            if let Some((previous_mode, previous_term)) = previous {
                 if p != previous_mode {
-                    transient += prev - term;
+                    transient += previous_term - term;
                 }
             }
             y.push(sf * rate[k] + term + transient + white_sigma * white.sample());
-            bias.push(b);
-            previous_term = Some(term);
-            previous_mode = p;
-            random_walk += walk_sigma * walk.sample();
-            if q > 0.0 {
-                for (source, a, drive, x) in &mut processes {
-                    *x = *a * *x + *drive * source.sample();
-                }
-            }
+            previous = Some((p, term));
         }
-        (y, bias)
+        (y, drift)
     }
 }
 

@@ -16,10 +16,10 @@
 //!
 //! # Implementation
 //!
-//! Each gyro has a position counter `t` in `0..W·L`, advanced by one per sample: A's starts at
-//! 0 after reset, B's at `W·L − S` (B begins `S` samples into the tail of a virtual previous
-//! cycle). For the sample at position `t`: interval `t / L`, phase `t % L`, blanked when
-//! `phase < M`, interval done when `phase = L − 1`. A window is done at the end of B's last
+//! Each gyro has a position `t` in `0..W·L` in the cycle, kept as a phase counter `t % L` and
+//! an interval counter `t / L`: A's starts at 0 after reset, B's at `W·L − S` (B begins `S`
+//! samples into the tail of a virtual previous cycle). A sample is blanked when
+//! `phase < M`, its interval done when `phase = L − 1`. A window is done at the end of B's last
 //! interval, counted only once B has started a full cycle (never on B's partial first one).
 //!
 //! # Interface (RTL `hdl/gyrofx_sequencer.v`), all for the current sample, 0 clocks latency
@@ -202,13 +202,15 @@ pub struct Slot {
     pub window_done: bool,
 }
 
-/// The sequencer model: call [`Sequencer::advance`] once per sample.
+/// The sequencer model: call [`Sequencer::advance`] once per sample. Like the RTL it keeps a
+/// phase and an interval counter per gyro (no division per sample).
 #[derive(Clone, Debug)]
 pub struct Sequencer {
     schedule: Schedule,
     modes: Vec<i8>,
-    position_a: usize,
-    position_b: usize,
+    /// Phase in the interval and interval index, of A and of B.
+    phase: [usize; 2],
+    interval: [usize; 2],
     /// B has started a full cycle since reset.
     b_started: bool,
 }
@@ -219,45 +221,55 @@ impl Sequencer {
         let mut s = Sequencer {
             modes: schedule.pattern.modes(schedule.intervals),
             schedule: schedule.clone(),
-            position_a: 0,
-            position_b: 0,
+            phase: [0; 2],
+            interval: [0; 2],
             b_started: false,
         };
         s.reset();
         s
     }
 
-    /// Synchronous reset.
+    /// Synchronous reset: A at position 0, B at `W·L − S`.
     pub fn reset(&mut self) {
-        let cycle = self.schedule.cycle_length();
-        self.position_a = 0;
-        self.position_b = (cycle - self.schedule.stagger) % cycle;
-        self.b_started = self.schedule.stagger == 0;
+        let s = &self.schedule;
+        let b_start = (s.cycle_length() - s.stagger) % s.cycle_length();
+        self.phase = [0, b_start % s.interval_length];
+        self.interval = [0, b_start / s.interval_length];
+        self.b_started = s.stagger == 0;
     }
 
     /// The slot of the current sample, then advances to the next sample.
+    #[inline]
     pub fn advance(&mut self) -> Slot {
         let s = &self.schedule;
-        let (l, cycle) = (s.interval_length, s.cycle_length());
-        let (interval_a, phase_a) = (self.position_a / l, self.position_a % l);
-        let (interval_b, phase_b) = (self.position_b / l, self.position_b % l);
-        if self.position_b == 0 {
+        let last_phase = s.interval_length - 1;
+        if self.phase[1] == 0 && self.interval[1] == 0 {
             self.b_started = true;
         }
-        let done_b = phase_b == l - 1;
+        let done = [self.phase[0] == last_phase, self.phase[1] == last_phase];
         let slot = Slot {
-            mode_a: self.modes[interval_a],
-            mode_b: -self.modes[interval_b],
-            blank_a: phase_a < s.blank,
-            blank_b: phase_b < s.blank,
-            interval_a,
-            interval_b,
-            done_a: phase_a == l - 1,
-            done_b,
-            window_done: done_b && interval_b == s.intervals - 1 && self.b_started,
+            mode_a: self.modes[self.interval[0]],
+            mode_b: -self.modes[self.interval[1]],
+            blank_a: self.phase[0] < s.blank,
+            blank_b: self.phase[1] < s.blank,
+            interval_a: self.interval[0],
+            interval_b: self.interval[1],
+            done_a: done[0],
+            done_b: done[1],
+            window_done: done[1] && self.interval[1] == s.intervals - 1 && self.b_started,
         };
-        self.position_a = (self.position_a + 1) % cycle;
-        self.position_b = (self.position_b + 1) % cycle;
+        for ((phase, interval), done) in self.phase.iter_mut().zip(&mut self.interval).zip(done) {
+            if done {
+                *phase = 0;
+                *interval = if *interval == s.intervals - 1 {
+                    0
+                } else {
+                    *interval + 1
+                };
+            } else {
+                *phase += 1;
+            }
+        }
         slot
     }
 }

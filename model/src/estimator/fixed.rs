@@ -1,6 +1,6 @@
 //! [`FixedEstimator`]: the bit-accurate bias estimator with calibration and combination.
 
-use crate::fx::Quantizer;
+use crate::fx::{mode, Quantizer, Rounding};
 use crate::sequencer::Slot;
 
 use super::plan::Plan;
@@ -52,6 +52,8 @@ pub struct FixedEstimator {
     combined_q: Quantizer,
     /// Common fraction of `y − p·b`.
     calibration_frac: i32,
+    /// `y − p·b` and `out_A + out_B` fit 62 bits: the 64-bit path applies.
+    narrow: bool,
 }
 
 impl FixedEstimator {
@@ -72,6 +74,10 @@ impl FixedEstimator {
             calibrated_q: [0, 1].map(|_| q(calibration_frac, plan.calibrated)),
             combined_q: q(plan.calibrated.frac + 1, plan.calibrated),
             calibration_frac,
+            narrow: {
+                let int = (plan.input.int_bits()).max(plan.bias.int_bits()) + 1;
+                int + calibration_frac <= 62 && plan.calibrated.width <= 61
+            },
         }
     }
 
@@ -87,6 +93,19 @@ impl FixedEstimator {
 
     /// One sample: the sequencer's `slot` and the gyro codes `y` (input format).
     pub fn step(&mut self, slot: &Slot, y: [i64; 2]) -> Sample {
+        match self.plan.rounding {
+            Rounding::Floor => self.step_mode::<{ mode::FLOOR }>(slot, y),
+            Rounding::Ceil => self.step_mode::<{ mode::CEIL }>(slot, y),
+            Rounding::Zero => self.step_mode::<{ mode::ZERO }>(slot, y),
+            Rounding::Nearest => self.step_mode::<{ mode::NEAREST }>(slot, y),
+            Rounding::Round => self.step_mode::<{ mode::ROUND }>(slot, y),
+            Rounding::Convergent => self.step_mode::<{ mode::CONVERGENT }>(slot, y),
+        }
+    }
+
+    /// [`FixedEstimator::step`] with the plan's rounding mode fixed at compile time.
+    #[inline(always)]
+    pub(crate) fn step_mode<const MODE: u8>(&mut self, slot: &Slot, y: [i64; 2]) -> Sample {
         let modes = [slot.mode_a, slot.mode_b];
         let valid = [!slot.blank_a, !slot.blank_b];
         let bias_used = [self.bias[0] as i64, self.bias[1] as i64];
@@ -94,11 +113,27 @@ impl FixedEstimator {
         // Calibration with the estimates of earlier windows.
         let f = self.calibration_frac;
         let mut out = [0i64; 2];
-        for g in 0..2 {
+        if self.narrow {
+            for g in 0..2 {
+                let y_aligned = y[g] << (f - self.plan.input.frac);
+                let b_aligned = (self.bias[g] as i64) << (f - self.plan.bias.frac);
+                let corrected = if modes[g] > 0 {
+                    y_aligned - b_aligned
+                } else {
+                    y_aligned + b_aligned
+                };
+                out[g] = self.calibrated_q[g].apply_mode_i64::<MODE>(corrected);
+            }
+        }
+        for g in (0..2).filter(|_| !self.narrow) {
             let y_aligned = i128::from(y[g]) << (f - self.plan.input.frac);
             let b_aligned = self.bias[g] << (f - self.plan.bias.frac);
-            let corrected = y_aligned - i128::from(modes[g]) * b_aligned;
-            out[g] = self.calibrated_q[g].apply(corrected) as i64;
+            let corrected = if modes[g] > 0 {
+                y_aligned - b_aligned
+            } else {
+                y_aligned + b_aligned
+            };
+            out[g] = self.calibrated_q[g].apply_mode::<MODE>(corrected) as i64;
         }
         let combined = match valid {
             [true, true] => self

@@ -111,9 +111,15 @@ pub fn fitting_format(values: &[f64], width: u32) -> Result<Format, FxError> {
     }
 }
 
-/// `2^exp` as f64, exact for -1074 <= exp <= 1023 (pure bit construction: no libm).
+/// `2^exp` as f64, exact for -1074 <= exp <= 1023: built from the exponent bits for normal
+/// results, through the pure-Rust `libm::ldexp` for subnormal and out-of-range ones.
+#[inline]
 pub fn pow2(exp: i32) -> f64 {
-    libm::ldexp(1.0, exp)
+    if (-1022..=1023).contains(&exp) {
+        f64::from_bits(((exp + 1023) as u64) << 52)
+    } else {
+        libm::ldexp(1.0, exp)
+    }
 }
 
 /// A code together with its format: the exact-arithmetic view of a fixed-point value.

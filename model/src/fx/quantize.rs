@@ -267,6 +267,27 @@ pub fn round_right<const MODE: u8>(value: i128, shift: u32) -> i128 {
     quotient + increment
 }
 
+/// [`round_right`] on 64-bit values (`1 <= shift <= 63`): the same branch-free rounding for
+/// the per-sample paths whose plans prove their values fit 64 bits.
+#[inline(always)]
+pub fn round_right_i64<const MODE: u8>(value: i64, shift: u32) -> i64 {
+    let quotient = value >> shift;
+    let dropped_mask = i64::MAX >> (63 - shift);
+    let any_dropped = i64::from(value & dropped_mask != 0);
+    let half_bit = (value >> (shift - 1)) & 1;
+    let below_half = i64::from(value & (dropped_mask >> 1) != 0);
+    let negative = i64::from(value < 0);
+    let increment = match MODE {
+        mode::FLOOR => 0,
+        mode::CEIL => any_dropped,
+        mode::ZERO => any_dropped & negative,
+        mode::NEAREST => half_bit,
+        mode::ROUND => half_bit & (below_half | (1 - negative)),
+        _ => half_bit & (below_half | (quotient & 1)),
+    };
+    quotient + increment
+}
+
 #[inline(always)]
 fn finish_overflow(
     rounded: i128,
@@ -326,25 +347,11 @@ pub fn from_f64(
     }
     let scaled = scale_by_pow2(value, to.frac);
     let floor = scaled.floor();
-    let remainder = scaled - floor; // exact: both are f64 with the same exponent range
+    let remainder = scaled - floor; // exact: floor has no fewer integer bits than scaled
     let negative = scaled < 0.0;
-    let quotient_odd = (floor % 2.0).abs() == 1.0;
-    let up = if remainder == 0.0 {
-        false
-    } else {
-        match rounding {
-            Rounding::Floor => false,
-            Rounding::Ceil => true,
-            Rounding::Zero => negative,
-            Rounding::Nearest => remainder >= 0.5,
-            Rounding::Round => remainder > 0.5 || (remainder == 0.5 && !negative),
-            Rounding::Convergent => remainder > 0.5 || (remainder == 0.5 && quotient_odd),
-        }
-    };
-    let rounded = floor + if up { 1.0 } else { 0.0 };
     // 2^127 is exactly representable; anything at or beyond it cannot fit any format.
     let limit = pow2(127);
-    if rounded >= limit || rounded < -limit {
+    if floor >= limit || floor < -limit {
         let sat = finish_overflow(0, true, negative, to, Overflow::Saturate);
         let code = match overflow {
             Overflow::Saturate => sat.code,
@@ -356,8 +363,22 @@ pub fn from_f64(
             overflowed: true,
         });
     }
+    let quotient = floor as i128; // exact: an integer-valued f64 below 2^127
+    let up = if remainder == 0.0 {
+        false
+    } else {
+        match rounding {
+            Rounding::Floor => false,
+            Rounding::Ceil => true,
+            Rounding::Zero => negative,
+            Rounding::Nearest => remainder >= 0.5,
+            Rounding::Round => remainder > 0.5 || (remainder == 0.5 && !negative),
+            Rounding::Convergent => remainder > 0.5 || (remainder == 0.5 && quotient & 1 == 1),
+        }
+    };
+    // quotient + 1 only overflows i128 at 2^127 - 1, which f64 cannot hold below the limit.
     Ok(finish_overflow(
-        rounded as i128,
+        quotient + i128::from(up),
         false,
         negative,
         to,
@@ -447,6 +468,19 @@ impl Quantizer {
             Overflow::Saturate => rounded.clamp(self.min, self.max),
             Overflow::Wrap => self.to.wrap(rounded),
         }
+    }
+
+    /// [`Quantizer::apply_mode`] on a 64-bit value (shifts of 1..=63 take the 64-bit kernel;
+    /// anything else, and every overflow, the general path).
+    #[inline(always)]
+    pub fn apply_mode_i64<const MODE: u8>(&mut self, code: i64) -> i64 {
+        if self.shift >= 1 && self.shift <= 63 {
+            let rounded = round_right_i64::<MODE>(code, self.shift as u32);
+            if i128::from(rounded) >= self.min && i128::from(rounded) <= self.max {
+                return rounded;
+            }
+        }
+        self.apply_mode::<MODE>(i128::from(code)) as i64
     }
 
     /// Whether the dropped bits of `code` are exactly half an LSB of the target: the case

@@ -285,6 +285,52 @@ fn quantizer_fast_path_equals_requantize() {
     }
 }
 
+/// The 64-bit kernel against [`requantize`]: exhaustively on small values, and on the extremes.
+#[test]
+fn quantizer_i64_path_equals_requantize() {
+    fn check<const M: u8>(rounding: Rounding) {
+        for overflow in Overflow::ALL {
+            for shift in 1..=12i32 {
+                for to in [
+                    fmt("s4.0"),
+                    fmt("s9.2"),
+                    fmt("u3.1"),
+                    fmt("s40.3"),
+                    fmt("s64.0"),
+                ] {
+                    let from_frac = to.frac + shift;
+                    let mut q = Quantizer::new(from_frac, to, rounding, overflow);
+                    let mut overflows = 0;
+                    let extremes = [
+                        i64::MIN,
+                        i64::MIN + 1,
+                        i64::MAX,
+                        i64::MAX - 1,
+                        -(1 << 62),
+                        1 << 62,
+                    ];
+                    for code in (-5000i64..=5000).chain(extremes) {
+                        let want = requantize(i128::from(code), from_frac, to, rounding, overflow);
+                        overflows += u64::from(want.overflowed);
+                        assert_eq!(
+                            i128::from(q.apply_mode_i64::<M>(code)),
+                            want.code,
+                            "{code} >> {shift} into {to} {rounding} {overflow}"
+                        );
+                    }
+                    assert_eq!(q.overflow_count, overflows);
+                }
+            }
+        }
+    }
+    check::<{ mode::FLOOR }>(Rounding::Floor);
+    check::<{ mode::CEIL }>(Rounding::Ceil);
+    check::<{ mode::ZERO }>(Rounding::Zero);
+    check::<{ mode::NEAREST }>(Rounding::Nearest);
+    check::<{ mode::ROUND }>(Rounding::Round);
+    check::<{ mode::CONVERGENT }>(Rounding::Convergent);
+}
+
 #[test]
 fn extreme_shifts_round_correctly() {
     let to = fmt("s8.0");

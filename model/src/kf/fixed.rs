@@ -122,7 +122,7 @@ impl FixedKf {
 
     /// One sample with the rounding mode fixed at compile time (the plan's mode).
     #[inline(always)]
-    fn step_mode<const MODE: u8>(&mut self, z: i64, bw_sel: usize) -> i64 {
+    pub(crate) fn step_mode<const MODE: u8>(&mut self, z: i64, bw_sel: usize) -> i64 {
         if !self.narrow {
             return self.step_reference(z, bw_sel);
         }
@@ -133,7 +133,7 @@ impl FixedKf {
         let x1 = self.update::<MODE>(0, x1, i128::from(g1) * e);
         let x2 = self.update::<MODE>(1, x2, i128::from(g2) * e);
         self.x = [x1, x2];
-        self.output_quantizer.apply_mode::<MODE>(i128::from(x1)) as i64
+        self.output_quantizer.apply_mode_i64::<MODE>(x1)
     }
 
     /// `Q(x·2^s + p)` into the state format. For floor, ceil and nearest, adding a multiple of
