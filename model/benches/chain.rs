@@ -81,7 +81,16 @@ fn chain(c: &mut Criterion) {
     let mut group = c.benchmark_group("chain");
     group.throughput(Throughput::Elements(N as u64));
     group.sample_size(10);
-    group.bench_function("fixed_chain_1M", |b| {
+    let y: Vec<[i64; 2]> = ya.iter().zip(&yb).map(|(a, b)| [*a, *b]).collect();
+    let mut rates = vec![None; N];
+    group.bench_function("fixed_chain_process_1M", |b| {
+        b.iter(|| {
+            let mut chain = FixedChain::new(&plan);
+            chain.process(black_box(&y), 0, &mut rates);
+            black_box(&rates);
+        })
+    });
+    group.bench_function("fixed_chain_step_1M", |b| {
         b.iter(|| {
             let mut chain = FixedChain::new(&plan);
             let mut acc = 0i64;

@@ -239,7 +239,7 @@ impl Sequencer {
     }
 
     /// The slot of the current sample, then advances to the next sample.
-    #[inline]
+    #[inline(always)]
     pub fn advance(&mut self) -> Slot {
         let s = &self.schedule;
         let last_phase = s.interval_length - 1;

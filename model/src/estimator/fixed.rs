@@ -50,10 +50,11 @@ pub struct FixedEstimator {
     smooth_q: [Quantizer; 2],
     calibrated_q: [Quantizer; 2],
     combined_q: Quantizer,
-    /// Common fraction of `y − p·b`.
-    calibration_frac: i32,
     /// `y − p·b` and `out_A + out_B` fit 62 bits: the 64-bit path applies.
     narrow: bool,
+    /// Shifts aligning `y` and `b` to `calibration_frac`.
+    y_shift: u32,
+    b_shift: u32,
 }
 
 impl FixedEstimator {
@@ -73,7 +74,8 @@ impl FixedEstimator {
             smooth_q: [0, 1].map(|_| q(plan.bias.frac + plan.smoothing_shift as i32, plan.bias)),
             calibrated_q: [0, 1].map(|_| q(calibration_frac, plan.calibrated)),
             combined_q: q(plan.calibrated.frac + 1, plan.calibrated),
-            calibration_frac,
+            y_shift: (calibration_frac - plan.input.frac) as u32,
+            b_shift: (calibration_frac - plan.bias.frac) as u32,
             narrow: {
                 let int = (plan.input.int_bits()).max(plan.bias.int_bits()) + 1;
                 int + calibration_frac <= 62 && plan.calibrated.width <= 61
@@ -111,12 +113,11 @@ impl FixedEstimator {
         let bias_used = [self.bias[0] as i64, self.bias[1] as i64];
 
         // Calibration with the estimates of earlier windows.
-        let f = self.calibration_frac;
         let mut out = [0i64; 2];
         if self.narrow {
             for g in 0..2 {
-                let y_aligned = y[g] << (f - self.plan.input.frac);
-                let b_aligned = (self.bias[g] as i64) << (f - self.plan.bias.frac);
+                let y_aligned = y[g] << self.y_shift;
+                let b_aligned = (self.bias[g] as i64) << self.b_shift;
                 let corrected = if modes[g] > 0 {
                     y_aligned - b_aligned
                 } else {
@@ -126,8 +127,8 @@ impl FixedEstimator {
             }
         }
         for g in (0..2).filter(|_| !self.narrow) {
-            let y_aligned = i128::from(y[g]) << (f - self.plan.input.frac);
-            let b_aligned = self.bias[g] << (f - self.plan.bias.frac);
+            let y_aligned = i128::from(y[g]) << self.y_shift;
+            let b_aligned = self.bias[g] << self.b_shift;
             let corrected = if modes[g] > 0 {
                 y_aligned - b_aligned
             } else {
