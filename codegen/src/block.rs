@@ -178,8 +178,9 @@ pub struct Block {
     pub inputs: Vec<Signal>,
     /// Outputs and how they are checked.
     pub outputs: Vec<Output>,
-    /// Row-major codes: per row `rst`, the inputs, the outputs.
-    codes: Vec<i128>,
+    /// Row-major codes: per row `rst`, the inputs, the outputs (every declared format is at
+    /// most 64 bits wide).
+    codes: Vec<i64>,
     /// Extra real-valued CSV columns (name, one value per row; NaN prints empty).
     pub extra: Vec<(&'static str, Vec<f64>)>,
 }
@@ -206,6 +207,11 @@ impl Block {
         }
     }
 
+    /// Reserves room for `rows` more rows.
+    pub fn reserve(&mut self, rows: usize) {
+        self.codes.reserve(rows * self.stride());
+    }
+
     /// Codes per row.
     pub fn stride(&self) -> usize {
         1 + self.inputs.len() + self.outputs.len()
@@ -219,7 +225,7 @@ impl Block {
     pub fn push(&mut self, rst: bool, inputs: &[i128], outputs: &[i128]) {
         assert_eq!(inputs.len(), self.inputs.len(), "{}: inputs", self.name);
         assert_eq!(outputs.len(), self.outputs.len(), "{}: outputs", self.name);
-        self.codes.push(i128::from(rst));
+        self.codes.push(i64::from(rst));
         for (code, s) in inputs.iter().zip(&self.inputs) {
             debug_assert!(
                 s.format.contains(*code),
@@ -227,7 +233,7 @@ impl Block {
                 self.name,
                 s.name
             );
-            self.codes.push(*code);
+            self.codes.push(*code as i64);
         }
         for (code, o) in outputs.iter().zip(&self.outputs) {
             debug_assert!(
@@ -236,7 +242,7 @@ impl Block {
                 self.name,
                 o.signal.name
             );
-            self.codes.push(*code);
+            self.codes.push(*code as i64);
         }
     }
 
@@ -251,7 +257,7 @@ impl Block {
     }
 
     /// Row `k`: `rst`, inputs, outputs.
-    pub fn row(&self, k: usize) -> &[i128] {
+    pub fn row(&self, k: usize) -> &[i64] {
         &self.codes[k * self.stride()..(k + 1) * self.stride()]
     }
 

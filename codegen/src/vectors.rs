@@ -462,190 +462,215 @@ pub fn run(
 
     let [mut seq_block, mut est_block, mut kf_block, mut top_block] =
         empty_blocks(job, rom_kf.0, rom_estimator.0);
+    for block in [
+        &mut seq_block,
+        &mut est_block,
+        &mut kf_block,
+        &mut top_block,
+    ] {
+        block.reserve(n + 1);
+    }
     est_block.roms.push(rom_estimator.clone());
     kf_block.roms.push(rom_kf.clone());
     top_block.roms.push(rom_estimator);
     top_block.roms.push(rom_kf);
 
-    let mut fixed = FixedChain::new(plan);
-    let mut float = FloatChain::quantized(plan);
-    let mut ideal = FloatChain::ideal(plan);
-    let mut kf_float = FloatKf::new(kf.quantized_gains());
-    let mut kf_ideal = FloatKf::new(kf.gains.clone());
-    let (mut kf_acc, mut chain_acc, mut bias_acc) = (
-        Accumulator::default(),
-        Accumulator::default(),
-        Accumulator::default(),
-    );
-    let mut chain_switches = 0u64;
-    let mut previous_sel = None;
-    let out_lsb = kf.output.lsb();
-    let bias_lsb = est.bias.lsb();
-    let (mut combined_series, mut filtered_series) = (Vec::with_capacity(n), Vec::with_capacity(n));
-    let mut true_series = Vec::with_capacity(n);
-    let mut extra_float = Vec::with_capacity(n + 2);
-    let mut extra_ideal = Vec::with_capacity(n + 2);
-    let mut extra_true = Vec::with_capacity(n + 2);
-    let zero_outputs_top = [0i128; 7];
+    // Report: the same gyros run without reversal (same noise streams), simulated on the other
+    // core while the chain runs.
+    std::thread::scope(|scope| -> Result<Run> {
+        let raw_record = scope.spawn(|| plant.simulate(&rate, &vec![[1i8, 1i8]; n], seed));
+        let mut fixed = FixedChain::new(plan);
+        let mut float = FloatChain::quantized(plan);
+        let mut ideal = FloatChain::ideal(plan);
+        let mut kf_float = FloatKf::new(kf.quantized_gains());
+        let mut kf_ideal = FloatKf::new(kf.gains.clone());
+        let (mut kf_acc, mut chain_acc, mut bias_acc) = (
+            Accumulator::default(),
+            Accumulator::default(),
+            Accumulator::default(),
+        );
+        let mut chain_switches = 0u64;
+        let mut previous_sel = None;
+        let out_lsb = kf.output.lsb();
+        let bias_lsb = est.bias.lsb();
+        let (mut combined_series, mut filtered_series) =
+            (Vec::with_capacity(n), Vec::with_capacity(n));
+        let mut true_series = Vec::with_capacity(n);
+        let mut extra_float = Vec::with_capacity(n + 2);
+        let mut extra_ideal = Vec::with_capacity(n + 2);
+        let mut extra_true = Vec::with_capacity(n + 2);
+        let zero_outputs_top = [0i128; 7];
 
-    for k in 0..n {
-        if reset_at == Some(k) {
-            fixed.reset();
-            float.reset();
-            ideal.reset();
-            kf_float.reset();
-            kf_ideal.reset();
-            seq_block.push(true, &[], &[0; 9]);
-            est_block.push(true, &[0; 9], &[0, 0, 0]);
-            kf_block.push(true, &[0, 0], &[0, 0]);
-            top_block.push(true, &[0, 0, 0], &zero_outputs_top);
-            for extra in [&mut extra_float, &mut extra_ideal, &mut extra_true] {
-                extra.push(f64::NAN);
+        for k in 0..n {
+            if reset_at == Some(k) {
+                fixed.reset();
+                float.reset();
+                ideal.reset();
+                kf_float.reset();
+                kf_ideal.reset();
+                seq_block.push(true, &[], &[0; 9]);
+                est_block.push(true, &[0; 9], &[0, 0, 0]);
+                kf_block.push(true, &[0, 0], &[0, 0]);
+                top_block.push(true, &[0, 0, 0], &zero_outputs_top);
+                for extra in [&mut extra_float, &mut extra_ideal, &mut extra_true] {
+                    extra.push(f64::NAN);
+                }
             }
-        }
-        let bw_sel = (k / chunk) % entries;
-        let y = [ya[k], yb[k]];
-        let y_real = [
-            est.input.to_f64(i128::from(y[0])),
-            est.input.to_f64(i128::from(y[1])),
-        ];
-        let a = fixed.step(y, bw_sel);
-        let b = float.step(y_real, bw_sel);
-        let c = ideal.step(y_real, bw_sel);
-        let s = a.slot;
-        let slot_codes = [
-            flag(s.blank_a),
-            flag(s.blank_b),
-            flag(s.done_a),
-            flag(s.done_b),
-            s.interval_a as i128,
-            s.interval_b as i128,
-            flag(s.window_done),
-        ];
-        seq_block.push(
-            false,
-            &[],
-            &[
-                mode_bit(s.mode_a),
-                mode_bit(s.mode_b),
+            let bw_sel = (k / chunk) % entries;
+            let y = [ya[k], yb[k]];
+            let y_real = [
+                est.input.to_f64(i128::from(y[0])),
+                est.input.to_f64(i128::from(y[1])),
+            ];
+            let a = fixed.step(y, bw_sel);
+            let b = float.step(y_real, bw_sel);
+            let c = ideal.step(y_real, bw_sel);
+            let s = a.slot;
+            let slot_codes = [
                 flag(s.blank_a),
                 flag(s.blank_b),
-                s.interval_a as i128,
-                s.interval_b as i128,
                 flag(s.done_a),
                 flag(s.done_b),
+                s.interval_a as i128,
+                s.interval_b as i128,
                 flag(s.window_done),
-            ],
-        );
-        let bias_after = fixed.estimator().bias();
-        let estimated = flag(fixed.estimator().estimated());
-        let mut est_inputs = vec![i128::from(y[0]), i128::from(y[1])];
-        est_inputs.extend(slot_codes);
-        est_block.push(
-            false,
-            &est_inputs,
-            &[bias_after[0], bias_after[1], estimated],
-        );
-        let rate_code = a.rate.map(i128::from).unwrap_or(0);
-        top_block.push(
-            false,
-            &[bw_sel as i128, i128::from(y[0]), i128::from(y[1])],
-            &[
-                mode_bit(s.mode_a),
-                mode_bit(s.mode_b),
-                flag(a.rate.is_some()),
-                rate_code,
-                bias_after[0],
-                bias_after[1],
-                estimated,
-            ],
-        );
-        extra_float.push(b.rate.unwrap_or(f64::NAN));
-        extra_ideal.push(c.rate.unwrap_or(f64::NAN));
-        extra_true.push(rate[k]);
-
-        // Bias estimates: fixed vs float, every sample (the ones in use).
-        for g in 0..2 {
-            bias_acc.add(
-                est.bias.to_f64(i128::from(a.estimator.bias[g])),
-                b.estimator.bias[g],
-                c.estimator.bias[g],
-                bias_lsb,
-            );
-        }
-        if let Some(code) = a.rate {
-            if previous_sel.is_some_and(|p| p != bw_sel) {
-                chain_switches += 1;
-            }
-            previous_sel = Some(bw_sel);
-            let fixed_real = kf.output.to_f64(i128::from(code));
-            chain_acc.add(
-                fixed_real,
-                b.rate.unwrap_or(f64::NAN),
-                c.rate.unwrap_or(f64::NAN),
-                out_lsb,
-            );
-            // The KF block sees exactly the chain's KF inputs.
-            let z = a.estimator.combined;
-            kf_block.push(
+            ];
+            seq_block.push(
                 false,
-                &[bw_sel as i128, i128::from(z)],
-                &[1, i128::from(code)],
+                &[],
+                &[
+                    mode_bit(s.mode_a),
+                    mode_bit(s.mode_b),
+                    flag(s.blank_a),
+                    flag(s.blank_b),
+                    s.interval_a as i128,
+                    s.interval_b as i128,
+                    flag(s.done_a),
+                    flag(s.done_b),
+                    flag(s.window_done),
+                ],
             );
-            let z_real = kf.input.to_f64(i128::from(z));
-            let kf_b = kf_float.step(z_real, bw_sel);
-            let kf_c = kf_ideal.step(z_real, bw_sel);
-            kf_acc.add(fixed_real, kf_b, kf_c, out_lsb);
-            filtered_series.push(fixed_real);
-        } else {
-            filtered_series.push(*filtered_series.last().unwrap_or(&0.0));
+            let bias_after = fixed.estimator().bias();
+            let estimated = flag(fixed.estimator().estimated());
+            let [s0, s1, s2, s3, s4, s5, s6] = slot_codes;
+            let est_inputs = [
+                i128::from(y[0]),
+                i128::from(y[1]),
+                s0,
+                s1,
+                s2,
+                s3,
+                s4,
+                s5,
+                s6,
+            ];
+            est_block.push(
+                false,
+                &est_inputs,
+                &[bias_after[0], bias_after[1], estimated],
+            );
+            let rate_code = a.rate.map(i128::from).unwrap_or(0);
+            top_block.push(
+                false,
+                &[bw_sel as i128, i128::from(y[0]), i128::from(y[1])],
+                &[
+                    mode_bit(s.mode_a),
+                    mode_bit(s.mode_b),
+                    flag(a.rate.is_some()),
+                    rate_code,
+                    bias_after[0],
+                    bias_after[1],
+                    estimated,
+                ],
+            );
+            extra_float.push(b.rate.unwrap_or(f64::NAN));
+            extra_ideal.push(c.rate.unwrap_or(f64::NAN));
+            extra_true.push(rate[k]);
+
+            // Bias estimates: fixed vs float, every sample (the ones in use).
+            for g in 0..2 {
+                bias_acc.add(
+                    est.bias.to_f64(i128::from(a.estimator.bias[g])),
+                    b.estimator.bias[g],
+                    c.estimator.bias[g],
+                    bias_lsb,
+                );
+            }
+            if let Some(code) = a.rate {
+                if previous_sel.is_some_and(|p| p != bw_sel) {
+                    chain_switches += 1;
+                }
+                previous_sel = Some(bw_sel);
+                let fixed_real = kf.output.to_f64(i128::from(code));
+                chain_acc.add(
+                    fixed_real,
+                    b.rate.unwrap_or(f64::NAN),
+                    c.rate.unwrap_or(f64::NAN),
+                    out_lsb,
+                );
+                // The KF block sees exactly the chain's KF inputs.
+                let z = a.estimator.combined;
+                kf_block.push(
+                    false,
+                    &[bw_sel as i128, i128::from(z)],
+                    &[1, i128::from(code)],
+                );
+                let z_real = kf.input.to_f64(i128::from(z));
+                let kf_b = kf_float.step(z_real, bw_sel);
+                let kf_c = kf_ideal.step(z_real, bw_sel);
+                kf_acc.add(fixed_real, kf_b, kf_c, out_lsb);
+                filtered_series.push(fixed_real);
+            } else {
+                filtered_series.push(*filtered_series.last().unwrap_or(&0.0));
+            }
+            let combined = if a.estimator.combined_valid {
+                est.calibrated.to_f64(i128::from(a.estimator.combined))
+            } else {
+                *combined_series.last().unwrap_or(&0.0)
+            };
+            combined_series.push(combined);
+            true_series.push(rate[k]);
         }
-        let combined = if a.estimator.combined_valid {
-            est.calibrated.to_f64(i128::from(a.estimator.combined))
-        } else {
-            *combined_series.last().unwrap_or(&0.0)
-        };
-        combined_series.push(combined);
-        true_series.push(rate[k]);
-    }
-    let kf_chain_overflows = fixed.kf().overflow_counts();
-    let estimator_overflows = fixed.estimator().overflow_counts();
-    let kf_steps = kf_acc.count;
-    let kf_stats = kf_acc.finish(rate_error_bound_lsb(kf, kf_steps, chain_switches));
-    let chain_stats = chain_acc.finish(plan.rate_error_bound_lsb(kf_steps, chain_switches));
-    let bias_stats = bias_acc.finish(est.bias_error_bound() / bias_lsb);
+        let kf_chain_overflows = fixed.kf().overflow_counts();
+        let estimator_overflows = fixed.estimator().overflow_counts();
+        let kf_steps = kf_acc.count;
+        let kf_stats = kf_acc.finish(rate_error_bound_lsb(kf, kf_steps, chain_switches));
+        let chain_stats = chain_acc.finish(plan.rate_error_bound_lsb(kf_steps, chain_switches));
+        let bias_stats = bias_acc.finish(est.bias_error_bound() / bias_lsb);
 
-    // The KF's directed segment: ties and full scale, each from reset.
-    let ties = find_ties(kf);
-    let directed_overflows = directed_segment(kf, &ties, &mut kf_block);
-    top_block.extra = vec![
-        ("float_rate_dps", extra_float),
-        ("ideal_rate_dps", extra_ideal),
-        ("true_rate_dps", extra_true),
-    ];
+        // The KF's directed segment: ties and full scale, each from reset.
+        let ties = find_ties(kf);
+        let directed_overflows = directed_segment(kf, &ties, &mut kf_block);
+        top_block.extra = vec![
+            ("float_rate_dps", extra_float),
+            ("ideal_rate_dps", extra_ideal),
+            ("true_rate_dps", extra_true),
+        ];
 
-    // Report: raw gyros run without reversal (same noise streams), calibrated, filtered.
-    let raw = plant.simulate(&rate, &vec![[1i8, 1i8]; n], seed);
-    let fs = job.config.stimulus.fs_hz;
-    let report = report(
-        fs,
-        &rate,
-        [&raw.y[0], &raw.y[1], &combined_series, &filtered_series],
-    );
-    Ok(Run {
-        blocks: vec![seq_block, est_block, kf_block, top_block],
-        kf_stats,
-        chain_stats,
-        bias_stats,
-        overflows: Overflows {
-            adc: [sat_a, sat_b],
-            estimator: estimator_overflows.into(),
-            kf_chain: kf_chain_overflows.into(),
-            kf_directed: directed_overflows.into(),
-        },
-        ties,
-        report,
-        samples: n,
+        let raw = raw_record
+            .join()
+            .expect("the plant simulation does not panic");
+        let fs = job.config.stimulus.fs_hz;
+        let report = report(
+            fs,
+            &rate,
+            [&raw.y[0], &raw.y[1], &combined_series, &filtered_series],
+        );
+        Ok(Run {
+            blocks: vec![seq_block, est_block, kf_block, top_block],
+            kf_stats,
+            chain_stats,
+            bias_stats,
+            overflows: Overflows {
+                adc: [sat_a, sat_b],
+                estimator: estimator_overflows.into(),
+                kf_chain: kf_chain_overflows.into(),
+                kf_directed: directed_overflows.into(),
+            },
+            ties,
+            report,
+            samples: n,
+        })
     })
 }
 
@@ -777,7 +802,7 @@ mod tests {
             assert!(kf.ties(tie.rate_hat.expect("output tie"), tie.bw_sel)[2]);
         }
         // Every bw_sel value occurs in the top vectors.
-        let sels: std::collections::BTreeSet<i128> = (0..run.blocks[3].len())
+        let sels: std::collections::BTreeSet<i64> = (0..run.blocks[3].len())
             .map(|k| run.blocks[3].row(k)[1])
             .collect();
         assert_eq!(sels.len(), 3);

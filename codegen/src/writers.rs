@@ -203,17 +203,17 @@ pub fn vector_hex(block: &Block, provenance: &Provenance) -> (String, String) {
     let ni = block.inputs.len();
     for k in 0..n {
         let row = block.row(k);
-        push_hex(&mut stimulus, row[0], bit);
+        push_hex(&mut stimulus, i128::from(row[0]), bit);
         for (code, s) in row[1..=ni].iter().zip(&block.inputs) {
             stimulus.push(' ');
-            push_hex(&mut stimulus, *code, s.format);
+            push_hex(&mut stimulus, i128::from(*code), s.format);
         }
         stimulus.push('\n');
         for (i, (code, o)) in row[1 + ni..].iter().zip(&block.outputs).enumerate() {
             if i > 0 {
                 expected.push(' ');
             }
-            push_hex(&mut expected, *code, o.signal.format);
+            push_hex(&mut expected, i128::from(*code), o.signal.format);
         }
         expected.push('\n');
     }
@@ -253,7 +253,7 @@ pub fn vector_csv(block: &Block, provenance: &Provenance) -> String {
             csv.push_str(int.format(*code));
             if s.is_real() {
                 csv.push(',');
-                push_real(&mut csv, &mut real, s.format.to_f64(*code));
+                push_real(&mut csv, &mut real, s.format.to_f64(i128::from(*code)));
             }
         }
         for (_, values) in &block.extra {
