@@ -246,47 +246,44 @@ pub mod mode {
     pub const CONVERGENT: u8 = 5;
 }
 
-/// `value / 2^shift` rounded with the mode `MODE` (see [`mode`]), for `1 <= shift <= 127`:
-/// branch-free, the same result as [`requantize`]'s rounding (an exhaustive test checks it).
-#[inline(always)]
-pub fn round_right<const MODE: u8>(value: i128, shift: u32) -> i128 {
-    let quotient = value >> shift;
-    let dropped_mask = i128::MAX >> (127 - shift);
-    let any_dropped = i128::from(value & dropped_mask != 0);
-    let half_bit = (value >> (shift - 1)) & 1;
-    let below_half = i128::from(value & (dropped_mask >> 1) != 0);
-    let negative = i128::from(value < 0);
-    let increment = match MODE {
-        mode::FLOOR => 0,
-        mode::CEIL => any_dropped,
-        mode::ZERO => any_dropped & negative,
-        mode::NEAREST => half_bit,
-        mode::ROUND => half_bit & (below_half | (1 - negative)),
-        _ => half_bit & (below_half | (quotient & 1)),
+/// One branch-free rounding kernel per word type: `value / 2^shift` rounded with `MODE`.
+macro_rules! round_right_kernel {
+    ($(#[$doc:meta])* $name:ident, $word:ty) => {
+        $(#[$doc])*
+        #[inline(always)]
+        pub fn $name<const MODE: u8>(value: $word, shift: u32) -> $word {
+            let quotient = value >> shift;
+            let dropped_mask = <$word>::MAX >> (<$word>::BITS - 1 - shift);
+            let any_dropped = <$word>::from(value & dropped_mask != 0);
+            let half_bit = (value >> (shift - 1)) & 1;
+            let below_half = <$word>::from(value & (dropped_mask >> 1) != 0);
+            let negative = <$word>::from(value < 0);
+            let increment = match MODE {
+                mode::FLOOR => 0,
+                mode::CEIL => any_dropped,
+                mode::ZERO => any_dropped & negative,
+                mode::NEAREST => half_bit,
+                mode::ROUND => half_bit & (below_half | (1 - negative)),
+                _ => half_bit & (below_half | (quotient & 1)),
+            };
+            quotient + increment
+        }
     };
-    quotient + increment
 }
 
-/// [`round_right`] on 64-bit values (`1 <= shift <= 63`): the same branch-free rounding for
-/// the per-sample paths whose plans prove their values fit 64 bits.
-#[inline(always)]
-pub fn round_right_i64<const MODE: u8>(value: i64, shift: u32) -> i64 {
-    let quotient = value >> shift;
-    let dropped_mask = i64::MAX >> (63 - shift);
-    let any_dropped = i64::from(value & dropped_mask != 0);
-    let half_bit = (value >> (shift - 1)) & 1;
-    let below_half = i64::from(value & (dropped_mask >> 1) != 0);
-    let negative = i64::from(value < 0);
-    let increment = match MODE {
-        mode::FLOOR => 0,
-        mode::CEIL => any_dropped,
-        mode::ZERO => any_dropped & negative,
-        mode::NEAREST => half_bit,
-        mode::ROUND => half_bit & (below_half | (1 - negative)),
-        _ => half_bit & (below_half | (quotient & 1)),
-    };
-    quotient + increment
-}
+round_right_kernel!(
+    /// `value / 2^shift` rounded with the mode `MODE` (see [`mode`]), for `1 <= shift <= 127`:
+    /// branch-free, the same result as [`requantize`]'s rounding (an exhaustive test checks it).
+    round_right,
+    i128
+);
+
+round_right_kernel!(
+    /// [`round_right`] on 64-bit values (`1 <= shift <= 63`), for the per-sample paths whose
+    /// plans prove their values fit 64 bits (an exhaustive test checks it).
+    round_right_i64,
+    i64
+);
 
 #[inline(always)]
 fn finish_overflow(
