@@ -137,9 +137,11 @@ impl FixedEstimator {
             out[g] = self.calibrated_q[g].apply_mode::<MODE>(corrected) as i64;
         }
         let combined = match valid {
+            [true, true] if self.narrow => self.combined_q.apply_mode_i64::<MODE>(out[0] + out[1]),
             [true, true] => self
                 .combined_q
-                .apply(i128::from(out[0]) + i128::from(out[1])) as i64,
+                .apply_mode::<MODE>(i128::from(out[0]) + i128::from(out[1]))
+                as i64,
             [true, false] => out[0],
             [false, true] => out[1],
             [false, false] => 0,
@@ -154,7 +156,7 @@ impl FixedEstimator {
             }
             if done[g] {
                 let scaled = self.accumulator[g] * self.plan.reciprocal_code;
-                self.means[g][interval[g]] = self.mean_q[g].apply(scaled);
+                self.means[g][interval[g]] = self.mean_q[g].apply_mode::<MODE>(scaled);
                 self.accumulator[g] = 0;
             }
         }
@@ -167,11 +169,11 @@ impl FixedEstimator {
                     .enumerate()
                     .map(|(j, c)| c * self.means[j % 2][j / 2])
                     .sum();
-                let new = self.bias_q[g].apply(dot);
+                let new = self.bias_q[g].apply_mode::<MODE>(dot);
                 self.bias[g] = if self.estimated && self.plan.smoothing_shift > 0 {
                     let s = self.plan.smoothing_shift;
                     let smoothed = (self.bias[g] << s) + (new - self.bias[g]);
-                    self.smooth_q[g].apply(smoothed)
+                    self.smooth_q[g].apply_mode::<MODE>(smoothed)
                 } else {
                     new
                 };
