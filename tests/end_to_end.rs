@@ -408,3 +408,40 @@ fn every_preset_generates_and_passes_in_icarus() {
         "{log}"
     );
 }
+
+/// The gu2019 report shows what mode reversal is for: the bias is removed and the long-τ
+/// Allan deviation falls below both raw gyros'.
+#[test]
+fn mode_reversal_removes_the_drift_in_the_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("gu");
+    ok(&[
+        "generate",
+        "--preset",
+        "gu2019",
+        "--samples",
+        "60000",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("manifest.json")).unwrap()).unwrap();
+    let report = &manifest["report"];
+    let line = |i: usize| &report["lines"][i];
+    let bias = |i: usize| line(i)["bias_error_dps"].as_f64().unwrap().abs();
+    let last = report["tau_s"].as_array().unwrap().len() - 1;
+    let adev = |i: usize| line(i)["adev_dps"][last].as_f64().unwrap();
+    assert!(bias(0) > 0.5 && bias(1) > 0.5, "raw biases: {report}");
+    assert!(
+        bias(2) < bias(1) / 100.0 && bias(3) < bias(1) / 100.0,
+        "{report}"
+    );
+    assert!(
+        adev(2) < adev(0) && adev(2) < adev(1),
+        "τ = {}: {report}",
+        report["tau_s"][last]
+    );
+    assert!(std::fs::read_to_string(out.join("report.md"))
+        .unwrap()
+        .contains("| calibrated, combined |"));
+}

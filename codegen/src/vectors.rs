@@ -170,6 +170,8 @@ pub struct ReportLine {
 /// calibrated combined output, and the filtered output.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Report {
+    /// Samples analysed.
+    pub samples: usize,
     /// Averaging times, s.
     pub tau_s: Vec<f64>,
     /// One line per signal.
@@ -442,7 +444,9 @@ pub fn run(
     let n = rate.len();
     let entries = kf.rom.len();
     let chunk = (n / (2 * entries)).max(1);
-    let reset_at = if n >= 4 { Some(n / 2) } else { None };
+    // One reset of the whole chain, late in the run, so that the report has a long stretch of
+    // calibrated output before it.
+    let reset_at = if n >= 20 { Some(n - n / 10) } else { None };
 
     // The modes the sequencer asks for, resets included: the plant runs in them.
     let mut sequencer = Sequencer::new(&est.schedule);
@@ -496,6 +500,7 @@ pub fn run(
         let (mut combined_series, mut filtered_series) =
             (Vec::with_capacity(n), Vec::with_capacity(n));
         let mut true_series = Vec::with_capacity(n);
+        let mut first_estimate: Option<usize> = None;
         let mut extra_float = Vec::with_capacity(n + 2);
         let mut extra_ideal = Vec::with_capacity(n + 2);
         let mut extra_true = Vec::with_capacity(n + 2);
@@ -630,6 +635,9 @@ pub fn run(
             };
             combined_series.push(combined);
             true_series.push(rate[k]);
+            if first_estimate.is_none() && a.estimator.estimated {
+                first_estimate = Some(k);
+            }
         }
         let kf_chain_overflows = fixed.kf().overflow_counts();
         let estimator_overflows = fixed.estimator().overflow_counts();
@@ -651,10 +659,18 @@ pub fn run(
             .join()
             .expect("the plant simulation does not panic");
         let fs = job.config.stimulus.fs_hz;
+        // Only calibrated samples: from the first estimate to the reset.
+        let start = first_estimate.unwrap_or(n).min(n);
+        let end = reset_at.unwrap_or(n).max(start);
         let report = report(
             fs,
-            &rate,
-            [&raw.y[0], &raw.y[1], &combined_series, &filtered_series],
+            &rate[start..end],
+            [
+                &raw.y[0][start..end],
+                &raw.y[1][start..end],
+                &combined_series[start..end],
+                &filtered_series[start..end],
+            ],
         );
         Ok(Run {
             blocks: vec![seq_block, est_block, kf_block, top_block],
@@ -700,7 +716,11 @@ fn report(fs: f64, rate: &[f64], signals: [&[f64]; 4]) -> Report {
             }
         })
         .collect();
-    Report { tau_s, lines }
+    Report {
+        samples: rate.len(),
+        tau_s,
+        lines,
+    }
 }
 
 /// For each ROM entry, an input that from reset lands each quantization point exactly on a

@@ -396,13 +396,16 @@ pub fn report_md(run: &Run, provenance: &Provenance) -> String {
         "<!-- {} -->
 # gyrofx report
 
-{} samples. Error = signal − true rate. \"Raw\" gyros are the same gyros, with the same noise,
-run without mode reversal; the calibrated output is the mean of the valid calibrated outputs
-(held over blanked samples); the filtered output is the KF's (bw_sel as scheduled).
+{} samples, of which the {} from the first bias estimate to the reset near the end are
+analysed (before the first window ends the output is not yet calibrated). Error = signal −
+true rate. \"Raw\" gyros are the same gyros, with the same noise, run without mode reversal;
+the calibrated output is the mean of the valid calibrated outputs (held over blanked samples);
+the filtered output is the KF's (bw_sel as scheduled).
 
 | signal | bias error (°/s) |",
         provenance.line("").trim_start(),
-        run.samples
+        run.samples,
+        run.report.samples
     );
     for tau in &r.tau_s {
         let _ = write!(out, " ADEV τ={tau} s (°/s) |");

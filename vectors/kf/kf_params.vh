@@ -15,6 +15,6 @@ localparam integer P_ROM_DEPTH = 3; // coefficient sets
 localparam integer P_ROUNDING = 3; // nearest
 localparam integer P_SATURATE = 1; // saturate
 localparam P_ROM_FILE = "kf_coefficients.mem"; // coefficient ROM
-localparam integer VECTOR_COUNT = 9486;
+localparam integer VECTOR_COUNT = 9496;
 localparam STIMULUS_FILE = "kf_stimulus.hex";
 localparam EXPECTED_FILE = "kf_expected.hex";
