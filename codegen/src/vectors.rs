@@ -6,7 +6,7 @@
 //! every ROM entry (each for `samples / (2·entries)` samples), and one reset of the whole chain
 //! half-way. The gyros are simulated in the modes the sequencer asks for, resets included.
 
-use gyrofx_model::analysis::overlapping_adev;
+use gyrofx_model::analysis::allan::{self, Kind};
 use gyrofx_model::chain::{FixedChain, FloatChain};
 use gyrofx_model::estimator::OverflowCounts as EstimatorOverflows;
 use gyrofx_model::kf::bound::rate_error_bound_lsb;
@@ -709,10 +709,16 @@ fn report(fs: f64, rate: &[f64], signals: [&[f64]; 4]) -> Report {
             ReportLine {
                 signal: name.to_string(),
                 bias_error_dps: errors.iter().sum::<f64>() / errors.len().max(1) as f64,
-                adev_dps: tau_s
-                    .iter()
-                    .map(|tau| overlapping_adev(&errors, (tau * fs).round() as usize))
-                    .collect(),
+                adev_dps: {
+                    let x = allan::phase(&errors);
+                    tau_s
+                        .iter()
+                        .map(|tau| {
+                            allan::deviation(Kind::Overlapping, &x, (tau * fs).round() as usize, fs)
+                                .map(|(dev, _)| dev)
+                        })
+                        .collect()
+                },
             }
         })
         .collect();

@@ -1,41 +1,17 @@
-//! Noise analysis of rate records (f64). For now the overlapping Allan deviation the
-//! mode-reversal report needs; the noise-analysis work extends this module.
+//! Noise analysis of rate records (f64): the Allan family of deviations with confidence
+//! intervals ([`allan`]), the χ² distribution they need ([`chi2`]).
 
-/// Overlapping Allan deviation of the rate record `rate` (°/s) at an averaging time of `m`
-/// samples: `σ²(τ) = Σ (x[i+2m] − 2x[i+m] + x[i])² / (2 m² (N − 2m))` over the phase
-/// `x = Σ rate` (°·samples). The mean is removed first, and the phase is summed with
-/// Kahan compensation, so long records keep their precision. `None` when the record is too
-/// short (fewer than `2m + 1` phase points) or `m` is 0.
-pub fn overlapping_adev(rate: &[f64], m: usize) -> Option<f64> {
-    let n = rate.len();
-    if m == 0 || n < 2 * m + 1 {
-        return None;
-    }
-    let mean = rate.iter().sum::<f64>() / n as f64;
-    let mut phase = Vec::with_capacity(n + 1);
-    let (mut sum, mut compensation) = (0.0f64, 0.0f64);
-    phase.push(0.0);
-    for v in rate {
-        let y = (v - mean) - compensation;
-        let t = sum + y;
-        compensation = (t - sum) - y;
-        sum = t;
-        phase.push(sum);
-    }
-    let terms = phase.len() - 2 * m;
-    let total: f64 = (0..terms)
-        .map(|i| {
-            let d = phase[i + 2 * m] - 2.0 * phase[i + m] + phase[i];
-            d * d
-        })
-        .sum();
-    Some((total / (2.0 * (m * m) as f64 * terms as f64)).sqrt())
-}
+pub mod allan;
+pub mod chi2;
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::allan::{deviation, phase, Kind};
     use crate::stimulus::{Gaussian, Stream};
+
+    fn overlapping_adev(rate: &[f64], m: usize) -> Option<f64> {
+        deviation(Kind::Overlapping, &phase(rate), m, 1.0).map(|(dev, _)| dev)
+    }
 
     #[test]
     fn white_noise_falls_as_one_over_root_tau() {

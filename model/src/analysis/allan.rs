@@ -1,0 +1,426 @@
+//! Allan-family deviations of rate records, their confidence intervals, and noise types.
+//!
+//! Input is a rate record (°/s, or any "frequency" data) at `rate_hz`; the phase (angle) is its
+//! prefix sum `x[k] = τ0 Σ_{i<k} y[i]`. The mean is removed before summing (the deviations
+//! are differences of the phase and do not depend on a constant rate offset) and the sum is
+//! Kahan-compensated, so a 10⁷-sample record keeps ~1e-16 relative precision in the phase.
+//! Each deviation at an averaging factor `m` (τ = m τ0) is one O(N) pass:
+//!
+//! - overlapping ADEV: `σ² = Σ_{i=0}^{N−2m−1} (x[i+2m] − 2x[i+m] + x[i])² / (2 τ² (N − 2m))`
+//! - non-overlapping ADEV: the same over `i = 0, m, 2m, …`
+//! - modified ADEV: `σ² = Σ_j (Σ_{i=j}^{j+m−1} (x[i+2m] − 2x[i+m] + x[i]))² / (2 m² τ² (N − 3m + 1))`,
+//!   the inner sum kept as a sliding window
+//! - overlapping Hadamard: `σ² = Σ (x[i+3m] − 3x[i+2m] + 3x[i+m] − x[i])² / (6 τ² (N − 3m))`
+//!
+//! with `N` the number of phase points (samples + 1), as in NIST SP 1065 (§5.2), whose
+//! reference values the tests reproduce.
+//!
+//! Confidence intervals: the equivalent degrees of freedom of the overlapping ADEV from the
+//! simple approximations of NIST SP 1065 Table 5 (Howe, Allan & Barnes 1981) for the noise type
+//! identified at that τ, and the χ² interval `σ² · edf / χ²(p)` (SP 1065 eq. 45), by default
+//! the 68.3 % (1σ) interval. The noise type at each τ comes from the lag-1 autocorrelation of
+//! the τ-averaged rate (Riley & Greenhall 2004): `ρ = r1/(1 + r1)`, differencing while `ρ >= ¼`
+//! (at most twice), `α = −2(ρ + d)` rounded — α = 2 white PM (quantization), 0 white FM
+//! (ARW), −1 flicker FM (bias instability), −2 random-walk FM (RRW).
+
+use super::chi2::chi2_quantile;
+
+/// Which deviation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// Overlapping Allan deviation.
+    Overlapping,
+    /// Non-overlapping (classic) Allan deviation.
+    NonOverlapping,
+    /// Modified Allan deviation.
+    Modified,
+    /// Overlapping Hadamard deviation.
+    Hadamard,
+}
+
+/// Which averaging factors.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Grid {
+    /// 1, 2, 4, 8, …
+    Octave,
+    /// 1, 2, 5, 10, 20, 50, …
+    Decade,
+    /// Every m.
+    All,
+}
+
+impl std::str::FromStr for Grid {
+    type Err = String;
+    fn from_str(text: &str) -> Result<Self, String> {
+        match text {
+            "octave" => Ok(Grid::Octave),
+            "decade" => Ok(Grid::Decade),
+            "all" => Ok(Grid::All),
+            other => Err(format!(
+                "'{other}' is not a tau grid: expected octave, decade or all"
+            )),
+        }
+    }
+}
+
+/// The phase of a rate record (in units of rate × samples; multiply by τ0 for angle), mean
+/// removed, Kahan-compensated: `N + 1` points for `N` samples.
+pub fn phase(rate: &[f64]) -> Vec<f64> {
+    let mean = rate.iter().sum::<f64>() / rate.len().max(1) as f64;
+    let mut out = Vec::with_capacity(rate.len() + 1);
+    let (mut sum, mut compensation) = (0.0f64, 0.0f64);
+    out.push(0.0);
+    for v in rate {
+        let y = (v - mean) - compensation;
+        let t = sum + y;
+        compensation = (t - sum) - y;
+        sum = t;
+        out.push(sum);
+    }
+    out
+}
+
+/// Largest averaging factor `kind` can use on `points` phase points (at least 2 terms for ADEV
+/// and Hadamard, 1 for the modified).
+pub fn max_factor(kind: Kind, points: usize) -> usize {
+    match kind {
+        Kind::Overlapping | Kind::NonOverlapping => points.saturating_sub(2) / 2,
+        Kind::Modified => points.saturating_sub(1) / 3,
+        Kind::Hadamard => points.saturating_sub(2) / 3,
+    }
+}
+
+/// The averaging factors of `grid` for a record of `points` phase points.
+pub fn factors(kind: Kind, grid: Grid, points: usize) -> Vec<usize> {
+    let max = max_factor(kind, points);
+    let mut out = Vec::new();
+    match grid {
+        Grid::All => out.extend(1..=max),
+        Grid::Octave => {
+            let mut m = 1;
+            while m <= max {
+                out.push(m);
+                m *= 2;
+            }
+        }
+        Grid::Decade => {
+            let mut decade = 1usize;
+            'outer: loop {
+                for step in [1, 2, 5] {
+                    let m = step * decade;
+                    if m > max {
+                        break 'outer;
+                    }
+                    out.push(m);
+                }
+                decade *= 10;
+            }
+        }
+    }
+    out
+}
+
+/// Sum of squares with four accumulators (independent chains: the loop pipelines).
+#[inline]
+fn sum_squares(n: usize, mut term: impl FnMut(usize) -> f64) -> f64 {
+    let mut acc = [0.0f64; 4];
+    let chunks = n / 4;
+    for c in 0..chunks {
+        let i = 4 * c;
+        for (lane, a) in acc.iter_mut().enumerate() {
+            let d = term(i + lane);
+            *a += d * d;
+        }
+    }
+    let mut total = acc[0] + acc[1] + acc[2] + acc[3];
+    for i in 4 * chunks..n {
+        let d = term(i);
+        total += d * d;
+    }
+    total
+}
+
+/// The deviation `kind` at averaging factor `m` from the phase `x` (see [`phase`]) of a
+/// record sampled at `rate_hz`, with the number of terms it averaged. `None` when the record
+/// is too short for `m`.
+pub fn deviation(kind: Kind, x: &[f64], m: usize, rate_hz: f64) -> Option<(f64, usize)> {
+    let n = x.len();
+    if m == 0 || m > max_factor(kind, n) {
+        return None;
+    }
+    let tau = m as f64 / rate_hz;
+    let tau0 = 1.0 / rate_hz;
+    // Phase in angle units: x · τ0.
+    let (sum, terms, normalization) = match kind {
+        Kind::Overlapping => {
+            let terms = n - 2 * m;
+            let s = sum_squares(terms, |i| x[i + 2 * m] - 2.0 * x[i + m] + x[i]);
+            (s, terms, 2.0 * terms as f64)
+        }
+        Kind::NonOverlapping => {
+            let terms = (n - 1 - 2 * m) / m + 1;
+            let s = sum_squares(terms, |j| {
+                let i = j * m;
+                x[i + 2 * m] - 2.0 * x[i + m] + x[i]
+            });
+            (s, terms, 2.0 * terms as f64)
+        }
+        Kind::Hadamard => {
+            let terms = n - 3 * m;
+            let s = sum_squares(terms, |i| {
+                x[i + 3 * m] - 3.0 * x[i + 2 * m] + 3.0 * x[i + m] - x[i]
+            });
+            (s, terms, 6.0 * terms as f64)
+        }
+        Kind::Modified => {
+            let terms = n - 3 * m + 1;
+            let second = |i: usize| x[i + 2 * m] - 2.0 * x[i + m] + x[i];
+            let mut window: f64 = (0..m).map(second).sum();
+            let mut s = window * window;
+            for j in 1..terms {
+                window += second(j + m - 1) - second(j - 1);
+                s += window * window;
+            }
+            (s, terms, 2.0 * (m * m) as f64 * terms as f64)
+        }
+    };
+    let variance = sum * tau0 * tau0 / (normalization * tau * tau);
+    Some((variance.sqrt(), terms))
+}
+
+/// Noise type at averaging factor `m` by the lag-1 autocorrelation of the m-averaged rate:
+/// the power-law exponent α (2, 1, 0, −1, −2), or `None` with fewer than 32 averages.
+pub fn noise_type(rate: &[f64], m: usize) -> Option<i32> {
+    let averages: Vec<f64> = rate
+        .chunks_exact(m.max(1))
+        .map(|c| c.iter().sum::<f64>() / c.len() as f64)
+        .collect();
+    if averages.len() < 32 {
+        return None;
+    }
+    let mut z = averages;
+    let mut d = 0;
+    loop {
+        let mean = z.iter().sum::<f64>() / z.len() as f64;
+        let denominator: f64 = z.iter().map(|v| (v - mean) * (v - mean)).sum();
+        let numerator: f64 = z.windows(2).map(|w| (w[0] - mean) * (w[1] - mean)).sum();
+        let r1 = if denominator > 0.0 {
+            numerator / denominator
+        } else {
+            0.0
+        };
+        let rho = r1 / (1.0 + r1);
+        if rho < 0.25 || d >= 2 {
+            let alpha = -2.0 * (rho + d as f64);
+            return Some((alpha.round() as i32).clamp(-2, 2));
+        }
+        z = z.windows(2).map(|w| w[1] - w[0]).collect();
+        d += 1;
+    }
+}
+
+/// Equivalent degrees of freedom of the overlapping ADEV with `points` phase points at
+/// averaging factor `m` for noise type `alpha` (NIST SP 1065 Table 5).
+pub fn edf_overlapping(points: usize, m: usize, alpha: i32) -> f64 {
+    let n = points as f64;
+    let m = m as f64;
+    let edf = match alpha {
+        2 => (n + 1.0) * (n - 2.0 * m) / (2.0 * (n - m)),
+        1 => libm::exp(
+            (libm::log((n - 1.0) / (2.0 * m)) * libm::log((2.0 * m + 1.0) * (n - 1.0) / 4.0))
+                .sqrt(),
+        ),
+        0 => {
+            (3.0 * (n - 1.0) / (2.0 * m) - 2.0 * (n - 2.0) / n) * (4.0 * m * m)
+                / (4.0 * m * m + 5.0)
+        }
+        -1 if m == 1.0 => 2.0 * (n - 2.0) / (2.3 * n - 4.9),
+        -1 => 5.0 * n * n / (4.0 * m * (n + 3.0 * m)),
+        _ => {
+            (n - 2.0) / (m * (n - 3.0) * (n - 3.0))
+                * ((n - 1.0) * (n - 1.0) - 3.0 * m * (n - 1.0) + 4.0 * m * m)
+        }
+    };
+    edf.max(1.0)
+}
+
+/// The `confidence` (e.g. 0.6827) interval `[lo, hi]` of a deviation `dev` with `edf`
+/// degrees of freedom: `σ² edf / χ²(1 − p/2)` … `σ² edf / χ²(p/2)` (SP 1065 eq. 45).
+pub fn confidence_interval(dev: f64, edf: f64, confidence: f64) -> (f64, f64) {
+    let tail = (1.0 - confidence) / 2.0;
+    let lo = dev * (edf / chi2_quantile(1.0 - tail, edf)).sqrt();
+    let hi = dev * (edf / chi2_quantile(tail, edf)).sqrt();
+    (lo, hi)
+}
+
+/// One point of an Allan curve.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Point {
+    /// Averaging time, s.
+    pub tau_s: f64,
+    /// Averaging factor.
+    pub m: usize,
+    /// The deviation (units of the rate).
+    pub dev: f64,
+    /// Lower end of the 1σ confidence interval.
+    pub lo: f64,
+    /// Upper end.
+    pub hi: f64,
+    /// Equivalent degrees of freedom.
+    pub edf: f64,
+    /// Noise type used for the EDF (α; white FM when too few averages to tell).
+    pub alpha: i32,
+    /// Terms averaged.
+    pub terms: usize,
+}
+
+/// The 1σ confidence level, erf(1/√2).
+pub const ONE_SIGMA: f64 = 0.682_689_492_137_085_9;
+
+/// The curve of `kind` over `grid` for a rate record at `rate_hz`, with 1σ confidence
+/// intervals (the overlapping-ADEV EDF for every kind).
+pub fn curve(kind: Kind, rate: &[f64], rate_hz: f64, grid: Grid) -> Vec<Point> {
+    let x = phase(rate);
+    factors(kind, grid, x.len())
+        .into_iter()
+        .filter_map(|m| {
+            let (dev, terms) = deviation(kind, &x, m, rate_hz)?;
+            let alpha = noise_type(rate, m).unwrap_or(0);
+            let edf = edf_overlapping(x.len(), m, alpha);
+            let (lo, hi) = confidence_interval(dev, edf, ONE_SIGMA);
+            Some(Point {
+                tau_s: m as f64 / rate_hz,
+                m,
+                dev,
+                lo,
+                hi,
+                edf,
+                alpha,
+                terms,
+            })
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// NIST SP 1065 §12.4 / Riley's 1000-point test set: n(i+1) = 16807 n(i) mod (2³¹ − 1),
+    /// n(0) = 1234567890, y(i) = n(i) / (2³¹ − 1).
+    fn nbs14_1000() -> Vec<f64> {
+        let mut n = vec![1_234_567_890u64];
+        for i in 0..999 {
+            n.push(16807 * n[i] % 2_147_483_647);
+        }
+        assert_eq!(&n[1..4], &[395_529_916, 1_209_410_747, 633_705_974]);
+        n.iter().map(|v| *v as f64 / 2_147_483_647.0).collect()
+    }
+
+    fn check(kind: Kind, data: &[f64], taus: &[usize], published: &[f64]) {
+        let x = phase(data);
+        for (m, want) in taus.iter().zip(published) {
+            let (got, _) = deviation(kind, &x, *m, 1.0).unwrap();
+            // The published values have 7 significant digits.
+            assert!(
+                (got / want - 1.0).abs() < 1e-6,
+                "{kind:?} m = {m}: {got:.9e} vs {want:e}"
+            );
+        }
+    }
+
+    #[test]
+    fn reproduces_the_nist_1000_point_reference_values() {
+        // NIST SP 1065, p. 108 (Riley, Table III): τ = 1, 10, 100.
+        let y = nbs14_1000();
+        check(
+            Kind::NonOverlapping,
+            &y,
+            &[1, 10, 100],
+            &[2.922319e-01, 9.965736e-02, 3.897804e-02],
+        );
+        check(
+            Kind::Overlapping,
+            &y,
+            &[1, 10, 100],
+            &[2.922319e-01, 9.159953e-02, 3.241343e-02],
+        );
+        check(
+            Kind::Modified,
+            &y,
+            &[1, 10, 100],
+            &[2.922319e-01, 6.172376e-02, 2.170921e-02],
+        );
+        check(
+            Kind::Hadamard,
+            &y,
+            &[1, 10, 100],
+            &[2.943883e-01, 9.581083e-02, 3.237638e-02],
+        );
+    }
+
+    #[test]
+    fn reproduces_the_nist_10_point_reference_values() {
+        // NBS14 frequency data (SP 1065 p. 107): τ = 1, 2.
+        let y = [
+            892.0, 809.0, 823.0, 798.0, 671.0, 644.0, 883.0, 903.0, 677.0,
+        ];
+        check(Kind::NonOverlapping, &y, &[1, 2], &[91.22945, 115.8082]);
+        check(Kind::Overlapping, &y, &[1, 2], &[91.22945, 85.95287]);
+        check(Kind::Modified, &y, &[1, 2], &[91.22945, 74.78849]);
+        check(Kind::Hadamard, &y, &[1, 2], &[70.80607, 85.61487]);
+    }
+
+    #[test]
+    fn grids() {
+        assert_eq!(
+            factors(Kind::Overlapping, Grid::Octave, 101),
+            vec![1, 2, 4, 8, 16, 32]
+        );
+        assert_eq!(
+            factors(Kind::Overlapping, Grid::Decade, 1001),
+            vec![1, 2, 5, 10, 20, 50, 100, 200]
+        );
+        assert_eq!(factors(Kind::Hadamard, Grid::All, 11).len(), 3);
+        assert!(deviation(Kind::Overlapping, &phase(&[1.0; 10]), 5, 1.0).is_none());
+    }
+
+    #[test]
+    fn noise_types_are_identified() {
+        use crate::stimulus::{Gaussian, Stream};
+        let mut g = Gaussian::new(2, Stream::AngleRandomWalk(0));
+        let white: Vec<f64> = (0..100_000).map(|_| g.sample()).collect();
+        let mut walk = 0.0;
+        let random_walk: Vec<f64> = white
+            .iter()
+            .map(|w| {
+                walk += w;
+                walk
+            })
+            .collect();
+        let white_pm: Vec<f64> = white.windows(2).map(|w| w[1] - w[0]).collect();
+        for m in [1, 10, 100] {
+            assert_eq!(noise_type(&white, m), Some(0), "white FM at m = {m}");
+            assert_eq!(noise_type(&random_walk, m), Some(-2), "RW FM at m = {m}");
+        }
+        assert_eq!(noise_type(&white_pm, 1), Some(2));
+    }
+
+    #[test]
+    fn confidence_intervals_cover_the_truth_about_68_percent_of_the_time() {
+        use crate::stimulus::{Gaussian, Stream};
+        // White FM of σ = 1 per sample: ADEV(m) = 1/√m exactly in expectation.
+        let mut covered = 0;
+        let trials = 200;
+        for seed in 0..trials {
+            let mut g = Gaussian::new(seed, Stream::RateRandomWalk(1));
+            let y: Vec<f64> = (0..2000).map(|_| g.sample()).collect();
+            let p = curve(Kind::Overlapping, &y, 1.0, Grid::Octave);
+            let point = p.iter().find(|p| p.m == 16).unwrap();
+            let truth = 1.0 / 4.0;
+            covered += usize::from(point.lo <= truth && truth <= point.hi);
+        }
+        let rate = covered as f64 / trials as f64;
+        assert!((0.58..=0.78).contains(&rate), "coverage {rate}");
+    }
+}
