@@ -1,8 +1,10 @@
 //! Noise analysis of rate records (f64): the Allan family of deviations with confidence
-//! intervals ([`allan`]), the χ² distribution they need ([`chi2`]).
+//! intervals ([`allan`]), the χ² distribution they need ([`chi2`]), and the five-term noise
+//! identification ([`noise`]).
 
 pub mod allan;
 pub mod chi2;
+pub mod noise;
 
 #[cfg(test)]
 mod tests {
