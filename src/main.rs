@@ -8,7 +8,7 @@ use clap::{Parser, Subcommand};
 
 use gyrofx_codegen::config::{Config, DEFAULT_TOML};
 use gyrofx_codegen::generate::{generate, provenance};
-use gyrofx_codegen::input::read_column;
+use gyrofx_codegen::input::{read_column, read_column_with_gaps};
 use gyrofx_codegen::job::{design_bandwidths, plan_for, Job};
 use gyrofx_codegen::report;
 use gyrofx_codegen::simulate::{self, Simulator};
@@ -29,6 +29,28 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Allan deviation of rate records (°/s) with 1σ confidence intervals, and the five noise
+    /// terms fitted to it.
+    Allan {
+        /// CSV file(s) with a header line; `#` lines are skipped (gyrofx's CSVs work as is).
+        #[arg(long, required = true)]
+        input: Vec<PathBuf>,
+        /// Column of rates in °/s (for every input).
+        #[arg(long, default_value = "rate_dps")]
+        column: String,
+        /// Sample rate, Hz.
+        #[arg(long, allow_negative_numbers = true)]
+        rate: f64,
+        /// Averaging times: octave, decade or all.
+        #[arg(long, default_value = "octave")]
+        taus: String,
+        /// Deviation: overlapping, nonoverlapping, modified or hadamard.
+        #[arg(long, default_value = "overlapping")]
+        kind: String,
+        /// Print JSON (one object per input; an array for several).
+        #[arg(long)]
+        json: bool,
+    },
     /// Print the annotated default config, or a preset (an overlay of it).
     Init {
         /// gu2019 (paper 004), xue2015 (paper 000) or mpu6050.
@@ -125,6 +147,14 @@ fn main() -> ExitCode {
 
 fn run(cli: Cli) -> Result<ExitCode> {
     match cli.command {
+        Command::Allan {
+            input,
+            column,
+            rate,
+            taus,
+            kind,
+            json,
+        } => run_allan(&input, &column, rate, &taus, &kind, json),
         Command::Init { preset } => {
             match preset {
                 Some(name) => print!("{}", gyrofx_codegen::config::preset(&name)?),
@@ -419,5 +449,121 @@ fn run_filter(
         o.x2,
         o.rate_hat
     );
+    Ok(ExitCode::SUCCESS)
+}
+
+fn run_allan(
+    inputs: &[PathBuf],
+    column: &str,
+    rate: f64,
+    taus: &str,
+    kind: &str,
+    json: bool,
+) -> Result<ExitCode> {
+    use gyrofx_model::analysis::{allan, noise};
+    if !(rate.is_finite() && rate > 0.0) {
+        bail!("--rate {rate} is not allowed: the sample rate must be a finite number of Hz > 0");
+    }
+    let grid: allan::Grid = taus.parse().map_err(anyhow::Error::msg)?;
+    let kind = match kind {
+        "overlapping" => allan::Kind::Overlapping,
+        "nonoverlapping" => allan::Kind::NonOverlapping,
+        "modified" => allan::Kind::Modified,
+        "hadamard" => allan::Kind::Hadamard,
+        other => bail!("--kind {other} is not a deviation: expected overlapping, nonoverlapping, modified or hadamard"),
+    };
+    let mut results = Vec::new();
+    for path in inputs {
+        let (values, skipped) = read_column_with_gaps(path, column)?;
+        if skipped > 0 && !json {
+            eprintln!(
+                "{}: skipped {skipped} rows with an empty {column} cell",
+                path.display()
+            );
+        }
+        if values.len() < 4 {
+            bail!(
+                "{}: {} samples are too few: an Allan deviation needs at least 4 (τ = 1/rate needs 2 differences)",
+                path.display(),
+                values.len()
+            );
+        }
+        let points = allan::curve(kind, &values, rate, grid);
+        let terms = noise::fit(&points);
+        let report = noise::report(&points, &terms);
+        if json {
+            results.push(serde_json::json!({
+                "input": path.display().to_string(),
+                "column": column,
+                "samples": values.len(),
+                "skipped_empty_cells": skipped,
+                "rate_hz": rate,
+                "kind": format!("{kind:?}").to_lowercase(),
+                "tau_s": points.iter().map(|p| p.tau_s).collect::<Vec<_>>(),
+                "adev": points.iter().map(|p| p.dev).collect::<Vec<_>>(),
+                "adev_lo": points.iter().map(|p| p.lo).collect::<Vec<_>>(),
+                "adev_hi": points.iter().map(|p| p.hi).collect::<Vec<_>>(),
+                "edf": points.iter().map(|p| p.edf).collect::<Vec<_>>(),
+                "noise_alpha": points.iter().map(|p| p.alpha).collect::<Vec<_>>(),
+                "noise": report,
+            }));
+        } else {
+            println!(
+                "{} ({} samples at {rate} Hz, column {column}), {kind:?} deviation",
+                path.display(),
+                values.len()
+            );
+            println!(
+                "{:>12} {:>13} {:>13} {:>13} {:>6} {:>9}",
+                "tau (s)", "dev (°/s)", "lo", "hi", "alpha", "edf"
+            );
+            for p in &points {
+                println!(
+                    "{:>12.6} {:>13.6e} {:>13.6e} {:>13.6e} {:>6} {:>9.1}",
+                    p.tau_s, p.dev, p.lo, p.hi, p.alpha, p.edf
+                );
+            }
+            let line = |name: &str, e: noise::Estimate, unit: &str| {
+                println!(
+                    "  {name:<28} {:>12.5e} [{:.5e}, {:.5e}] {unit}",
+                    e.value, e.lo, e.hi
+                );
+            };
+            println!("noise terms (weighted non-negative fit, ±1 standard error):");
+            line("quantization Q", report.quantization_urad, "µrad");
+            line("angle random walk N", report.arw_deg_per_sqrt_h, "°/√h");
+            line(
+                "bias instability B",
+                report.bias_instability_deg_per_h,
+                "°/h",
+            );
+            line(
+                "rate random walk K",
+                report.rrw_deg_per_h_per_sqrt_h,
+                "°/h/√h",
+            );
+            line("rate ramp R", report.rate_ramp_deg_per_h2, "°/h²");
+            println!(
+                "  Kalibr: noise density {:.5e} rad/s/√Hz, random walk {:.5e} rad/s²/√Hz",
+                report.kalibr_noise_density_rad_per_s_per_sqrt_hz,
+                report.kalibr_random_walk_rad_per_s2_per_sqrt_hz
+            );
+            let opt = |v: Option<f64>| v.map(|v| format!("{v:.5e}")).unwrap_or_else(|| "-".into());
+            println!(
+                "  slope readings: N {} °/√h (τ = 1 s), K {} °/h/√h (τ = 3 s), B {:.5e} °/h (min/0.6643)",
+                opt(report.slope_arw_deg_per_sqrt_h),
+                opt(report.slope_rrw_deg_per_h_per_sqrt_h),
+                report.slope_bias_instability_deg_per_h
+            );
+        }
+    }
+    if json {
+        let value = if results.len() == 1 {
+            results.remove(0)
+        } else {
+            serde_json::Value::Array(results)
+        };
+        println!("{}", serde_json::to_string_pretty(&value)?);
+    }
     Ok(ExitCode::SUCCESS)
 }

@@ -1,0 +1,147 @@
+//! `gyrofx allan`: JSON fields, agreement with the library on a known record, and bad input.
+
+mod common;
+
+use common::*;
+
+/// White rate noise from a fixed LCG (the NIST test generator), written as a CSV.
+fn white_csv(dir: &std::path::Path, samples: usize) -> String {
+    let mut n: u64 = 1_234_567_890;
+    let mut text = String::from("# a comment line, as gyrofx writes them\nt,rate_dps\n");
+    for k in 0..samples {
+        n = 16807 * n % 2_147_483_647;
+        text.push_str(&format!("{k},{}\n", n as f64 / 2_147_483_647.0 - 0.5));
+    }
+    let path = dir.join("white.csv");
+    std::fs::write(&path, text).unwrap();
+    path.to_string_lossy().into_owned()
+}
+
+#[test]
+fn json_has_the_documented_fields() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = white_csv(dir.path(), 999);
+    let out = ok(&[
+        "allan", "--input", &csv, "--rate", "1", "--taus", "decade", "--json",
+    ]);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    for key in ["tau_s", "adev", "adev_lo", "adev_hi"] {
+        assert!(v[key].is_array(), "{key}: {out}");
+    }
+    for key in [
+        "quantization_urad",
+        "arw_deg_per_sqrt_h",
+        "bias_instability_deg_per_h",
+        "rrw_deg_per_h_per_sqrt_h",
+        "rate_ramp_deg_per_h2",
+    ] {
+        for part in ["value", "lo", "hi"] {
+            assert!(
+                v["noise"][key][part].is_number(),
+                "noise.{key}.{part}: {out}"
+            );
+        }
+    }
+    // Every confidence interval contains its value.
+    let adev = v["adev"].as_array().unwrap();
+    for (i, a) in adev.iter().enumerate() {
+        let (a, lo, hi) = (
+            a.as_f64().unwrap(),
+            v["adev_lo"][i].as_f64().unwrap(),
+            v["adev_hi"][i].as_f64().unwrap(),
+        );
+        assert!(lo <= a && a <= hi, "{i}: {lo} {a} {hi}");
+    }
+    // White noise of a uniform on [-0.5, 0.5): ADEV(1) = σ = 1/√12.
+    assert!(
+        (adev[0].as_f64().unwrap() - 12f64.sqrt().recip()).abs() < 0.02,
+        "{out}"
+    );
+}
+
+#[test]
+fn several_inputs_give_an_array() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = white_csv(dir.path(), 500);
+    let out = ok(&[
+        "allan", "--input", &csv, "--input", &csv, "--rate", "10", "--json",
+    ]);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v.as_array().unwrap().len(), 2);
+    assert_eq!(v[0]["adev"], v[1]["adev"]);
+}
+
+#[test]
+fn a_generated_csv_is_valid_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("pkg");
+    ok(&[
+        "generate",
+        "--out",
+        out.to_str().unwrap(),
+        "--samples",
+        "3000",
+    ]);
+    let csv = out.join("top/top_vectors.csv");
+    let log = ok(&[
+        "allan",
+        "--input",
+        csv.to_str().unwrap(),
+        "--column",
+        "true_rate_dps",
+        "--rate",
+        "200",
+    ]);
+    assert!(log.contains("angle random walk N"), "{log}");
+}
+
+#[test]
+fn bad_input_is_refused_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, text: &str| {
+        let p = dir.path().join(name);
+        std::fs::write(&p, text).unwrap();
+        p.to_string_lossy().into_owned()
+    };
+    let empty = write("empty.csv", "");
+    let word = write("word.csv", "t,rate_dps\n0,1\n1,2\n2,x\n3,4\n4,5\n");
+    let nan = write("nan.csv", "t,rate_dps\n0,1\n1,NaN\n2,3\n3,4\n4,5\n");
+    let short = write("short.csv", "t,rate_dps\n0,1\n1,2\n");
+    let good = white_csv(dir.path(), 100);
+    for (args, needle) in [
+        (vec!["--input", &empty, "--rate", "1"], "empty"),
+        (
+            vec!["--input", &word, "--rate", "1"],
+            "line 4, column \"rate_dps\": \"x\" is not a number",
+        ),
+        (
+            vec!["--input", &nan, "--rate", "1"],
+            "line 3, column \"rate_dps\": NaN is not allowed",
+        ),
+        (
+            vec!["--input", &short, "--rate", "1"],
+            "2 samples are too few",
+        ),
+        (
+            vec!["--input", &good, "--rate", "0"],
+            "--rate 0 is not allowed",
+        ),
+        (
+            vec!["--input", &good, "--rate", "-5"],
+            "--rate -5 is not allowed",
+        ),
+        (
+            vec!["--input", &good, "--rate", "1", "--taus", "weekly"],
+            "'weekly' is not a tau grid",
+        ),
+        (
+            vec!["--input", &good, "--rate", "1", "--column", "gyro"],
+            "no column named \"gyro\"",
+        ),
+    ] {
+        let mut all = vec!["allan"];
+        all.extend(args);
+        let log = fails(&all);
+        assert!(log.contains(needle), "{all:?}: {log}");
+    }
+}
