@@ -145,3 +145,113 @@ fn bad_input_is_refused_clearly() {
         assert!(log.contains(needle), "{all:?}: {log}");
     }
 }
+
+/// White noise with a ×8 burst from 90 s to 100 s at 100 Hz.
+fn burst_csv(dir: &std::path::Path) -> String {
+    let mut n: u64 = 987_654_321;
+    let mut text = String::from("t,rate_dps\n");
+    for k in 0..20_000 {
+        // Sum of 12 uniforms − 6: near-Gaussian, unit variance.
+        let mut g = -6.0;
+        for _ in 0..12 {
+            n = 16807 * n % 2_147_483_647;
+            g += n as f64 / 2_147_483_647.0;
+        }
+        let scale = if (9000..10_000).contains(&k) {
+            8.0
+        } else {
+            1.0
+        };
+        text.push_str(&format!("{k},{}\n", g * scale));
+    }
+    let path = dir.join("burst.csv");
+    std::fs::write(&path, text).unwrap();
+    path.to_string_lossy().into_owned()
+}
+
+#[test]
+fn davar_finds_the_burst_and_the_adaptive_window_is_closer() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = burst_csv(dir.path());
+    let fixed: serde_json::Value = serde_json::from_str(&ok(&[
+        "davar", "--input", &csv, "--rate", "100", "--window", "1001", "--json",
+    ]))
+    .unwrap();
+    let adaptive: serde_json::Value = serde_json::from_str(&ok(&[
+        "davar",
+        "--input",
+        &csv,
+        "--rate",
+        "100",
+        "--window",
+        "1001",
+        "--adaptive",
+        "--json",
+    ]))
+    .unwrap();
+    for v in [&fixed, &adaptive] {
+        for key in ["time_s", "window", "tau_s", "adev"] {
+            assert!(v["davar"][key].is_array(), "{key}");
+        }
+        for key in [
+            "arw_deg_per_sqrt_h",
+            "bias_instability_deg_per_h",
+            "rrw_deg_per_h_per_sqrt_h",
+        ] {
+            assert!(v["coefficients"][key].is_array(), "{key}");
+        }
+        assert_eq!(
+            v["disturbances"].as_array().unwrap().len(),
+            1,
+            "{}",
+            v["disturbances"]
+        );
+    }
+    let span = |v: &serde_json::Value| {
+        let d = &v["disturbances"][0];
+        (d["start_s"].as_f64().unwrap(), d["end_s"].as_f64().unwrap())
+    };
+    let (fs, fe) = span(&fixed);
+    let (a_s, ae) = span(&adaptive);
+    assert!(
+        fs < 90.0 && fe > 100.0 && fs > 84.0 && fe < 106.0,
+        "fixed {fs}..{fe}"
+    );
+    assert!(
+        (ae - a_s) <= (fe - fs),
+        "adaptive {a_s}..{ae} vs fixed {fs}..{fe}"
+    );
+    let windows = adaptive["davar"]["window"].as_array().unwrap();
+    assert!(
+        windows.iter().any(|w| w.as_u64().unwrap() < 1001),
+        "the adaptive window shortens"
+    );
+}
+
+#[test]
+fn davar_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = white_csv(dir.path(), 1000);
+    for (args, needle) in [
+        (
+            vec!["--window", "5000"],
+            "--window 5000 is not allowed: it must be 4..=1000",
+        ),
+        (vec!["--window", "2"], "--window 2 is not allowed"),
+        (
+            vec!["--window", "500", "--adaptive", "--min-window", "600"],
+            "--min-window 600 is not allowed",
+        ),
+        (
+            vec!["--window", "500", "--step", "0"],
+            "--step 0 is not allowed",
+        ),
+    ] {
+        let mut all = vec!["davar", "--input", &csv, "--rate", "10"];
+        all.extend(args);
+        let log = fails(&all);
+        assert!(log.contains(needle), "{all:?}: {log}");
+    }
+    let log = fails(&["davar", "--input", &csv, "--rate", "0"]);
+    assert!(log.contains("--rate 0 is not allowed"), "{log}");
+}

@@ -4,6 +4,7 @@
 
 pub mod allan;
 pub mod chi2;
+pub mod davar;
 pub mod noise;
 
 #[cfg(test)]
