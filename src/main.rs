@@ -549,6 +549,11 @@ fn run_allan(
         let points = allan::curve(kind, &values, rate, grid);
         let terms = noise::fit(&points);
         let report = noise::report(&points, &terms);
+        // Welch with the largest power-of-two segment up to N/8 (at most 4096).
+        let segment = (values.len() / 8).clamp(8, 4096).next_power_of_two() / 2;
+        let density = (segment >= 8)
+            .then(|| gyrofx_model::analysis::spectrum::welch(&values, rate, segment.max(8)))
+            .and_then(|psd| psd.median_density(rate / 50.0, rate / 5.0));
         if json {
             results.push(serde_json::json!({
                 "input": path.display().to_string(),
@@ -564,6 +569,7 @@ fn run_allan(
                 "edf": points.iter().map(|p| p.edf).collect::<Vec<_>>(),
                 "noise_alpha": points.iter().map(|p| p.alpha).collect::<Vec<_>>(),
                 "noise": report,
+                "noise_density_dps_per_sqrt_hz": density,
             }));
         } else {
             println!(
@@ -607,6 +613,10 @@ fn run_allan(
                 report.kalibr_random_walk_rad_per_s2_per_sqrt_hz
             );
             let opt = |v: Option<f64>| v.map(|v| format!("{v:.5e}")).unwrap_or_else(|| "-".into());
+            println!(
+                "  noise density (Welch, median over fs/50..fs/5): {} °/s/√Hz",
+                opt(density)
+            );
             println!(
                 "  slope readings: N {} °/√h (τ = 1 s), K {} °/h/√h (τ = 3 s), B {:.5e} °/h (min/0.6643)",
                 opt(report.slope_arw_deg_per_sqrt_h),

@@ -42,6 +42,9 @@ fn json_has_the_documented_fields() {
             );
         }
     }
+    // White uniform noise of σ = 1/√12 at 1 Hz: density √(S/2) = σ/√fs.
+    let density = v["noise_density_dps_per_sqrt_hz"].as_f64().unwrap();
+    assert!((density * 12f64.sqrt() - 1.0).abs() < 0.15, "{density}");
     // Every confidence interval contains its value.
     let adev = v["adev"].as_array().unwrap();
     for (i, a) in adev.iter().enumerate() {

@@ -6,6 +6,7 @@ pub mod allan;
 pub mod chi2;
 pub mod davar;
 pub mod noise;
+pub mod spectrum;
 
 #[cfg(test)]
 mod tests {
