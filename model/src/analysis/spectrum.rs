@@ -72,7 +72,7 @@ pub fn welch(rate: &[f64], rate_hz: f64, segment: usize) -> Psd {
         fft.process(&mut buffer);
         for (k, s) in sum.iter_mut().enumerate() {
             // One-sided: double every bin but DC and Nyquist.
-            let factor = if k == 0 || (segment % 2 == 0 && k == segment / 2) {
+            let factor = if k == 0 || (segment.is_multiple_of(2) && k == segment / 2) {
                 1.0
             } else {
                 2.0
