@@ -4,25 +4,29 @@
 #   scripts/test.sh
 #
 # Installs the simulators and synthesis tool with apt-get where missing (iverilog, verilator,
-# ghdl, yosys, make): a missing simulator is a failure, never a skipped test. Then: rustfmt,
+# ghdl, yosys, make, and the DejaVu font the plots use): a missing simulator is a failure,
+# never a skipped test. Then: rustfmt,
 # clippy, Verilator lint of the RTL, and the whole test suite (unit, property, end-to-end
 # with both simulators, golden vectors). Benchmarks are compiled (clippy --all-targets) but
 # not run: run them with `cargo bench`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+font=/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf
 missing=()
 for program in iverilog vvp verilator ghdl yosys make sha256sum; do
     command -v "$program" >/dev/null 2>&1 || missing+=("$program")
 done
+[ -f "$font" ] || missing+=("$font")
 if [ ${#missing[@]} -gt 0 ]; then
     echo "== installing (missing: ${missing[*]})"
     sudo=""
     if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
     $sudo apt-get update -qq
     DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq \
-        iverilog verilator ghdl yosys make coreutils >/dev/null
+        iverilog verilator ghdl yosys make coreutils fonts-dejavu-core >/dev/null
 fi
+[ -f "$font" ] || { echo "FAIL: $font is still missing after apt-get (plots need it)" >&2; exit 1; }
 for program in iverilog vvp verilator ghdl yosys make sha256sum; do
     command -v "$program" >/dev/null 2>&1 || { echo "FAIL: $program is still missing after apt-get" >&2; exit 1; }
 done

@@ -50,6 +50,9 @@ enum Command {
         /// Print JSON (one object per input; an array for several).
         #[arg(long)]
         json: bool,
+        /// Write a log-log plot with confidence bars and fitted terms (.png or .svg).
+        #[arg(long)]
+        plot: Option<PathBuf>,
     },
     /// Dynamic Allan deviation: the ADEV of a window sliding along the record, fixed or
     /// PID-adapted (paper 002), with the noise coefficients over time and the disturbances.
@@ -85,6 +88,9 @@ enum Command {
         /// Print JSON.
         #[arg(long)]
         json: bool,
+        /// Write the heatmap and the coefficients over time (.png or .svg).
+        #[arg(long)]
+        plot: Option<PathBuf>,
     },
     /// Print the annotated default config, or a preset (an overlay of it).
     Init {
@@ -189,7 +195,8 @@ fn run(cli: Cli) -> Result<ExitCode> {
             taus,
             kind,
             json,
-        } => run_allan(&input, &column, rate, &taus, &kind, json),
+            plot,
+        } => run_allan(&input, &column, rate, &taus, &kind, json, plot.as_deref()),
         Command::Davar {
             input,
             column,
@@ -202,6 +209,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
             kd,
             step,
             json,
+            plot,
         } => run_davar(
             &input,
             &column,
@@ -212,6 +220,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
             [kp, ki, kd],
             step,
             json,
+            plot.as_deref(),
         ),
         Command::Init { preset } => {
             match preset {
@@ -510,6 +519,7 @@ fn run_filter(
     Ok(ExitCode::SUCCESS)
 }
 
+#[allow(clippy::too_many_arguments)]
 fn run_allan(
     inputs: &[PathBuf],
     column: &str,
@@ -517,6 +527,7 @@ fn run_allan(
     taus: &str,
     kind: &str,
     json: bool,
+    plot: Option<&Path>,
 ) -> Result<ExitCode> {
     use gyrofx_model::analysis::{allan, noise};
     if !(rate.is_finite() && rate > 0.0) {
@@ -531,6 +542,7 @@ fn run_allan(
         other => bail!("--kind {other} is not a deviation: expected overlapping, nonoverlapping, modified or hadamard"),
     };
     let mut results = Vec::new();
+    let mut curves = Vec::new();
     for path in inputs {
         let (values, skipped) = read_column_with_gaps(path, column)?;
         if skipped > 0 && !json {
@@ -549,6 +561,7 @@ fn run_allan(
         let points = allan::curve(kind, &values, rate, grid);
         let terms = noise::fit(&points);
         let report = noise::report(&points, &terms);
+        curves.push((path.display().to_string(), points.clone(), terms));
         // Welch with the largest power-of-two segment up to N/8 (at most 4096).
         let segment = (values.len() / 8).clamp(8, 4096).next_power_of_two() / 2;
         let density = (segment >= 8)
@@ -625,6 +638,20 @@ fn run_allan(
             );
         }
     }
+    if let Some(path) = plot {
+        let series: Vec<gyrofx_codegen::plot::AllanSeries> = curves
+            .iter()
+            .map(|(label, points, terms)| gyrofx_codegen::plot::AllanSeries {
+                label: label.clone(),
+                points,
+                terms: Some(terms),
+            })
+            .collect();
+        gyrofx_codegen::plot::allan(path, &series)?;
+        if !json {
+            println!("plot: {}", path.display());
+        }
+    }
     if json {
         let value = if results.len() == 1 {
             results.remove(0)
@@ -647,6 +674,7 @@ fn run_davar(
     gains: [Option<f64>; 3],
     step: Option<usize>,
     json: bool,
+    plot: Option<&Path>,
 ) -> Result<ExitCode> {
     use gyrofx_model::analysis::davar::{coefficients, davar, disturbances, Pid, Window};
     if !(rate.is_finite() && rate > 0.0) {
@@ -681,6 +709,12 @@ fn run_davar(
     let d = davar(&values, rate, mode, step);
     let c = coefficients(&d);
     let runs = disturbances(&d, 2.0);
+    if let Some(path) = plot {
+        gyrofx_codegen::plot::davar(path, &d, &c)?;
+        if !json {
+            println!("plot: {}", path.display());
+        }
+    }
     if json {
         let value = serde_json::json!({
             "input": input.display().to_string(),

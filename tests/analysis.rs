@@ -258,3 +258,76 @@ fn davar_bad_input() {
     let log = fails(&["davar", "--input", &csv, "--rate", "0"]);
     assert!(log.contains("--rate 0 is not allowed"), "{log}");
 }
+
+#[test]
+fn plots_are_written_as_png_or_svg() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = burst_csv(dir.path());
+    let png = dir.path().join("allan.png");
+    let svg = dir.path().join("davar.svg");
+    ok(&[
+        "allan",
+        "--input",
+        &csv,
+        "--rate",
+        "100",
+        "--plot",
+        png.to_str().unwrap(),
+    ]);
+    ok(&[
+        "davar",
+        "--input",
+        &csv,
+        "--rate",
+        "100",
+        "--window",
+        "1001",
+        "--plot",
+        svg.to_str().unwrap(),
+    ]);
+    let bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "a PNG file");
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(
+        text.contains("<svg") && text.contains("Dynamic Allan deviation"),
+        "an SVG with its title"
+    );
+
+    let log = fails(&[
+        "allan",
+        "--input",
+        &csv,
+        "--rate",
+        "100",
+        "--plot",
+        dir.path().join("a.jpg").to_str().unwrap(),
+    ]);
+    assert!(log.contains("must end in .png or .svg"), "{log}");
+    let constant = dir.path().join("constant.csv");
+    std::fs::write(
+        &constant,
+        "t,rate_dps\n".to_string() + &(0..100).map(|k| format!("{k},1.5\n")).collect::<String>(),
+    )
+    .unwrap();
+    let refused = dir.path().join("refused.png");
+    let log = fails(&[
+        "allan",
+        "--input",
+        constant.to_str().unwrap(),
+        "--rate",
+        "1",
+        "--plot",
+        refused.to_str().unwrap(),
+    ]);
+    assert!(log.contains("nothing to plot"), "{log}");
+    let names: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(
+        !names
+            .iter()
+            .any(|n| n.contains("refused") || n.starts_with(".gyrofx-plot")),
+        "{names:?}"
+    );
+}

@@ -65,6 +65,9 @@ pub enum Error {
         /// Why.
         message: String,
     },
+    /// A plot cannot be drawn (no font).
+    #[error("{0}")]
+    Plot(String),
     /// A simulation could not run or did not pass.
     #[error("{0}")]
     Simulation(String),

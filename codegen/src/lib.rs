@@ -14,6 +14,7 @@ pub mod generate;
 pub mod input;
 pub mod job;
 pub mod package;
+pub mod plot;
 pub mod report;
 pub mod simulate;
 pub mod testbench;

@@ -274,9 +274,14 @@ pub fn coefficients(d: &Davar) -> Coefficients {
             continue;
         }
         let terms = noise::fit(&points);
-        c.arw_deg_per_sqrt_h.push(terms.n.value * 60.0);
-        c.bias_instability_deg_per_h.push(terms.b.value * 3600.0);
-        c.rrw_deg_per_h_per_sqrt_h.push(terms.k.value * 216_000.0);
+        // A degenerate window (e.g. all points equal) can make the fit non-finite: NaN,
+        // written as null.
+        let finite = |v: f64| if v.is_finite() { v } else { f64::NAN };
+        c.arw_deg_per_sqrt_h.push(finite(terms.n.value * 60.0));
+        c.bias_instability_deg_per_h
+            .push(finite(terms.b.value * 3600.0));
+        c.rrw_deg_per_h_per_sqrt_h
+            .push(finite(terms.k.value * 216_000.0));
     }
     c
 }
