@@ -121,24 +121,57 @@ pub fn factors(kind: Kind, grid: Grid, points: usize) -> Vec<usize> {
     out
 }
 
-/// `Σ_i (c[i] − 2 b[i] + a[i])²`: the overlapping ADEV's second differences, with the same
-/// four-lane summation as [`sum_squares`].
+/// `Σ_i (c[i] − 2 b[i] + a[i])²`: the overlapping ADEV's second differences, summed in
+/// [`LANES`] lanes (lane = i mod LANES) added pairwise at the end. On x86-64 with AVX2 the same code is compiled for
+/// 256-bit vectors and chosen at run time; every lane adds the same terms in the same order
+/// (and Rust never fuses a multiply and an add), so the result is bit-identical either way.
 #[inline]
 fn sum_second_differences(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
-    let mut acc = [0.0f64; 4];
-    let chunks = a.len() / 4;
-    for ((a, b), c) in a
-        .chunks_exact(4)
-        .zip(b.chunks_exact(4))
-        .zip(c.chunks_exact(4))
+    #[cfg(target_arch = "x86_64")]
     {
-        for lane in 0..4 {
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2, checked just above.
+            return unsafe { sum_second_differences_avx2(a, b, c) };
+        }
+    }
+    second_differences_kernel(a, b, c)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn sum_second_differences_avx2(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
+    second_differences_kernel(a, b, c)
+}
+
+/// Lanes of the second-difference sum: enough independent accumulators to hide the add
+/// latency (eight 256-bit registers with AVX2; measured: 16 lanes 360 ms, 32 lanes 285 ms, 64
+/// lanes 278 ms for every tau of 10^5 samples).
+const LANES: usize = 32;
+
+#[inline(always)]
+fn second_differences_kernel(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
+    let mut acc = [0.0f64; LANES];
+    let chunks = a.len() / LANES;
+    for ((a, b), c) in a
+        .chunks_exact(LANES)
+        .zip(b.chunks_exact(LANES))
+        .zip(c.chunks_exact(LANES))
+    {
+        for lane in 0..LANES {
             let v = c[lane] - 2.0 * b[lane] + a[lane];
             acc[lane] += v * v;
         }
     }
-    let mut total = (acc[0] + acc[1]) + (acc[2] + acc[3]);
-    for i in 4 * chunks..a.len() {
+    // A fixed pairwise order for the lanes.
+    let mut width = LANES;
+    while width > 1 {
+        width /= 2;
+        for lane in 0..width {
+            acc[lane] += acc[lane + width];
+        }
+    }
+    let mut total = acc[0];
+    for i in LANES * chunks..a.len() {
         let v = c[i] - 2.0 * b[i] + a[i];
         total += v * v;
     }
@@ -461,6 +494,23 @@ mod tests {
         check(Kind::Overlapping, &y, &[1, 2], &[91.22945, 85.95287]);
         check(Kind::Modified, &y, &[1, 2], &[91.22945, 74.78849]);
         check(Kind::Hadamard, &y, &[1, 2], &[70.80607, 85.61487]);
+    }
+
+    #[test]
+    fn the_avx2_kernel_gives_the_same_bits() {
+        use crate::stimulus::{Gaussian, Stream};
+        let mut g = Gaussian::new(9, Stream::AngleRandomWalk(0));
+        let x = phase(&(0..10_007).map(|_| g.sample()).collect::<Vec<_>>());
+        for m in [1usize, 3, 64, 1000] {
+            let terms = x.len() - 2 * m;
+            let (a, b, c) = (&x[..terms], &x[m..m + terms], &x[2 * m..2 * m + terms]);
+            let portable = second_differences_kernel(a, b, c);
+            assert_eq!(
+                sum_second_differences(a, b, c).to_bits(),
+                portable.to_bits(),
+                "m {m}"
+            );
+        }
     }
 
     #[test]
