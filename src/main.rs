@@ -35,9 +35,9 @@ enum Command {
         /// CSV file(s) with a header line; `#` lines are skipped (gyrofx's CSVs work as is).
         #[arg(long, required = true)]
         input: Vec<PathBuf>,
-        /// Column of rates in °/s (for every input).
+        /// Column(s) of rates in °/s; each input × column is one series.
         #[arg(long, default_value = "rate_dps")]
-        column: String,
+        column: Vec<String>,
         /// Sample rate, Hz.
         #[arg(long, allow_negative_numbers = true)]
         rate: f64,
@@ -522,7 +522,7 @@ fn run_filter(
 #[allow(clippy::too_many_arguments)]
 fn run_allan(
     inputs: &[PathBuf],
-    column: &str,
+    columns: &[String],
     rate: f64,
     taus: &str,
     kind: &str,
@@ -543,7 +543,11 @@ fn run_allan(
     };
     let mut results = Vec::new();
     let mut curves = Vec::new();
-    for path in inputs {
+    let series: Vec<(&PathBuf, &str)> = inputs
+        .iter()
+        .flat_map(|p| columns.iter().map(move |c| (p, c.as_str())))
+        .collect();
+    for (path, column) in series {
         let (values, skipped) = read_column_with_gaps(path, column)?;
         if skipped > 0 && !json {
             eprintln!(
@@ -561,7 +565,12 @@ fn run_allan(
         let points = allan::curve(kind, &values, rate, grid);
         let terms = noise::fit(&points);
         let report = noise::report(&points, &terms);
-        curves.push((path.display().to_string(), points.clone(), terms));
+        let label = if columns.len() > 1 {
+            format!("{} [{column}]", path.display())
+        } else {
+            path.display().to_string()
+        };
+        curves.push((label, points.clone(), terms));
         // Welch with the largest power-of-two segment up to N/8 (at most 4096).
         let segment = (values.len() / 8).clamp(8, 4096).next_power_of_two() / 2;
         let density = (segment >= 8)

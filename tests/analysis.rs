@@ -75,6 +75,36 @@ fn several_inputs_give_an_array() {
 }
 
 #[test]
+fn several_columns_give_several_series() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("pkg");
+    ok(&[
+        "generate",
+        "--out",
+        out.to_str().unwrap(),
+        "--samples",
+        "3000",
+    ]);
+    let csv = out.join("top/top_vectors.csv");
+    let json = ok(&[
+        "allan",
+        "--input",
+        csv.to_str().unwrap(),
+        "--column",
+        "y_a_dps",
+        "--column",
+        "y_b_dps",
+        "--rate",
+        "200",
+        "--json",
+    ]);
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(v.as_array().unwrap().len(), 2);
+    assert_eq!(v[1]["column"], "y_b_dps");
+    assert_ne!(v[0]["adev"], v[1]["adev"]);
+}
+
+#[test]
 fn a_generated_csv_is_valid_input() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("pkg");
