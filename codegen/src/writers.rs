@@ -221,7 +221,8 @@ pub fn vector_hex(block: &Block, provenance: &Provenance) -> (String, String) {
 }
 
 /// The block's vectors as CSV: sample, rst, then per signal its code (and its real value in
-/// °/s for signed signals), then the block's extra columns.
+/// °/s for signed signals), then the block's extra columns. A gated output's cells are empty
+/// where its gate is 0.
 pub fn vector_csv(block: &Block, provenance: &Provenance) -> String {
     let n = block.len();
     let mut csv = String::with_capacity(n * 16 * block.stride() + 256);
@@ -242,18 +243,39 @@ pub fn vector_csv(block: &Block, provenance: &Provenance) -> String {
         let _ = write!(csv, ",{name}");
     }
     csv.push('\n');
+    // For each signal (inputs, then outputs), the row index of its gate, if it has one.
+    let gate_of: Vec<Option<usize>> = block
+        .inputs
+        .iter()
+        .map(|_| None)
+        .chain(block.outputs.iter().map(|o| {
+            o.gate.and_then(|gate| {
+                block
+                    .outputs
+                    .iter()
+                    .position(|other| other.signal.name == gate)
+                    .map(|p| block.inputs.len() + p)
+            })
+        }))
+        .collect();
     let (mut real, mut int) = (ryu::Buffer::new(), itoa::Buffer::new());
     for k in 0..n {
         let row = block.row(k);
         csv.push_str(int.format(k));
         csv.push(',');
         csv.push_str(int.format(row[0]));
-        for (code, s) in row[1..].iter().zip(&signals) {
+        for ((index, code), s) in row[1..].iter().enumerate().zip(&signals) {
+            // A gated output means nothing where its gate is 0: an empty cell, not a 0.
+            let shown = gate_of[index].is_none_or(|g| row[1 + g] == 1);
             csv.push(',');
-            csv.push_str(int.format(*code));
+            if shown {
+                csv.push_str(int.format(*code));
+            }
             if s.is_real() {
                 csv.push(',');
-                push_real(&mut csv, &mut real, s.format.to_f64(i128::from(*code)));
+                if shown {
+                    push_real(&mut csv, &mut real, s.format.to_f64(i128::from(*code)));
+                }
             }
         }
         for (_, values) in &block.extra {
