@@ -38,9 +38,9 @@ pub struct Config {
     /// The true rate.
     pub stimulus: StimulusConfig,
     /// Gyro A's errors.
-    pub gyro_a: GyroConfig,
+    pub gyro_a: GyroErrors,
     /// Gyro B's errors.
-    pub gyro_b: GyroConfig,
+    pub gyro_b: GyroErrors,
     /// Plant-wide settings.
     pub plant: PlantConfig,
     /// The sequencer.
@@ -75,30 +75,6 @@ pub struct StimulusConfig {
     /// Column of the CSV file.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub csv_column: Option<String>,
-}
-
-/// `[gyro_a]`, `[gyro_b]`: one gyro's errors (see `gyrofx_model::plant`).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct GyroConfig {
-    /// Scale-factor error in normal mode, ppm.
-    pub sf_ppm: f64,
-    /// Reverse minus normal scale factor, ppm.
-    pub sf_mode_mismatch_ppm: f64,
-    /// Bias at t = 0, °/s.
-    pub bias_dps: f64,
-    /// Bias part that does not flip with the mode, °/s.
-    pub bias_mode_mismatch_dps: f64,
-    /// ARW, °/√h.
-    pub arw_deg_per_sqrt_h: f64,
-    /// Bias instability B, °/h.
-    pub bias_instability_deg_per_h: f64,
-    /// RRW, °/h/√h.
-    pub rrw_deg_per_h_per_sqrt_h: f64,
-    /// Rate ramp, °/h².
-    pub rate_ramp_deg_per_h2: f64,
-    /// Settling time constant after a switch, s.
-    pub settle_tau_s: f64,
 }
 
 /// `[plant]`.
@@ -624,7 +600,8 @@ fn width(field: &str, width: u32) -> Result<CoefficientFormat> {
     }
 }
 
-fn gyro(section: &str, g: &GyroConfig) -> Result<GyroErrors> {
+/// Checks one gyro's section.
+fn gyro(section: &str, g: &GyroErrors) -> Result<GyroErrors> {
     let field = |name: &str| format!("{section}.{name}");
     for (name, value) in [
         ("sf_ppm", g.sf_ppm),
@@ -643,17 +620,7 @@ fn gyro(section: &str, g: &GyroConfig) -> Result<GyroErrors> {
     ] {
         non_negative(&field(name), value)?;
     }
-    Ok(GyroErrors {
-        sf_ppm: g.sf_ppm,
-        sf_mode_mismatch_ppm: g.sf_mode_mismatch_ppm,
-        bias_dps: g.bias_dps,
-        bias_mode_mismatch_dps: g.bias_mode_mismatch_dps,
-        arw_deg_per_sqrt_h: g.arw_deg_per_sqrt_h,
-        bias_instability_deg_per_h: g.bias_instability_deg_per_h,
-        rrw_deg_per_h_per_sqrt_h: g.rrw_deg_per_h_per_sqrt_h,
-        rate_ramp_deg_per_h2: g.rate_ramp_deg_per_h2,
-        settle_tau_s: g.settle_tau_s,
-    })
+    Ok(*g)
 }
 
 fn parse_format(field: &str, text: &str) -> Result<Format> {

@@ -4,39 +4,16 @@
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 
 use gyrofx_model::chain::{FixedChain, Plan};
-use gyrofx_model::estimator;
 use gyrofx_model::examples;
-use gyrofx_model::fx::{CoefficientFormat, Overflow, Rounding};
-use gyrofx_model::kf;
+use gyrofx_model::fx::Rounding;
 use gyrofx_model::plant::{GyroErrors, Plant};
-use gyrofx_model::sequencer::{Pattern, Schedule, Sequencer};
+use gyrofx_model::sequencer::Sequencer;
 use gyrofx_model::stimulus::adc;
 
 const N: usize = 1 << 20;
 
 fn plan() -> Plan {
-    let kf_spec = examples::kf_spec();
-    let estimator = estimator::Plan::new(&estimator::Spec {
-        schedule: Schedule {
-            interval_length: 150,
-            intervals: 4,
-            pattern: Pattern::Alternating,
-            blank: 10,
-            stagger: 0,
-        },
-        rate_order: 0,
-        input: kf_spec.input,
-        mean: "s28.18".parse().unwrap(),
-        bias: "s28.18".parse().unwrap(),
-        calibrated: kf_spec.input,
-        gain: CoefficientFormat::Auto { width: 18 },
-        reciprocal: CoefficientFormat::Auto { width: 18 },
-        smoothing_shift: 0,
-        rounding: Rounding::Nearest,
-        overflow: Overflow::Saturate,
-    })
-    .unwrap();
-    Plan::new(estimator, kf::Plan::new(&kf_spec).unwrap()).unwrap()
+    examples::chain_plan(150, 10, 0, 0, Rounding::Nearest)
 }
 
 fn plant() -> Plant {

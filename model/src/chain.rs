@@ -248,34 +248,11 @@ impl FloatChain {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fx::{from_f64, CoefficientFormat, Overflow, Rounding};
-    use crate::sequencer::{Pattern, Schedule};
+    use crate::fx::{from_f64, Overflow, Rounding};
     use proptest::prelude::*;
 
     fn plans(stagger: usize, rounding: Rounding) -> Plan {
-        let mut kf_spec = crate::examples::kf_spec();
-        kf_spec.rounding = rounding;
-        let est = estimator::Plan::new(&estimator::Spec {
-            schedule: Schedule {
-                interval_length: 40,
-                intervals: 4,
-                pattern: Pattern::Alternating,
-                blank: 5,
-                stagger,
-            },
-            rate_order: 0,
-            input: kf_spec.input,
-            mean: "s28.18".parse().unwrap(),
-            bias: "s28.18".parse().unwrap(),
-            calibrated: kf_spec.input,
-            gain: CoefficientFormat::Auto { width: 18 },
-            reciprocal: CoefficientFormat::Auto { width: 18 },
-            smoothing_shift: 1,
-            rounding,
-            overflow: Overflow::Saturate,
-        })
-        .unwrap();
-        Plan::new(est, kf::Plan::new(&kf_spec).unwrap()).unwrap()
+        crate::examples::chain_plan(40, 5, stagger, 1, rounding)
     }
 
     #[test]

@@ -1,9 +1,12 @@
 //! The worked example of paper 000 that the embedded default config also describes (a codegen
 //! test checks that they agree): for tests, benchmarks and documentation.
 
+use crate::chain;
+use crate::estimator;
 use crate::fx::{Overflow, Rounding};
 use crate::kf::design::{design_for_bandwidth, Convergence, Method, Noise};
-use crate::kf::{CoefficientFormat, Spec};
+use crate::kf::{self as kf_block, CoefficientFormat, Spec};
+use crate::sequencer::{Pattern, Schedule};
 use crate::stimulus::{Scenario, SingleGyro};
 
 /// Sample rate of the example, Hz.
@@ -51,4 +54,43 @@ pub fn gyro() -> SingleGyro {
         arw_deg_per_sqrt_h: ARW_DEG_PER_SQRT_H,
         rrw_deg_per_h_per_sqrt_h: RRW_DEG_PER_H_PER_SQRT_H,
     }
+}
+
+/// The example chain: the KF of [`kf_spec`] (with `rounding`) behind an alternating sequencer
+/// of four intervals of `interval_length` samples, `blank` blanked, B `stagger` behind, and a
+/// constant-rate estimator with 4 guard bits and smoothing shift `smoothing`.
+pub fn chain_plan(
+    interval_length: usize,
+    blank: usize,
+    stagger: usize,
+    smoothing: u32,
+    rounding: Rounding,
+) -> chain::Plan {
+    let mut spec = kf_spec();
+    spec.rounding = rounding;
+    let estimator = estimator::Plan::new(&estimator::Spec {
+        schedule: Schedule {
+            interval_length,
+            intervals: 4,
+            pattern: Pattern::Alternating,
+            blank,
+            stagger,
+        },
+        rate_order: 0,
+        input: spec.input,
+        mean: "s28.18".parse().expect("valid"),
+        bias: "s28.18".parse().expect("valid"),
+        calibrated: spec.input,
+        gain: CoefficientFormat::Auto { width: 18 },
+        reciprocal: CoefficientFormat::Auto { width: 18 },
+        smoothing_shift: smoothing,
+        rounding,
+        overflow: Overflow::Saturate,
+    })
+    .expect("the example is plannable");
+    chain::Plan::new(
+        estimator,
+        kf_block::Plan::new(&spec).expect("the example is plannable"),
+    )
+    .expect("the example's blocks connect")
 }

@@ -30,8 +30,9 @@
 
 use crate::stimulus::{Gaussian, Stream};
 
-/// One gyro's errors.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// One gyro's errors (also the `[gyro_a]` / `[gyro_b]` config sections).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct GyroErrors {
     /// Scale-factor error in normal mode, ppm.
     pub sf_ppm: f64,
