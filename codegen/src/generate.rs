@@ -10,6 +10,7 @@ use crate::error::Result;
 use crate::job::Job;
 use crate::package::{sha256_hex, Package, MANIFEST};
 use crate::report;
+use crate::rom::{self, Rom, RomFormat, ROM_FOLDER};
 use crate::testbench::testbench;
 use crate::vectors::{self, Run};
 use crate::writers::{self, Provenance, ESTIMATOR_ROM, KF_ROM};
@@ -119,10 +120,15 @@ pub fn build_package(
     progress("chain run");
     let kf = job.kf();
     let est = &job.chain.estimator;
+    let kf_rom = Rom::kf(kf);
+    let estimator_rom = Rom::estimator(est);
     let run = vectors::run(
         job,
-        (KF_ROM, writers::kf_rom(kf, provenance)),
-        (ESTIMATOR_ROM, writers::estimator_rom(est, provenance)),
+        (KF_ROM, rom::write(&kf_rom, RomFormat::Mem, provenance)),
+        (
+            ESTIMATOR_ROM,
+            rom::write(&estimator_rom, RomFormat::Mem, provenance),
+        ),
     )?;
     progress("files");
     let mut package = Package::new();
@@ -131,6 +137,14 @@ pub fn build_package(
     package.add("report.md", writers::report_md(&run, provenance));
     for (name, source) in writers::RTL_SOURCES {
         package.add(format!("hdl/{name}"), source);
+    }
+    for rom in [&kf_rom, &estimator_rom] {
+        for format in RomFormat::ALL {
+            package.add(
+                format!("{ROM_FOLDER}/{}", format.file_name(rom)),
+                rom::write(rom, format, provenance),
+            );
+        }
     }
     let per_block: Vec<Vec<(String, String)>> = std::thread::scope(|scope| {
         let handles: Vec<_> = run
@@ -181,7 +195,7 @@ pub fn build_package(
             "latency_clocks": 1,
             "designs": report::designs(&job.designs, kf),
             "coefficients": report::coefficients(kf),
-            "rom": {"file": KF_ROM, "depth": kf.rom.len(), "word_bits": writers::rom_word_width(kf),
+            "rom": {"file": KF_ROM, "depth": kf.rom.len(), "word_bits": kf_rom.width(), "all_formats": ROM_FOLDER,
                     "packing": "word = {g1, g2}: g1 in the high bits; address = bw_sel"},
             "tie_cases": run.ties,
             "fixed_vs_float": run.kf_stats,
@@ -207,7 +221,7 @@ pub fn build_package(
             },
             "reciprocal": {"value": 1.0 / est.schedule.valid_count() as f64, "quantized": est.quantized_reciprocal(), "code": est.reciprocal_code as i64},
             "gains": {"designed": est.gains, "quantized": est.quantized_gains(), "all_shifts": est.gains_are_shifts(),
-                      "rom": {"file": ESTIMATOR_ROM, "order": "bias_a row over [mA0, mB0, mA1, ...], then bias_b row"}},
+                      "rom": {"file": ESTIMATOR_ROM, "word_bits": estimator_rom.width(), "all_formats": ROM_FOLDER, "order": "bias_a row over [mA0, mB0, mA1, ...], then bias_b row"}},
             "smoothing_shift": est.smoothing_shift,
             "fixed_vs_float_bias": run.bias_stats,
         },

@@ -16,6 +16,7 @@ pub mod job;
 pub mod package;
 pub mod plot;
 pub mod report;
+pub mod rom;
 pub mod simulate;
 pub mod testbench;
 pub mod vectors;

@@ -5,9 +5,7 @@
 
 use std::fmt::Write as _;
 
-use gyrofx_model::estimator;
 use gyrofx_model::fx::Format;
-use gyrofx_model::kf::{Plan, COEFFICIENT_NAMES};
 
 use crate::block::Block;
 use crate::testbench::header;
@@ -85,67 +83,6 @@ fn push_real(out: &mut String, buffer: &mut ryu::Buffer, value: f64) {
     if !value.is_nan() {
         out.push_str(buffer.format(value));
     }
-}
-
-/// Width of a KF ROM word: `g1` and `g2` side by side.
-pub fn rom_word_width(plan: &Plan) -> u32 {
-    plan.coefficient[0].width + plan.coefficient[1].width
-}
-
-/// The KF coefficient ROM for `$readmemh`: one word `{g1, g2}` per `bw_sel` address.
-pub fn kf_rom(plan: &Plan, provenance: &Provenance) -> String {
-    let word =
-        Format::intermediate(false, rom_word_width(plan), 0).expect("two declared widths fit");
-    let mut out = provenance.line("//");
-    let _ = writeln!(
-        out,
-        "\n// KF coefficient ROM: {} words of {} bits, word = {{g1 {}, g2 {}}}, address = bw_sel",
-        plan.rom.len(),
-        word.width,
-        plan.coefficient[0],
-        plan.coefficient[1]
-    );
-    let quantized = plan.quantized_gains();
-    for (address, codes) in plan.rom.iter().enumerate() {
-        let bits = (plan.coefficient[0].to_bits(codes[0]) << plan.coefficient[1].width)
-            | plan.coefficient[1].to_bits(codes[1]);
-        let _ = writeln!(
-            out,
-            "// @{address} {}: {} = {:e}, {} = {:e}\n{}",
-            plan.labels[address],
-            COEFFICIENT_NAMES[0],
-            quantized[address][0],
-            COEFFICIENT_NAMES[1],
-            quantized[address][1],
-            hex(bits as i128, word)
-        );
-    }
-    out
-}
-
-/// The estimator's gain ROM: A's row over `[mA0, mB0, mA1, …]`, then B's.
-pub fn estimator_rom(plan: &estimator::Plan, provenance: &Provenance) -> String {
-    let mut out = provenance.line("//");
-    let _ = writeln!(
-        out,
-        "\n// bias-estimator gains G ({}): {} words, A's row over [mA0, mB0, mA1, ...] then B's",
-        plan.gain,
-        2 * plan.rom[0].len()
-    );
-    let quantized = plan.quantized_gains();
-    for (row, name) in ["bias_a", "bias_b"].iter().enumerate() {
-        for (j, code) in plan.rom[row].iter().enumerate() {
-            let mean = if j % 2 == 0 { "mA" } else { "mB" };
-            let _ = writeln!(
-                out,
-                "// {name} <- {mean}{}: {}\n{}",
-                j / 2,
-                quantized[row][j],
-                hex(*code, plan.gain)
-            );
-        }
-    }
-    out
 }
 
 /// The block's parameter include: the DUT's parameters as `P_<NAME>` localparams, the vector
