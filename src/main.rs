@@ -143,6 +143,20 @@ enum Command {
         #[arg(long)]
         seed: Option<u64>,
     },
+    /// Synthesize the chain with the config's widths in yosys (generic and Xilinx 7-series):
+    /// fails on a latch, an undriven or multiply-driven net or a missing module; writes the
+    /// resource report, scripts and logs atomically.
+    Synth {
+        /// Output folder (replaced only if empty or a previous gyrofx output).
+        #[arg(long)]
+        out: PathBuf,
+        /// Config file (TOML, overlays the embedded default and the preset).
+        #[arg(long)]
+        config: Option<PathBuf>,
+        /// Start from a preset: gu2019, xue2015, mpu6050.
+        #[arg(long)]
+        preset: Option<String>,
+    },
     /// Run a generated package's testbench in a simulator; non-zero exit on failure.
     Verify {
         /// The package folder.
@@ -247,6 +261,11 @@ fn run(cli: Cli) -> Result<ExitCode> {
             seed,
         } => run_generate(&out, preset.as_deref(), config.as_deref(), samples, seed),
         Command::Verify { out, sim } => run_verify(&out, &sim),
+        Command::Synth {
+            out,
+            config,
+            preset,
+        } => run_synth(&out, preset.as_deref(), config.as_deref()),
         Command::Filter {
             input,
             column,
@@ -349,6 +368,29 @@ fn run_design(
             summary.eigenvalues[0], summary.eigenvalues[1]
         );
     }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn run_synth(out: &Path, preset: Option<&str>, config_path: Option<&Path>) -> Result<ExitCode> {
+    let config = Config::from_preset_and_file(preset, config_path)?;
+    let job = Job::new(config)?;
+    let mut provenance = provenance(&job, preset, config_path);
+    provenance.command = provenance.command.replacen("generate", "synth", 1);
+    let resources = gyrofx_codegen::synth::synthesize(&job, out, &provenance)?;
+    let (g, x) = (&resources.generic, &resources.xilinx);
+    println!(
+        "synthesis check passed: {}; report in {}",
+        gyrofx_codegen::synth::TOP,
+        out.join("report.md").display()
+    );
+    println!(
+        "generic: {} cells, {} flip-flops, {} multipliers",
+        g.cells, g.flip_flops, g.multipliers
+    );
+    println!(
+        "xilinx 7-series: {} LUTs, {} flip-flops, {} DSP48E1, {} block RAM",
+        x.luts, x.flip_flops, x.dsp48, x.block_rams
+    );
     Ok(ExitCode::SUCCESS)
 }
 

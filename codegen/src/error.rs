@@ -71,6 +71,9 @@ pub enum Error {
     /// A simulation could not run or did not pass.
     #[error("{0}")]
     Simulation(String),
+    /// yosys could not run, or the synthesis check failed.
+    #[error("{0}")]
+    Synthesis(String),
 }
 
 impl Error {

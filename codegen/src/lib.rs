@@ -18,6 +18,7 @@ pub mod plot;
 pub mod report;
 pub mod rom;
 pub mod simulate;
+pub mod synth;
 pub mod testbench;
 pub mod vectors;
 pub mod writers;

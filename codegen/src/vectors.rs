@@ -212,8 +212,9 @@ fn mode_bit(p: i8) -> i128 {
     i128::from(p > 0)
 }
 
-/// The blocks, their parameters and ROMs, without rows.
-fn empty_blocks(job: &Job, rom_kf: &str, rom_estimator: &str) -> [Block; 4] {
+/// The blocks (sequencer, estimator, KF, top) with their parameters and ROM file names, without
+/// vectors.
+pub fn empty_blocks(job: &Job, rom_kf: &str, rom_estimator: &str) -> [Block; 4] {
     let est = &job.chain.estimator;
     let kf = job.kf();
     let schedule = &est.schedule;

@@ -1,0 +1,274 @@
+//! Synthesis check of the reference RTL with a job's widths: yosys, generic and Xilinx 7-series.
+//!
+//! The whole chain (`gyrofx_top`) is elaborated with the job's parameters and ROMs. The check
+//! fails on a missing module (`hierarchy -check`), an inferred latch, and on undriven or
+//! multiply-driven nets (`check -assert`). Resources come from `stat -json`: generic cells,
+//! flip-flops and multipliers (counted before they are merged into `$macc` cells), and the
+//! `synth_xilinx` mapping's LUTs, flip-flops, DSP48E1s and block RAMs.
+
+use std::path::Path;
+use std::process::Command;
+
+use serde::Serialize;
+
+use crate::block::Block;
+use crate::error::{Error, Result};
+use crate::job::Job;
+use crate::package::Package;
+use crate::rom::{self, Rom, RomFormat};
+use crate::vectors::empty_blocks;
+use crate::writers::{self, Provenance};
+
+/// Module synthesized: the whole chain.
+pub const TOP: &str = "gyrofx_top";
+
+/// Generic (technology-independent) resources of the flattened chain.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct Generic {
+    /// Gate-level cells after `synth`.
+    pub cells: u64,
+    /// Flip-flops (bits).
+    pub flip_flops: u64,
+    /// `$mul` cells after coarse optimization: one per multiplier in the RTL.
+    pub multipliers: u64,
+}
+
+/// Xilinx 7-series estimate from `synth_xilinx`.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct Xilinx {
+    /// LUT1..LUT6.
+    pub luts: u64,
+    /// FDRE/FDSE/FDCE/FDPE.
+    pub flip_flops: u64,
+    /// DSP48E1 slices.
+    pub dsp48: u64,
+    /// RAMB18E1/RAMB36E1.
+    pub block_rams: u64,
+    /// CARRY4 chains.
+    pub carry4: u64,
+}
+
+/// What one synthesis run measured.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct Resources {
+    /// Generic mapping.
+    pub generic: Generic,
+    /// Xilinx 7-series mapping.
+    pub xilinx: Xilinx,
+}
+
+/// The `chparam` lines that give `TOP` the block's parameters.
+fn chparams(block: &Block) -> String {
+    block
+        .params
+        .iter()
+        .map(|p| format!("chparam -set {} {} {TOP}\n", p.name, p.value))
+        .collect()
+}
+
+fn read_sources() -> String {
+    let names: Vec<&str> = writers::RTL_SOURCES.iter().map(|(n, _)| *n).collect();
+    format!("read_verilog {}\n", names.join(" "))
+}
+
+/// The yosys script of the generic flow; writes `coarse.json` and `generic.json`.
+pub fn generic_script(top: &Block) -> String {
+    format!(
+        "{}{}hierarchy -check -top {TOP}\n\
+         synth -flatten -top {TOP} -run :coarse\n\
+         flatten\nproc\n\
+         select -assert-none t:$dlatch t:$adlatch t:$dlatchsr\n\
+         opt -fast\nwreduce\n\
+         tee -q -o coarse.json stat -json\n\
+         synth -flatten -top {TOP} -run coarse:\n\
+         select -assert-none t:$dlatch t:$adlatch t:$_DLATCH_*\n\
+         check -assert\n\
+         tee -q -o generic.json stat -json\n",
+        read_sources(),
+        chparams(top)
+    )
+}
+
+/// The yosys script of the Xilinx 7-series flow; writes `xilinx.json`.
+pub fn xilinx_script(top: &Block) -> String {
+    format!(
+        "{}{}hierarchy -check -top {TOP}\n\
+         synth_xilinx -flatten -top {TOP}\n\
+         select -assert-none t:LDCE t:LDPE\n\
+         check -assert\n\
+         tee -q -o xilinx.json stat -json\n",
+        read_sources(),
+        chparams(top)
+    )
+}
+
+/// Cell counts of the one (flattened) module in a `stat -json` file.
+fn cell_counts(dir: &Path, file: &str) -> Result<(u64, Vec<(String, u64)>)> {
+    let path = dir.join(file);
+    let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
+    let json: serde_json::Value = serde_json::from_str(&text)
+        .map_err(|e| Error::Synthesis(format!("yosys wrote unreadable {file}: {e}")))?;
+    let module = json["modules"]
+        .as_object()
+        .and_then(|m| m.values().next())
+        .ok_or_else(|| Error::Synthesis(format!("{file} lists no module")))?;
+    let total = module["num_cells"].as_u64().unwrap_or(0);
+    let by_type = module["num_cells_by_type"]
+        .as_object()
+        .map(|m| {
+            m.iter()
+                .map(|(k, v)| (k.clone(), v.as_u64().unwrap_or(0)))
+                .collect()
+        })
+        .unwrap_or_default();
+    Ok((total, by_type))
+}
+
+fn count(by_type: &[(String, u64)], keep: impl Fn(&str) -> bool) -> u64 {
+    by_type
+        .iter()
+        .filter(|(k, _)| keep(k))
+        .map(|(_, n)| n)
+        .sum()
+}
+
+fn yosys(dir: &Path, script: &str, log: &str) -> Result<()> {
+    let output = Command::new("yosys")
+        .args(["-q", "-l", log, "-s", script])
+        .current_dir(dir)
+        .output()
+        .map_err(|e| Error::Synthesis(format!("cannot run yosys (is it installed?): {e}")))?;
+    if !output.status.success() {
+        let text = std::fs::read_to_string(dir.join(log)).unwrap_or_default();
+        let tail: Vec<&str> = text.lines().rev().take(20).collect();
+        let tail: Vec<&str> = tail.into_iter().rev().collect();
+        return Err(Error::Synthesis(format!(
+            "synthesis check failed ({script}):\n{}\n{}",
+            tail.join("\n"),
+            String::from_utf8_lossy(&output.stderr)
+        )));
+    }
+    Ok(())
+}
+
+/// Runs both flows in `dir`, which must hold the RTL, the ROM images and the scripts.
+///
+/// # Errors
+/// [`Error::Synthesis`] when yosys is missing or a check fails (with the log's tail).
+pub fn measure(dir: &Path) -> Result<Resources> {
+    yosys(dir, "generic.ys", "generic.log")?;
+    yosys(dir, "xilinx.ys", "xilinx.log")?;
+    let (_, coarse) = cell_counts(dir, "coarse.json")?;
+    let (cells, generic) = cell_counts(dir, "generic.json")?;
+    let (_, xilinx) = cell_counts(dir, "xilinx.json")?;
+    Ok(Resources {
+        generic: Generic {
+            cells,
+            flip_flops: count(&generic, |k| k.contains("DFF")),
+            multipliers: count(&coarse, |k| k == "$mul"),
+        },
+        xilinx: Xilinx {
+            luts: count(&xilinx, |k| k.starts_with("LUT")),
+            flip_flops: count(&xilinx, |k| ["FDRE", "FDSE", "FDCE", "FDPE"].contains(&k)),
+            dsp48: count(&xilinx, |k| k.starts_with("DSP48")),
+            block_rams: count(&xilinx, |k| k.starts_with("RAMB")),
+            carry4: count(&xilinx, |k| k == "CARRY4"),
+        },
+    })
+}
+
+/// The synthesis folder's report.
+fn report(top: &Block, resources: &Resources, provenance: &Provenance) -> String {
+    let g = &resources.generic;
+    let x = &resources.xilinx;
+    let widths: Vec<String> = top
+        .params
+        .iter()
+        .filter(|p| p.name.ends_with("_W"))
+        .map(|p| format!("{}={}", p.name, p.value))
+        .collect();
+    format!(
+        "<!-- {} -->\n# Synthesis check: {TOP}\n\n\
+         yosys, flattened, with the config's parameters ({}).\n\
+         Checks passed: every module present, no latch, no undriven or multiply-driven net.\n\n\
+         | generic | count |\n|---|---|\n| cells | {} |\n| flip-flops | {} |\n| multipliers | {} |\n\n\
+         | Xilinx 7-series (`synth_xilinx`) | count |\n|---|---|\n| LUTs | {} |\n| flip-flops | {} |\n\
+         | DSP48E1 | {} |\n| block RAM | {} |\n| CARRY4 | {} |\n\n\
+         An estimate before place and route: the ROMs are small enough to map to LUTs, and \
+         `synth_xilinx` splits a product wider than 25x18 over several DSP48E1s.\n",
+        provenance.line("").trim_start(),
+        widths.join(", "),
+        g.cells,
+        g.flip_flops,
+        g.multipliers,
+        x.luts,
+        x.flip_flops,
+        x.dsp48,
+        x.block_rams,
+        x.carry4
+    )
+}
+
+/// Synthesizes the chain for `job` and writes the scripts, logs, stat files, report and
+/// manifest to `out` atomically; nothing is written when a check fails.
+///
+/// # Errors
+/// A failed check or a missing yosys ([`Error::Synthesis`]), or an I/O error.
+pub fn synthesize(job: &Job, out: &Path, provenance: &Provenance) -> Result<Resources> {
+    let kf_rom = Rom::kf(job.kf());
+    let estimator_rom = Rom::estimator(&job.chain.estimator);
+    let kf_name = RomFormat::Mem.file_name(&kf_rom);
+    let estimator_name = RomFormat::Mem.file_name(&estimator_rom);
+    let [_, _, _, top] = empty_blocks(job, &kf_name, &estimator_name);
+
+    let mut inputs: Vec<(String, String)> = writers::RTL_SOURCES
+        .iter()
+        .map(|(n, s)| (n.to_string(), s.to_string()))
+        .collect();
+    inputs.push((kf_name, rom::write(&kf_rom, RomFormat::Mem, provenance)));
+    inputs.push((
+        estimator_name,
+        rom::write(&estimator_rom, RomFormat::Mem, provenance),
+    ));
+    inputs.push(("generic.ys".into(), generic_script(&top)));
+    inputs.push(("xilinx.ys".into(), xilinx_script(&top)));
+
+    let work = tempfile::tempdir().map_err(|e| Error::io(Path::new("temporary folder"), e))?;
+    for (name, text) in &inputs {
+        let path = work.path().join(name);
+        std::fs::write(&path, text).map_err(|e| Error::io(&path, e))?;
+    }
+    let resources = measure(work.path())?;
+
+    let mut package = Package::new();
+    package.add("report.md", report(&top, &resources, provenance));
+    for (name, text) in &inputs {
+        package.add(name.as_str(), text.as_str());
+    }
+    for name in [
+        "generic.log",
+        "xilinx.log",
+        "coarse.json",
+        "generic.json",
+        "xilinx.json",
+    ] {
+        let path = work.path().join(name);
+        let data = std::fs::read(&path).map_err(|e| Error::io(&path, e))?;
+        package.add(format!("yosys/{name}"), data);
+    }
+    let manifest = serde_json::json!({
+        "tool": "gyrofx",
+        "version": provenance.version,
+        "config_sha256": provenance.config_sha256,
+        "config": job.config,
+        "top": TOP,
+        "parameters": top.params.iter().map(|p| (p.name.clone(), p.value.clone())).collect::<std::collections::BTreeMap<_, _>>(),
+        "resources": resources,
+        "files": package.entries(),
+    });
+    let mut text = serde_json::to_string_pretty(&manifest).expect("manifest serializes");
+    text.push('\n');
+    package.add(crate::package::MANIFEST, text);
+    package.write_atomically(out)?;
+    Ok(resources)
+}
