@@ -4,8 +4,8 @@
 #   scripts/test.sh
 #
 # Installs the simulators and synthesis tool with apt-get where missing (iverilog, verilator,
-# ghdl, yosys, make, and the DejaVu font the plots use): a missing simulator is a failure,
-# never a skipped test. Then: rustfmt,
+# ghdl, yosys, make, and the DejaVu font the plots use) and FuseSoC with pip in a virtualenv:
+# a missing simulator is a failure, never a skipped test. Then: rustfmt,
 # clippy, Verilator lint of the RTL, and the whole test suite (unit, property, end-to-end
 # with both simulators, golden vectors). Benchmarks are compiled (clippy --all-targets) but
 # not run: run them with `cargo bench`.
@@ -31,7 +31,26 @@ for program in iverilog vvp verilator ghdl yosys make sha256sum; do
     command -v "$program" >/dev/null 2>&1 || { echo "FAIL: $program is still missing after apt-get" >&2; exit 1; }
 done
 
-echo "== tools: $(iverilog -V 2>&1 | head -1); $(verilator --version); $(yosys -V)"
+# FuseSoC is not packaged for Debian: it goes into a virtualenv from PyPI, reused across runs.
+if ! command -v fusesoc >/dev/null 2>&1; then
+    venv="${XDG_CACHE_HOME:-$HOME/.cache}/gyrofx/fusesoc-venv"
+    if [ ! -x "$venv/bin/fusesoc" ]; then
+        echo "== installing fusesoc into $venv"
+        if ! python3 -m venv "$venv" >/dev/null 2>&1; then
+            sudo=""
+            if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
+            $sudo apt-get update -qq
+            DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq python3-venv >/dev/null
+            rm -rf "$venv"
+            python3 -m venv "$venv"
+        fi
+        "$venv/bin/pip" install -q fusesoc
+    fi
+    export PATH="$venv/bin:$PATH"
+fi
+command -v fusesoc >/dev/null 2>&1 || { echo "FAIL: fusesoc is still missing" >&2; exit 1; }
+
+echo "== tools: $(iverilog -V 2>&1 | head -1); $(verilator --version); $(yosys -V); fusesoc $(fusesoc --version)"
 echo "== cargo fmt --check"
 cargo fmt --all -- --check
 echo "== cargo clippy --all-targets -D warnings"
