@@ -445,3 +445,26 @@ fn mode_reversal_removes_the_drift_in_the_report() {
         .unwrap()
         .contains("| calibrated, combined |"));
 }
+
+/// The chain testbench notices a one-rule change in the RTL: the requantizer's
+/// round-half-up replaced by truncation (the vectors still expect the model's rounding).
+#[test]
+fn truncating_instead_of_rounding_in_the_rtl_fails_the_chain_testbench() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = generate_default(dir.path(), "3000");
+    let quantizer = std::path::Path::new(&out).join("hdl/gyrofx_quantize.v");
+    let source = std::fs::read_to_string(&quantizer).unwrap();
+    let truncating = source.replace("3: increment = half_bit;", "3: increment = 1'b0;");
+    assert_ne!(source, truncating, "the mutation must apply");
+    std::fs::write(&quantizer, truncating).unwrap();
+    let log = fails(&["verify", "--out", &out, "--sim", "iverilog"]);
+    let top = log
+        .split("== top")
+        .nth(1)
+        .unwrap_or_else(|| panic!("no top section: {log}"));
+    assert!(top.contains("FAIL mismatches="), "{log}");
+    assert!(
+        top.contains("rate_out"),
+        "the filtered rate must differ: {log}"
+    );
+}
