@@ -77,14 +77,7 @@ fn several_inputs_give_an_array() {
 #[test]
 fn several_columns_give_several_series() {
     let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("pkg");
-    ok(&[
-        "generate",
-        "--out",
-        out.to_str().unwrap(),
-        "--samples",
-        "3000",
-    ]);
+    let out = generate_default(dir.path(), "3000");
     let csv = out.join("top/top_vectors.csv");
     let json = ok(&[
         "allan",
@@ -107,14 +100,7 @@ fn several_columns_give_several_series() {
 #[test]
 fn a_generated_csv_is_valid_input() {
     let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("pkg");
-    ok(&[
-        "generate",
-        "--out",
-        out.to_str().unwrap(),
-        "--samples",
-        "3000",
-    ]);
+    let out = generate_default(dir.path(), "3000");
     let csv = out.join("top/top_vectors.csv");
     let log = ok(&[
         "allan",

@@ -4,16 +4,11 @@ mod common;
 
 use common::*;
 
-fn generate_default(dir: &std::path::Path, samples: &str) -> String {
-    let out = dir.join("pkg");
-    ok(&[
-        "generate",
-        "--out",
-        out.to_str().unwrap(),
-        "--samples",
-        samples,
-    ]);
-    out.to_string_lossy().into_owned()
+/// The package path as the CLI arguments take it.
+fn generate_default_str(dir: &std::path::Path, samples: &str) -> String {
+    generate_default(dir, samples)
+        .to_string_lossy()
+        .into_owned()
 }
 
 fn pass_lines(log: &str) -> Vec<String> {
@@ -26,7 +21,7 @@ fn pass_lines(log: &str) -> Vec<String> {
 #[test]
 fn default_package_passes_in_icarus_and_verilator_and_a_flipped_bit_fails_every_block() {
     let dir = tempfile::tempdir().unwrap();
-    let out = generate_default(dir.path(), "6000");
+    let out = generate_default_str(dir.path(), "6000");
     let root = std::path::Path::new(&out);
     for sim in ["iverilog", "verilator"] {
         let log = ok(&["verify", "--out", &out, "--sim", sim]);
@@ -66,7 +61,7 @@ fn default_package_passes_in_icarus_and_verilator_and_a_flipped_bit_fails_every_
 #[test]
 fn the_package_runs_without_gyrofx_through_its_makefile() {
     let dir = tempfile::tempdir().unwrap();
-    let out = generate_default(dir.path(), "500");
+    let out = generate_default_str(dir.path(), "500");
     let make = std::process::Command::new("make")
         .args(["-C", &out, "sim-iverilog"])
         .output()
@@ -78,7 +73,7 @@ fn the_package_runs_without_gyrofx_through_its_makefile() {
 #[test]
 fn a_vector_file_with_other_formats_or_missing_is_refused() {
     let dir = tempfile::tempdir().unwrap();
-    let out = generate_default(dir.path(), "300");
+    let out = generate_default_str(dir.path(), "300");
     let stimulus = dir.path().join("pkg/kf/kf_stimulus.hex");
     let original = std::fs::read_to_string(&stimulus).unwrap();
     std::fs::write(&stimulus, original.replacen("z:s24.14", "z:s24.13", 1)).unwrap();
@@ -202,7 +197,7 @@ fn one_seed_gives_byte_identical_packages_and_another_seed_differs() {
 #[test]
 fn the_manifest_lists_every_file_with_its_sha256() {
     let dir = tempfile::tempdir().unwrap();
-    let out = generate_default(dir.path(), "200");
+    let out = generate_default_str(dir.path(), "200");
     let root = std::path::Path::new(&out);
     let manifest: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(root.join("manifest.json")).unwrap())
@@ -272,7 +267,7 @@ fn filter_agrees_with_the_generated_vectors() {
     // The KF block's CSV holds its input (the chain's combined output) in °/s; filtering it
     // at the first bandwidth must reproduce the expected codes up to the first bw_sel switch.
     let dir = tempfile::tempdir().unwrap();
-    let out = generate_default(dir.path(), "1200");
+    let out = generate_default_str(dir.path(), "1200");
     let csv = std::fs::read_to_string(dir.path().join("pkg/kf/kf_vectors.csv")).unwrap();
     let rows: Vec<Vec<String>> = csv
         .lines()
@@ -451,7 +446,7 @@ fn mode_reversal_removes_the_drift_in_the_report() {
 #[test]
 fn truncating_instead_of_rounding_in_the_rtl_fails_the_chain_testbench() {
     let dir = tempfile::tempdir().unwrap();
-    let out = generate_default(dir.path(), "3000");
+    let out = generate_default_str(dir.path(), "3000");
     let quantizer = std::path::Path::new(&out).join("hdl/gyrofx_quantize.v");
     let source = std::fs::read_to_string(&quantizer).unwrap();
     let truncating = source.replace("3: increment = half_bit;", "3: increment = 1'b0;");

@@ -1,8 +1,11 @@
 //! `gyrofx.core`: the reference RTL as a FuseSoC core. Its file list is the whole of `hdl/`,
 //! and FuseSoC's lint target (Verilator -Wall) passes on it and fails without a module.
 
+mod common;
+
 use std::path::Path;
-use std::process::Command;
+
+use common::run_tool;
 
 const CORE: &str = "gyrofx:gyrofx:chain";
 
@@ -12,19 +15,12 @@ fn root() -> &'static Path {
 
 /// Runs the core's lint target with `cores_root` as the only cores root.
 fn lint(cores_root: &Path, work: &Path) -> (bool, String) {
-    let output = Command::new("fusesoc")
-        .arg("--cores-root")
-        .arg(cores_root)
-        .args(["run", "--target", "lint", CORE])
-        .current_dir(work)
-        .output()
-        .unwrap_or_else(|e| panic!("fusesoc must be installed (scripts/test.sh installs it): {e}"));
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&output.stdout),
-        String::from_utf8_lossy(&output.stderr)
-    );
-    (output.status.success(), text)
+    let root = cores_root.to_str().unwrap();
+    run_tool(
+        "fusesoc",
+        &["--cores-root", root, "run", "--target", "lint", CORE],
+        work,
+    )
 }
 
 fn listed_rtl(core: &str) -> Vec<String> {

@@ -5,28 +5,11 @@
 mod common;
 
 use std::path::Path;
-use std::process::Command;
 
 use common::*;
 use gyrofx_codegen::rom::{parse, RomFormat, ROM_FOLDER};
 
 const ROMS: [(&str, &str); 2] = [("kf_coefficients", "kf"), ("estimator_gains", "estimator")];
-
-fn run(program: &str, args: &[&str], cwd: &Path) -> (bool, String) {
-    let output = Command::new(program)
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .unwrap_or_else(|e| {
-            panic!("{program} must be installed (scripts/test.sh installs it): {e}")
-        });
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&output.stdout),
-        String::from_utf8_lossy(&output.stderr)
-    );
-    (output.status.success(), text)
-}
 
 fn read(path: &Path) -> String {
     std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
@@ -88,7 +71,7 @@ fn vhdl_bench(words: &[Vec<u128>; 2], widths: [u32; 2]) -> String {
 }
 
 fn ghdl(dir: &Path) -> (bool, String) {
-    let (ok_analyse, log) = run(
+    let (ok_analyse, log) = run_tool(
         "ghdl",
         &[
             "-a",
@@ -101,22 +84,15 @@ fn ghdl(dir: &Path) -> (bool, String) {
     );
     assert!(ok_analyse, "ghdl analysis: {log}");
     assert!(!log.contains("warning"), "ghdl warns: {log}");
-    let (ok_elaborate, log) = run("ghdl", &["-e", "--std=08", "rom_bench"], dir);
+    let (ok_elaborate, log) = run_tool("ghdl", &["-e", "--std=08", "rom_bench"], dir);
     assert!(ok_elaborate, "ghdl elaboration: {log}");
-    run("ghdl", &["-r", "--std=08", "rom_bench"], dir)
+    run_tool("ghdl", &["-r", "--std=08", "rom_bench"], dir)
 }
 
 #[test]
 fn every_rom_format_holds_the_blocks_words_in_every_simulator() {
     let dir = tempfile::tempdir().unwrap();
-    let package = dir.path().join("pkg");
-    ok(&[
-        "generate",
-        "--out",
-        package.to_str().unwrap(),
-        "--samples",
-        "2000",
-    ]);
+    let package = generate_default(dir.path(), "2000");
     let roms = package.join(ROM_FOLDER);
 
     // Every format parses back to the words the block testbenches read.
@@ -160,13 +136,13 @@ fn every_rom_format_holds_the_blocks_words_in_every_simulator() {
         "gyrofx_estimator_gains_pkg.sv",
         "rom_bench.sv",
     ];
-    let (compiled, log) = run("iverilog", &sources, &roms);
+    let (compiled, log) = run_tool("iverilog", &sources, &roms);
     assert!(compiled && log.trim().is_empty(), "iverilog: {log}");
-    let (_, log) = run("vvp", &["-n", "rom_bench.vvp"], &roms);
+    let (_, log) = run_tool("vvp", &["-n", "rom_bench.vvp"], &roms);
     assert!(log.contains("ROMS MATCH"), "vvp: {log}");
 
     // Verilator: the packages lint clean (the bench's unused include parameters aside).
-    let (linted, log) = run(
+    let (linted, log) = run_tool(
         "verilator",
         &[
             "--lint-only",
@@ -200,7 +176,7 @@ fn every_rom_format_holds_the_blocks_words_in_every_simulator() {
         original.replacen(&format!("\n{first}\n"), &format!("\n{changed}\n"), 1),
     )
     .unwrap();
-    let (_, log) = run("vvp", &["-n", "rom_bench.vvp"], &roms);
+    let (_, log) = run_tool("vvp", &["-n", "rom_bench.vvp"], &roms);
     assert!(log.contains("ROM MISMATCHES: 2"), "vvp after a flip: {log}");
 
     std::fs::write(

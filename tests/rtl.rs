@@ -2,29 +2,15 @@
 //! without latches, and the requantizer checked exhaustively against the model on small
 //! widths for every rounding and overflow mode.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
+use std::path::{Path, PathBuf};
+
+use common::run_tool;
 use gyrofx_model::fx::{requantize, Format, Overflow, Rounding};
 
 fn hdl(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("hdl").join(name)
-}
-
-fn run(program: &str, args: &[&str], cwd: &Path) -> (bool, String) {
-    let output = Command::new(program)
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .unwrap_or_else(|e| {
-            panic!("{program} must be installed (scripts/test.sh installs it): {e}")
-        });
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&output.stdout),
-        String::from_utf8_lossy(&output.stderr)
-    );
-    (output.status.success(), text)
 }
 
 #[test]
@@ -55,7 +41,7 @@ fn verilator_lint_is_clean_for_several_parameter_sets() {
         let mut args = vec!["--lint-only", "-Wall", "--top-module", "gyrofx_kf"];
         args.extend_from_slice(params);
         args.extend_from_slice(&sources);
-        let (ok, text) = run("verilator", &args, dir.path());
+        let (ok, text) = run_tool("verilator", &args, dir.path());
         assert!(
             ok && text.trim().is_empty(),
             "verilator -Wall {params:?}:\n{text}"
@@ -104,7 +90,7 @@ fn the_whole_chain_lints_clean_for_several_parameter_sets() {
         let mut args = vec!["--lint-only", "-Wall", "--top-module", "gyrofx_top"];
         args.extend_from_slice(params);
         args.extend(sources.iter().map(String::as_str));
-        let (ok, text) = run("verilator", &args, dir.path());
+        let (ok, text) = run_tool("verilator", &args, dir.path());
         assert!(
             ok && text.trim().is_empty(),
             "verilator -Wall {params:?}:\n{text}"
@@ -115,7 +101,7 @@ fn the_whole_chain_lints_clean_for_several_parameter_sets() {
 #[test]
 fn icarus_compiles_without_warnings() {
     let dir = tempfile::tempdir().unwrap();
-    let (ok, text) = run(
+    let (ok, text) = run_tool(
         "iverilog",
         &[
             "-g2005",
@@ -147,7 +133,7 @@ fn yosys_synthesizes_without_latches() {
         hdl("gyrofx_quantize.v").display(),
         hdl("gyrofx_kf.v").display()
     );
-    let (ok, text) = run("yosys", &["-q", "-p", &script], dir.path());
+    let (ok, text) = run_tool("yosys", &["-q", "-p", &script], dir.path());
     assert!(ok, "yosys:\n{text}");
     assert!(!text.to_lowercase().contains("latch inferred"), "{text}");
 }
@@ -206,7 +192,7 @@ endmodule
                     s = overflow.rtl_code()
                 );
                 std::fs::write(dir.path().join("tb.v"), tb).unwrap();
-                let (ok, text) = run(
+                let (ok, text) = run_tool(
                     "iverilog",
                     &[
                         "-g2005",
@@ -218,7 +204,7 @@ endmodule
                     dir.path(),
                 );
                 assert!(ok, "{text}");
-                let (ok, text) = run("vvp", &["-n", "tb.vvp"], dir.path());
+                let (ok, text) = run_tool("vvp", &["-n", "tb.vvp"], dir.path());
                 assert!(
                     ok && text.contains("PASS"),
                     "{from} -> {to} {rounding} {overflow}:\n{text}"

@@ -43,6 +43,31 @@ pub fn fails(args: &[&str]) -> String {
     text(&output)
 }
 
+/// Runs an external tool in `cwd`; a missing tool is a failure, never a skip.
+pub fn run_tool(program: &str, args: &[&str], cwd: &Path) -> (bool, String) {
+    let output = Command::new(program)
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .unwrap_or_else(|e| {
+            panic!("{program} must be installed (scripts/test.sh installs it): {e}")
+        });
+    (output.status.success(), text(&output))
+}
+
+/// Generates the default config's package with `samples` samples into `dir/pkg`.
+pub fn generate_default(dir: &Path, samples: &str) -> PathBuf {
+    let out = dir.join("pkg");
+    ok(&[
+        "generate",
+        "--out",
+        out.to_str().unwrap(),
+        "--samples",
+        samples,
+    ]);
+    out
+}
+
 /// Writes `toml` to `dir/name` and returns its path as a string.
 pub fn write_config(dir: &Path, name: &str, toml: &str) -> String {
     let path = dir.join(name);
