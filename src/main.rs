@@ -7,7 +7,7 @@ use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
 
 use gyrofx_codegen::config::{Config, DEFAULT_TOML};
-use gyrofx_codegen::generate::{generate, provenance};
+use gyrofx_codegen::generate::{generate, provenance, Output};
 use gyrofx_codegen::input::{read_column, read_column_with_gaps};
 use gyrofx_codegen::job::{design_bandwidths, plan_for, Job};
 use gyrofx_codegen::report;
@@ -374,8 +374,7 @@ fn run_design(
 fn run_synth(out: &Path, preset: Option<&str>, config_path: Option<&Path>) -> Result<ExitCode> {
     let config = Config::from_preset_and_file(preset, config_path)?;
     let job = Job::new(config)?;
-    let mut provenance = provenance(&job, preset, config_path);
-    provenance.command = provenance.command.replacen("generate", "synth", 1);
+    let provenance = provenance(&job, Output::Synthesis, preset, config_path);
     let resources = gyrofx_codegen::synth::synthesize(&job, out, &provenance)?;
     let (g, x) = (&resources.generic, &resources.xilinx);
     println!(
@@ -411,7 +410,7 @@ fn run_generate(
     let job = Job::new(config)?;
     let bar = indicatif::ProgressBar::new_spinner();
     let long = job.config.samples >= 1_000_000;
-    let provenance = provenance(&job, preset, config_path);
+    let provenance = provenance(&job, Output::Package, preset, config_path);
     let summary = generate(&job, out, &provenance, &mut |phase| {
         if long {
             bar.set_message(format!("generate: {phase}"));

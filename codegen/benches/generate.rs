@@ -3,7 +3,7 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 
 use gyrofx_codegen::config::Config;
-use gyrofx_codegen::generate::{generate, provenance};
+use gyrofx_codegen::generate::{generate, provenance, Output};
 use gyrofx_codegen::job::Job;
 
 fn generate_million(c: &mut Criterion) {
@@ -12,7 +12,7 @@ fn generate_million(c: &mut Criterion) {
     let job = Job::new(config).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("pkg");
-    let provenance = provenance(&job, None, None);
+    let provenance = provenance(&job, Output::Package, None, None);
     let mut group = c.benchmark_group("generate");
     group.sample_size(10);
     group.bench_function("default_1M_samples_all_files", |b| {

@@ -173,7 +173,7 @@ pub struct Block {
     /// DUT parameters.
     pub params: Vec<Param>,
     /// ROM images the DUT reads (file name, content).
-    pub roms: Vec<(&'static str, String)>,
+    pub roms: Vec<(String, String)>,
     /// Inputs driven each sample (after `rst`).
     pub inputs: Vec<Signal>,
     /// Outputs and how they are checked.

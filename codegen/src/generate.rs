@@ -13,7 +13,7 @@ use crate::report;
 use crate::rom::{self, Rom, RomFormat, ROM_FOLDER};
 use crate::testbench::testbench;
 use crate::vectors::{self, Run};
-use crate::writers::{self, Provenance, ESTIMATOR_ROM, KF_ROM};
+use crate::writers::{self, Provenance};
 
 /// What `generate` reports back.
 #[derive(Clone, Debug)]
@@ -24,20 +24,41 @@ pub struct Summary {
     pub files: Vec<String>,
 }
 
-/// The regenerate command for a job from the embedded default, a preset and/or a config file.
-pub fn provenance(job: &Job, preset: Option<&str>, config_file: Option<&Path>) -> Provenance {
+/// Which gyrofx output a [`Provenance`] is for: it names the command that regenerates it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Output {
+    /// The verification package (`gyrofx generate`): depends on the seed and the samples.
+    Package,
+    /// The synthesis check (`gyrofx synth`): depends on the formats only.
+    Synthesis,
+}
+
+/// The regenerate command for an `output` of a job from the embedded default, a preset and/or
+/// a config file.
+pub fn provenance(
+    job: &Job,
+    output: Output,
+    preset: Option<&str>,
+    config_file: Option<&Path>,
+) -> Provenance {
     let config_text = job.config.to_toml();
-    let mut command = "gyrofx generate --out <folder>".to_string();
+    let mut command = match output {
+        Output::Package => "gyrofx generate --out <folder>",
+        Output::Synthesis => "gyrofx synth --out <folder>",
+    }
+    .to_string();
     if let Some(name) = preset {
         command.push_str(&format!(" --preset {name}"));
     }
     if let Some(path) = config_file {
         command.push_str(&format!(" --config {}", path.display()));
     }
-    command.push_str(&format!(
-        " --seed {} --samples {}",
-        job.config.seed, job.config.samples
-    ));
+    if output == Output::Package {
+        command.push_str(&format!(
+            " --seed {} --samples {}",
+            job.config.seed, job.config.samples
+        ));
+    }
     Provenance {
         version: env!("CARGO_PKG_VERSION").to_string(),
         command,
@@ -122,11 +143,16 @@ pub fn build_package(
     let est = &job.chain.estimator;
     let kf_rom = Rom::kf(kf);
     let estimator_rom = Rom::estimator(est);
+    let kf_rom_file = RomFormat::Mem.file_name(&kf_rom.name);
+    let estimator_rom_file = RomFormat::Mem.file_name(&estimator_rom.name);
     let run = vectors::run(
         job,
-        (KF_ROM, rom::write(&kf_rom, RomFormat::Mem, provenance)),
         (
-            ESTIMATOR_ROM,
+            kf_rom_file.clone(),
+            rom::write(&kf_rom, RomFormat::Mem, provenance),
+        ),
+        (
+            estimator_rom_file.clone(),
             rom::write(&estimator_rom, RomFormat::Mem, provenance),
         ),
     )?;
@@ -141,7 +167,7 @@ pub fn build_package(
     for rom in [&kf_rom, &estimator_rom] {
         for format in RomFormat::ALL {
             package.add(
-                format!("{ROM_FOLDER}/{}", format.file_name(rom)),
+                format!("{ROM_FOLDER}/{}", format.file_name(&rom.name)),
                 rom::write(rom, format, provenance),
             );
         }
@@ -195,7 +221,7 @@ pub fn build_package(
             "latency_clocks": 1,
             "designs": report::designs(&job.designs, kf),
             "coefficients": report::coefficients(kf),
-            "rom": {"file": KF_ROM, "depth": kf.rom.len(), "word_bits": kf_rom.width(), "all_formats": ROM_FOLDER,
+            "rom": {"file": kf_rom_file, "depth": kf.rom.len(), "word_bits": kf_rom.width(), "all_formats": ROM_FOLDER,
                     "packing": "word = {g1, g2}: g1 in the high bits; address = bw_sel"},
             "tie_cases": run.ties,
             "fixed_vs_float": run.kf_stats,
@@ -221,7 +247,7 @@ pub fn build_package(
             },
             "reciprocal": {"value": 1.0 / est.schedule.valid_count() as f64, "quantized": est.quantized_reciprocal(), "code": est.reciprocal_code as i64},
             "gains": {"designed": est.gains, "quantized": est.quantized_gains(), "all_shifts": est.gains_are_shifts(),
-                      "rom": {"file": ESTIMATOR_ROM, "word_bits": estimator_rom.width(), "all_formats": ROM_FOLDER, "order": "bias_a row over [mA0, mB0, mA1, ...], then bias_b row"}},
+                      "rom": {"file": estimator_rom_file, "word_bits": estimator_rom.width(), "all_formats": ROM_FOLDER, "order": "bias_a row over [mA0, mB0, mA1, ...], then bias_b row"}},
             "smoothing_shift": est.smoothing_shift,
             "fixed_vs_float_bias": run.bias_stats,
         },

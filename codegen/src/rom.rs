@@ -173,15 +173,15 @@ impl RomFormat {
         RomFormat::VhdlPackage,
     ];
 
-    /// The file name of `rom` in this format.
-    pub fn file_name(self, rom: &Rom) -> String {
+    /// The file name of the ROM called `rom` (a [`Rom::name`]) in this format.
+    pub fn file_name(self, rom: &str) -> String {
         match self {
-            RomFormat::Mem => format!("{}.mem", rom.name),
-            RomFormat::Coe => format!("{}.coe", rom.name),
-            RomFormat::Mif => format!("{}.mif", rom.name),
-            RomFormat::VerilogInclude => format!("{}.vh", rom.name),
-            RomFormat::SystemVerilogPackage => format!("gyrofx_{}_pkg.sv", rom.name),
-            RomFormat::VhdlPackage => format!("gyrofx_{}_pkg.vhd", rom.name),
+            RomFormat::Mem => format!("{rom}.mem"),
+            RomFormat::Coe => format!("{rom}.coe"),
+            RomFormat::Mif => format!("{rom}.mif"),
+            RomFormat::VerilogInclude => format!("{rom}.vh"),
+            RomFormat::SystemVerilogPackage => format!("gyrofx_{rom}_pkg.sv"),
+            RomFormat::VhdlPackage => format!("gyrofx_{rom}_pkg.vhd"),
         }
     }
 

@@ -217,8 +217,8 @@ fn report(top: &Block, resources: &Resources, provenance: &Provenance) -> String
 pub fn synthesize(job: &Job, out: &Path, provenance: &Provenance) -> Result<Resources> {
     let kf_rom = Rom::kf(job.kf());
     let estimator_rom = Rom::estimator(&job.chain.estimator);
-    let kf_name = RomFormat::Mem.file_name(&kf_rom);
-    let estimator_name = RomFormat::Mem.file_name(&estimator_rom);
+    let kf_name = RomFormat::Mem.file_name(&kf_rom.name);
+    let estimator_name = RomFormat::Mem.file_name(&estimator_rom.name);
     let [_, _, _, top] = empty_blocks(job, &kf_name, &estimator_name);
 
     let mut inputs: Vec<(String, String)> = writers::RTL_SOURCES

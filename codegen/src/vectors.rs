@@ -433,11 +433,7 @@ pub fn empty_blocks(job: &Job, rom_kf: &str, rom_estimator: &str) -> [Block; 4] 
 ///
 /// # Errors
 /// Stimulus errors (a bad CSV file).
-pub fn run(
-    job: &Job,
-    rom_kf: (&'static str, String),
-    rom_estimator: (&'static str, String),
-) -> Result<Run> {
+pub fn run(job: &Job, rom_kf: (String, String), rom_estimator: (String, String)) -> Result<Run> {
     let plan = &job.chain;
     let kf = job.kf();
     let est = &plan.estimator;
@@ -466,7 +462,7 @@ pub fn run(
     let (yb, sat_b) = adc(&record.y[1], est.input);
 
     let [mut seq_block, mut est_block, mut kf_block, mut top_block] =
-        empty_blocks(job, rom_kf.0, rom_estimator.0);
+        empty_blocks(job, &rom_kf.0, &rom_estimator.0);
     for block in [
         &mut seq_block,
         &mut est_block,
@@ -812,7 +808,12 @@ mod tests {
         let mut config = Config::embedded();
         config.samples = 4000;
         let job = Job::new(config).unwrap();
-        let run = run(&job, ("kf.mem", String::new()), ("est.mem", String::new())).unwrap();
+        let run = run(
+            &job,
+            ("kf.mem".into(), String::new()),
+            ("est.mem".into(), String::new()),
+        )
+        .unwrap();
         let names: Vec<&str> = run.blocks.iter().map(|b| b.name).collect();
         assert_eq!(names, ["sequencer", "estimator", "kf", "top"]);
         // One row per sample plus the reset, in every chain block.

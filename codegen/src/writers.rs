@@ -33,11 +33,6 @@ pub const RTL_SOURCES: [(&str, &str); 6] = [
     ("gyrofx_top.v", include_str!("../../hdl/gyrofx_top.v")),
 ];
 
-/// File name of the KF coefficient ROM.
-pub const KF_ROM: &str = "kf_coefficients.mem";
-/// File name of the estimator's gain ROM.
-pub const ESTIMATOR_ROM: &str = "estimator_gains.mem";
-
 /// Where generated files come from: printed at the top of each.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Provenance {
