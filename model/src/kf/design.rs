@@ -132,7 +132,7 @@ pub enum DesignError {
         tolerance: f64,
     },
     /// The target bandwidth cannot be reached at this sample rate.
-    #[error("bandwidth {target_hz} Hz cannot be designed at fs = {fs_hz} Hz: a first-order steady-state KF reaches at most fs/2 = {max_hz} Hz, and the target must be > 0")]
+    #[error("bandwidth {target_hz} Hz cannot be designed at fs = {fs_hz} Hz with this method: it reaches at most {max_hz} Hz (the direct method fs/2; the paper's discretisation saturates lower), and the target must be > 0")]
     BandwidthUnreachable {
         /// The bandwidth asked for, Hz.
         target_hz: f64,
@@ -347,10 +347,24 @@ pub fn design_for_bandwidth(
         return Err(unreachable());
     }
     // The bisection runs on the closed-form gain (cheap, monotone); the returned design then
-    // comes from the Riccati iteration at the q_w found.
+    // comes from the Riccati iteration at the q_w found. The largest finite bandwidth met is
+    // kept: the paper's discretisation saturates below fs/2 (its gain sum passes 1, where the
+    // response no longer has a -3 dB point), and that is the limit to report.
+    let reached = std::cell::Cell::new(0.0_f64);
     let bandwidth_at = |q_w: f64| {
         let k = closed_form_gain(&Noise { q_w, ..noise }, fs_hz);
-        bandwidth_hz(innovation_gain(k, method), fs_hz).unwrap_or(f64::INFINITY)
+        match bandwidth_hz(innovation_gain(k, method), fs_hz) {
+            Some(bandwidth) => {
+                reached.set(reached.get().max(bandwidth));
+                bandwidth
+            }
+            None => f64::INFINITY,
+        }
+    };
+    let beyond = || DesignError::BandwidthUnreachable {
+        target_hz,
+        fs_hz,
+        max_hz: reached.get(),
     };
     let r_d = noise.q_n * fs_hz;
     let (mut lo, mut hi) = (r_d, r_d);
@@ -358,19 +372,20 @@ pub fn design_for_bandwidth(
     while bandwidth_at(lo) > target_hz {
         lo /= 16.0;
         expansions += 1;
-        if expansions > 400 {
+        if expansions > 400 || lo == 0.0 {
             return Err(unreachable());
         }
     }
     while bandwidth_at(hi) < target_hz {
         hi *= 16.0;
         expansions += 1;
-        if expansions > 400 {
-            return Err(unreachable());
+        if expansions > 400 || !hi.is_finite() {
+            return Err(beyond());
         }
     }
     for _ in 0..200 {
-        let mid = (lo * hi).sqrt();
+        // The geometric mean without overflowing lo * hi.
+        let mid = lo.sqrt() * hi.sqrt();
         if mid <= lo || mid >= hi {
             break;
         }
@@ -380,7 +395,13 @@ pub fn design_for_bandwidth(
             hi = mid;
         }
     }
-    let q_w = (lo * hi).sqrt();
+    let q_w = lo.sqrt() * hi.sqrt();
+    // A jump from a finite bandwidth below the target to none at all is a saturation, not a
+    // solution.
+    let found = bandwidth_at(q_w);
+    if !found.is_finite() || (found - target_hz).abs() > 1e-6 * target_hz {
+        return Err(beyond());
+    }
     design(Noise { q_w, ..noise }, fs_hz, method, convergence)
 }
 
@@ -522,6 +543,34 @@ mod tests {
             Convergence::default(),
         )
         .unwrap_err();
-        assert!(err.to_string().contains("fs/2 = 100"));
+        assert!(err.to_string().contains("at most 100 Hz"), "{err}");
+    }
+
+    /// The paper's discretisation saturates below fs/2 (g1 -> 1 - 1/e): a target above its
+    /// limit is refused with the limit, not with an infinite q_w, and just below it designs.
+    #[test]
+    fn paper_method_refuses_bandwidths_beyond_its_saturation_with_the_limit() {
+        let err = design_for_bandwidth(
+            38.0,
+            paper_default(),
+            200.0,
+            Method::Paper,
+            Convergence::default(),
+        )
+        .unwrap_err();
+        let DesignError::BandwidthUnreachable { max_hz, .. } = err else {
+            panic!("{err}");
+        };
+        assert!(max_hz > 30.0 && max_hz < 38.0, "{max_hz}");
+        let d = design_for_bandwidth(
+            0.98 * max_hz,
+            paper_default(),
+            200.0,
+            Method::Paper,
+            Convergence::default(),
+        )
+        .unwrap();
+        let got = d.bandwidth_hz.expect("a bandwidth");
+        assert!(rel(got, 0.98 * max_hz) < 1e-6, "{got}");
     }
 }
