@@ -50,12 +50,19 @@ if ! command -v fusesoc >/dev/null 2>&1; then
 fi
 command -v fusesoc >/dev/null 2>&1 || { echo "FAIL: fusesoc is still missing" >&2; exit 1; }
 
-echo "== tools: $(iverilog -V 2>&1 | head -1); $(verilator --version); $(yosys -V); fusesoc $(fusesoc --version)"
+echo "== tools: $(iverilog -V 2>&1 | head -1); $(verilator --version); $(ghdl --version | head -1); $(yosys -V); fusesoc $(fusesoc --version)"
 echo "== cargo fmt --check"
 cargo fmt --all -- --check
 echo "== cargo clippy --all-targets -D warnings"
 cargo clippy --workspace --all-targets --quiet -- -D warnings
 echo "== verilator --lint-only -Wall (hdl/)"
 verilator --lint-only -Wall --top-module gyrofx_top hdl/*.v
+echo "== ghdl -a --std=08 -Werror (hdl/, compile order)"
+ghdl_work="$(mktemp -d)"
+ghdl -a --std=08 -Werror -Wunused -Wbinding -Wbody -Wspecs --workdir="$ghdl_work" \
+    hdl/gyrofx_mem_pkg.vhd hdl/gyrofx_quantize.vhd hdl/gyrofx_kf.vhd hdl/gyrofx_sequencer.vhd \
+    hdl/gyrofx_bias_estimator.vhd hdl/gyrofx_calibration.vhd hdl/gyrofx_top.vhd \
+    hdl/gyrofx_testbench_pkg.vhd
+rm -rf "$ghdl_work"
 echo "== cargo test"
 cargo test --workspace

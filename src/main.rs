@@ -10,6 +10,7 @@ use gyrofx_codegen::config::{Config, DEFAULT_TOML};
 use gyrofx_codegen::generate::{generate, provenance, Output};
 use gyrofx_codegen::input::{read_column, read_column_with_gaps};
 use gyrofx_codegen::job::{design_bandwidths, plan_for, Job};
+use gyrofx_codegen::junit;
 use gyrofx_codegen::report;
 use gyrofx_codegen::simulate::{self, Simulator};
 use gyrofx_model::fx::{from_f64, Overflow, Rounding};
@@ -162,9 +163,24 @@ enum Command {
         /// The package folder.
         #[arg(long)]
         out: PathBuf,
-        /// iverilog or verilator.
+        /// Simulators, comma-separated: iverilog, verilator, ghdl (the VHDL RTL), or all.
         #[arg(long, default_value = "iverilog")]
         sim: String,
+        /// Latency mask: samples not compared at the start and from every reset sample on.
+        #[arg(long, default_value_t = 0)]
+        mask: u64,
+        /// Mismatches printed per testbench.
+        #[arg(long, default_value_t = 10)]
+        max_reported: u64,
+        /// Stop a testbench at this many mismatches (0: never).
+        #[arg(long, default_value_t = 0)]
+        max_mismatches: u64,
+        /// Write a VCD per testbench (tb_<module>.vcd in each block folder).
+        #[arg(long)]
+        waves: bool,
+        /// Write a JUnit XML summary here (one testsuite per simulator, one testcase per block).
+        #[arg(long)]
+        junit: Option<PathBuf>,
     },
     /// Run recorded rate data (°/s) through the bit-accurate KF and its float model.
     Filter {
@@ -260,7 +276,25 @@ fn run(cli: Cli) -> Result<ExitCode> {
             samples,
             seed,
         } => run_generate(&out, preset.as_deref(), config.as_deref(), samples, seed),
-        Command::Verify { out, sim } => run_verify(&out, &sim),
+        Command::Verify {
+            out,
+            sim,
+            mask,
+            max_reported,
+            max_mismatches,
+            waves,
+            junit,
+        } => run_verify(
+            &out,
+            &sim,
+            &simulate::Options {
+                mask,
+                max_reported,
+                max_mismatches,
+                waves,
+            },
+            junit.as_deref(),
+        ),
         Command::Synth {
             out,
             config,
@@ -472,20 +506,46 @@ fn run_generate(
     Ok(ExitCode::SUCCESS)
 }
 
-fn run_verify(out: &Path, sim: &str) -> Result<ExitCode> {
-    let simulator: Simulator = sim.parse()?;
-    let outcome = simulate::run(out, simulator)?;
-    for line in &outcome.report {
-        println!("{line}");
+fn run_verify(
+    out: &Path,
+    sim: &str,
+    options: &simulate::Options,
+    junit_path: Option<&Path>,
+) -> Result<ExitCode> {
+    let simulators: Vec<Simulator> = if sim == "all" {
+        Simulator::ALL.to_vec()
+    } else {
+        sim.split(',')
+            .map(|name| name.trim().parse())
+            .collect::<std::result::Result<_, _>>()?
+    };
+    let mut outcomes = Vec::with_capacity(simulators.len());
+    for simulator in simulators {
+        let outcome = simulate::run(out, simulator, options)?;
+        for line in outcome.report() {
+            println!("{line}");
+        }
+        for block in outcome
+            .blocks
+            .iter()
+            .filter(|b| !b.passed && b.report.is_empty())
+        {
+            eprintln!("{}", block.log);
+        }
+        if outcome.passed() {
+            println!("{}: passed", simulator.name());
+        } else {
+            eprintln!("{}: FAILED", simulator.name());
+        }
+        outcomes.push(outcome);
     }
-    if outcome.passed {
-        println!("{}: passed", simulator.name());
+    if let Some(path) = junit_path {
+        std::fs::write(path, junit::report(&outcomes))
+            .with_context(|| format!("cannot write the JUnit summary {}", path.display()))?;
+    }
+    if outcomes.iter().all(simulate::Outcome::passed) {
         Ok(ExitCode::SUCCESS)
     } else {
-        if outcome.report.is_empty() {
-            eprintln!("{}", outcome.log);
-        }
-        eprintln!("{}: FAILED", simulator.name());
         Ok(ExitCode::FAILURE)
     }
 }

@@ -1,4 +1,4 @@
-//! generate → verify in Icarus and Verilator → pass; and every way it must fail.
+//! generate → verify in Icarus, Verilator and GHDL → pass; and every way it must fail.
 
 mod common;
 
@@ -19,11 +19,11 @@ fn pass_lines(log: &str) -> Vec<String> {
 }
 
 #[test]
-fn default_package_passes_in_icarus_and_verilator_and_a_flipped_bit_fails_every_block() {
+fn default_package_passes_in_every_simulator_and_a_flipped_bit_fails_every_testbench() {
     let dir = tempfile::tempdir().unwrap();
     let out = generate_default_str(dir.path(), "6000");
     let root = std::path::Path::new(&out);
-    for sim in ["iverilog", "verilator"] {
+    for sim in SIMULATORS {
         let log = ok(&["verify", "--out", &out, "--sim", sim]);
         let lines = pass_lines(&log);
         assert_eq!(lines.len(), 8, "{sim}: {log}");
@@ -43,14 +43,14 @@ fn default_package_passes_in_icarus_and_verilator_and_a_flipped_bit_fails_every_
 
     for block in BLOCKS {
         let signal = flip_expected_bit(root, block, 1234);
-        for sim in ["iverilog", "verilator"] {
+        for sim in SIMULATORS {
             let log = fails(&["verify", "--out", &out, "--sim", sim]);
             assert!(
                 log.contains(&format!("MISMATCH sample 1234 signal {signal}")),
                 "{sim} {block}: {log}"
             );
             assert!(log.contains("FAIL mismatches=1 n="), "{sim} {block}: {log}");
-            // The other blocks still pass: -k runs them all.
+            // The other blocks still pass: verify runs them all.
             assert_eq!(log.matches("PASS n=").count(), 3, "{sim} {block}: {log}");
         }
         flip_expected_bit(root, block, 1234);
@@ -72,39 +72,49 @@ fn the_package_runs_without_gyrofx_through_its_makefile() {
 
 #[test]
 fn a_vector_file_with_other_formats_or_missing_is_refused() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = generate_default_str(dir.path(), "300");
-    let stimulus = dir.path().join("pkg/kf/kf_stimulus.hex");
-    let original = std::fs::read_to_string(&stimulus).unwrap();
-    std::fs::write(&stimulus, original.replacen("z:s24.14", "z:s24.13", 1)).unwrap();
-    let log = fails(&["verify", "--out", &out, "--sim", "iverilog"]);
-    assert!(
-        log.contains("kf_stimulus.hex declares rst:u1.0 bw_sel:u2.0 z:s24.13; the testbench expects rst:u1.0 bw_sel:u2.0 z:s24.14"),
-        "{log}"
-    );
+    for sim in ["iverilog", "ghdl"] {
+        let dir = tempfile::tempdir().unwrap();
+        let out = generate_default_str(dir.path(), "300");
+        let stimulus = dir.path().join("pkg/kf/kf_stimulus.hex");
+        let original = std::fs::read_to_string(&stimulus).unwrap();
+        std::fs::write(&stimulus, original.replacen("z:s24.14", "z:s24.13", 1)).unwrap();
+        let log = fails(&["verify", "--out", &out, "--sim", sim]);
+        assert!(
+            log.contains("kf_stimulus.hex declares rst:u1.0 bw_sel:u2.0 z:s24.13; the testbench expects rst:u1.0 bw_sel:u2.0 z:s24.14"),
+            "{sim}: {log}"
+        );
 
-    // A truncated stimulus file: the testbench names the sample whose line is missing.
-    let lines: Vec<&str> = original.lines().take(102).collect();
-    std::fs::write(&stimulus, lines.join("\n") + "\n").unwrap();
-    let log = fails(&["verify", "--out", &out, "--sim", "iverilog"]);
-    assert!(
-        log.contains("line for sample 100 is missing or malformed"),
-        "{log}"
-    );
+        // A truncated stimulus file: the testbench names the sample whose line is missing.
+        let lines: Vec<&str> = original.lines().take(102).collect();
+        std::fs::write(&stimulus, lines.join("\n") + "\n").unwrap();
+        let log = fails(&["verify", "--out", &out, "--sim", sim]);
+        assert!(
+            log.contains("line for sample 100 is missing or malformed"),
+            "{sim}: {log}"
+        );
 
-    std::fs::remove_file(&stimulus).unwrap();
-    let log = fails(&["verify", "--out", &out, "--sim", "iverilog"]);
-    assert!(log.contains("cannot open kf_stimulus.hex"), "{log}");
+        // A field that is not hex.
+        std::fs::write(&stimulus, original.replacen("\n0 0 ", "\n0 0 g", 1)).unwrap();
+        let log = fails(&["verify", "--out", &out, "--sim", sim]);
+        assert!(log.contains("FAIL"), "{sim}: {log}");
 
-    std::fs::remove_file(dir.path().join("pkg/kf/kf_coefficients.mem")).unwrap();
-    let log = fails(&["verify", "--out", &out, "--sim", "iverilog"]);
-    assert!(log.contains("cannot open kf_coefficients.mem"), "{log}");
+        std::fs::remove_file(&stimulus).unwrap();
+        let log = fails(&["verify", "--out", &out, "--sim", sim]);
+        assert!(log.contains("cannot open kf_stimulus.hex"), "{sim}: {log}");
+
+        std::fs::remove_file(dir.path().join("pkg/kf/kf_coefficients.mem")).unwrap();
+        let log = fails(&["verify", "--out", &out, "--sim", sim]);
+        assert!(
+            log.contains("cannot open kf_coefficients.mem"),
+            "{sim}: {log}"
+        );
+    }
 }
 
 /// Every rounding mode, and wrap-around overflow, through the RTL: the quantizer's six modes
 /// and both overflow behaviours are bit-exact with the model.
 #[test]
-fn every_rounding_mode_and_wrapping_overflow_pass_in_icarus() {
+fn every_rounding_mode_and_wrapping_overflow_pass_in_icarus_and_ghdl() {
     let dir = tempfile::tempdir().unwrap();
     let mut cases: Vec<(String, String)> = ["floor", "ceil", "zero", "nearest", "round", "convergent"]
         .iter()
@@ -141,9 +151,9 @@ fn every_rounding_mode_and_wrapping_overflow_pass_in_icarus() {
             "--out",
             out.to_str().unwrap(),
             "--sim",
-            "iverilog",
+            "iverilog,ghdl",
         ]);
-        assert!(log.contains("PASS"), "{name}: {log}");
+        assert_eq!(log.matches("PASS n=").count(), 8, "{name}: {log}");
     }
 }
 
@@ -371,7 +381,7 @@ fn design_json_has_the_documented_fields() {
 }
 
 #[test]
-fn every_preset_generates_and_passes_in_icarus() {
+fn every_preset_generates_and_passes_in_icarus_and_ghdl() {
     let dir = tempfile::tempdir().unwrap();
     for preset in ["gu2019", "xue2015", "mpu6050"] {
         let text = ok(&["init", "--preset", preset]);
@@ -391,9 +401,9 @@ fn every_preset_generates_and_passes_in_icarus() {
             "--out",
             out.to_str().unwrap(),
             "--sim",
-            "iverilog",
+            "iverilog,ghdl",
         ]);
-        assert_eq!(log.matches("PASS n=").count(), 4, "{preset}: {log}");
+        assert_eq!(log.matches("PASS n=").count(), 8, "{preset}: {log}");
         let manifest = std::fs::read_to_string(out.join("manifest.json")).unwrap();
         assert!(manifest.contains(&format!("--preset {preset}")), "{preset}");
     }
@@ -441,25 +451,42 @@ fn mode_reversal_removes_the_drift_in_the_report() {
         .contains("| calibrated, combined |"));
 }
 
-/// The chain testbench notices a one-rule change in the RTL: the requantizer's
-/// round-half-up replaced by truncation (the vectors still expect the model's rounding).
+/// The chain testbench notices a one-rule change in the RTL, in either language: the
+/// requantizer's round-half-up replaced by truncation (the vectors still expect the model's
+/// rounding).
 #[test]
 fn truncating_instead_of_rounding_in_the_rtl_fails_the_chain_testbench() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = generate_default_str(dir.path(), "3000");
-    let quantizer = std::path::Path::new(&out).join("hdl/gyrofx_quantize.v");
-    let source = std::fs::read_to_string(&quantizer).unwrap();
-    let truncating = source.replace("3: increment = half_bit;", "3: increment = 1'b0;");
-    assert_ne!(source, truncating, "the mutation must apply");
-    std::fs::write(&quantizer, truncating).unwrap();
-    let log = fails(&["verify", "--out", &out, "--sim", "iverilog"]);
-    let top = log
-        .split("== top")
-        .nth(1)
-        .unwrap_or_else(|| panic!("no top section: {log}"));
-    assert!(top.contains("FAIL mismatches="), "{log}");
-    assert!(
-        top.contains("rate_out"),
-        "the filtered rate must differ: {log}"
-    );
+    let mutations = [
+        (
+            "iverilog",
+            "gyrofx_quantize.v",
+            "3: increment = half_bit;",
+            "3: increment = 1'b0;",
+        ),
+        (
+            "ghdl",
+            "gyrofx_quantize.vhd",
+            "half_bit                                    when 3,",
+            "'0'                                         when 3,",
+        ),
+    ];
+    for (sim, file, rounding, truncation) in mutations {
+        let dir = tempfile::tempdir().unwrap();
+        let out = generate_default_str(dir.path(), "3000");
+        let quantizer = std::path::Path::new(&out).join("hdl").join(file);
+        let source = std::fs::read_to_string(&quantizer).unwrap();
+        let truncating = source.replace(rounding, truncation);
+        assert_ne!(source, truncating, "the mutation must apply to {file}");
+        std::fs::write(&quantizer, truncating).unwrap();
+        let log = fails(&["verify", "--out", &out, "--sim", sim]);
+        let top = log
+            .split("== top")
+            .nth(1)
+            .unwrap_or_else(|| panic!("{sim}: no top section: {log}"));
+        assert!(top.contains("FAIL mismatches="), "{sim}: {log}");
+        assert!(
+            top.contains("rate_out"),
+            "{sim}: the filtered rate must differ: {log}"
+        );
+    }
 }

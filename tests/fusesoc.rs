@@ -1,5 +1,6 @@
-//! `gyrofx.core`: the reference RTL as a FuseSoC core. Its file list is the whole of `hdl/`,
-//! and FuseSoC's lint target (Verilator -Wall) passes on it and fails without a module.
+//! `gyrofx.core`: the reference RTL as a FuseSoC core. Its file lists are the whole of `hdl/`
+//! (the VHDL testbench package aside), FuseSoC's lint target (Verilator -Wall) passes on it and
+//! fails without a module, and its VHDL target (GHDL) analyses and elaborates the VHDL twin.
 
 mod common;
 
@@ -13,36 +14,75 @@ fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// Runs the core's lint target with `cores_root` as the only cores root.
-fn lint(cores_root: &Path, work: &Path) -> (bool, String) {
+/// Runs the core's `target` with `cores_root` as the only cores root.
+fn run_target(cores_root: &Path, target: &str, work: &Path) -> (bool, String) {
     let root = cores_root.to_str().unwrap();
     run_tool(
         "fusesoc",
-        &["--cores-root", root, "run", "--target", "lint", CORE],
+        &["--cores-root", root, "run", "--target", target, CORE],
         work,
     )
 }
 
-fn listed_rtl(core: &str) -> Vec<String> {
-    core.lines()
+fn lint(cores_root: &Path, work: &Path) -> (bool, String) {
+    run_target(cores_root, "lint", work)
+}
+
+/// The core's `hdl/` files ending in `extension`, sorted.
+fn listed_rtl(core: &str, extension: &str) -> Vec<String> {
+    let mut listed: Vec<String> = core
+        .lines()
         .filter_map(|l| l.trim().strip_prefix("- hdl/"))
+        .filter(|n| n.ends_with(extension))
         .map(str::to_string)
-        .collect()
+        .collect();
+    listed.sort();
+    listed
+}
+
+/// `hdl/` files ending in `extension`, sorted.
+fn present_rtl(extension: &str) -> Vec<String> {
+    let mut present: Vec<String> = std::fs::read_dir(root().join("hdl"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(extension))
+        .collect();
+    present.sort();
+    present
+}
+
+#[test]
+fn the_core_lists_the_vhdl_twin_which_ghdl_elaborates_through_fusesoc() {
+    let core = std::fs::read_to_string(root().join("gyrofx.core")).unwrap();
+    let present: Vec<String> = present_rtl(".vhd")
+        .into_iter()
+        .filter(|n| n != "gyrofx_testbench_pkg.vhd")
+        .collect();
+    assert_eq!(
+        listed_rtl(&core, ".vhd"),
+        present,
+        "gyrofx.core must list hdl/*.vhd but the testbench package"
+    );
+    let work = tempfile::tempdir().unwrap();
+    let (passed, log) = run_target(root(), "lint_vhdl", work.path());
+    assert!(passed, "fusesoc lint_vhdl: {log}");
+    assert!(
+        log.contains("ghdl -m --std=08"),
+        "GHDL must elaborate: {log}"
+    );
+    assert!(!log.contains("warning"), "{log}");
 }
 
 #[test]
 fn the_core_lists_every_rtl_file_and_lints_clean_in_fusesoc() {
     let core = std::fs::read_to_string(root().join("gyrofx.core")).unwrap();
     assert!(core.starts_with("CAPI=2:"));
-    let mut listed = listed_rtl(&core);
-    listed.sort();
-    let mut present: Vec<String> = std::fs::read_dir(root().join("hdl"))
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .filter(|n| n.ends_with(".v"))
-        .collect();
-    present.sort();
-    assert_eq!(listed, present, "gyrofx.core must list exactly hdl/*.v");
+    let present = present_rtl(".v");
+    assert_eq!(
+        listed_rtl(&core, ".v"),
+        present,
+        "gyrofx.core must list exactly hdl/*.v"
+    );
 
     let work = tempfile::tempdir().unwrap();
     let (passed, log) = lint(root(), work.path());

@@ -20,17 +20,27 @@ pub struct Signal {
     pub name: &'static str,
     /// Its format (flags are `u1.0`, indices `u<n>.0`).
     pub format: Format,
+    /// A 1-bit flag (`std_logic` in VHDL) rather than a vector (an index of any width, even
+    /// 1 bit, is an `unsigned` there).
+    pub flag: bool,
 }
 
 impl Signal {
     /// A signal.
     pub fn new(name: &'static str, format: Format) -> Self {
-        Signal { name, format }
+        Signal {
+            name,
+            format,
+            flag: false,
+        }
     }
 
     /// A 1-bit flag.
     pub fn flag(name: &'static str) -> Self {
-        Signal::new(name, Format::new(false, 1, 0).expect("1 bit"))
+        Signal {
+            flag: true,
+            ..Signal::new(name, Format::new(false, 1, 0).expect("1 bit"))
+        }
     }
 
     /// An unsigned index of `bits` bits.
@@ -109,6 +119,10 @@ pub struct Param {
     pub kind: String,
     /// The Verilog literal.
     pub value: String,
+    /// The VHDL generic's type: `integer`, `string` or `std_logic_vector`.
+    pub vhdl_type: &'static str,
+    /// The VHDL-2008 literal (bit vectors as sized hex, e.g. `4x"5"`).
+    pub vhdl_value: String,
     /// What it is.
     pub comment: String,
 }
@@ -120,6 +134,8 @@ impl Param {
             name: name.to_string(),
             kind: "integer".into(),
             value: value.to_string(),
+            vhdl_type: "integer",
+            vhdl_value: value.to_string(),
             comment: comment.into(),
         }
     }
@@ -130,6 +146,8 @@ impl Param {
             name: name.to_string(),
             kind: String::new(),
             value: format!("\"{value}\""),
+            vhdl_type: "string",
+            vhdl_value: format!("\"{value}\""),
             comment: comment.into(),
         }
     }
@@ -140,6 +158,8 @@ impl Param {
             name: name.to_string(),
             kind: format!("[{}:0]", width - 1),
             value: format!("{width}'h{value:x}"),
+            vhdl_type: "std_logic_vector",
+            vhdl_value: format!("{width}x\"{value:x}\""),
             comment: comment.into(),
         }
     }
@@ -265,6 +285,7 @@ impl Block {
     pub fn file(&self, what: &str) -> String {
         match what {
             "tb" => format!("tb_{}.v", self.module),
+            "tb.vhd" => format!("tb_{}.vhd", self.module),
             other => format!("{}_{other}", self.name),
         }
     }

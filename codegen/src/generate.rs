@@ -11,7 +11,7 @@ use crate::job::Job;
 use crate::package::{sha256_hex, Package, MANIFEST};
 use crate::report;
 use crate::rom::{self, Rom, RomFormat, ROM_FOLDER};
-use crate::testbench::testbench;
+use crate::testbench::{verilog, vhdl};
 use crate::vectors::{self, Run};
 use crate::writers::{self, Provenance};
 
@@ -80,7 +80,8 @@ fn block_files(block: &Block, provenance: &Provenance) -> Vec<(String, String)> 
             block.file("vectors.csv"),
             writers::vector_csv(block, provenance),
         ),
-        (block.file("tb"), testbench(block, provenance)),
+        (block.file("tb"), verilog::testbench(block, provenance)),
+        (block.file("tb.vhd"), vhdl::testbench(block, provenance)),
     ];
     files.extend(
         block
@@ -161,8 +162,8 @@ pub fn build_package(
     package.add("README.md", writers::package_readme(&run, provenance));
     package.add("Makefile", writers::makefile(&run.blocks, provenance));
     package.add("report.md", writers::report_md(&run, provenance));
-    for (name, source) in writers::RTL_SOURCES {
-        package.add(format!("hdl/{name}"), source);
+    for (name, source) in writers::RTL_SOURCES.iter().chain(&writers::VHDL_SOURCES) {
+        package.add(format!("hdl/{name}"), *source);
     }
     for rom in [&kf_rom, &estimator_rom] {
         for format in RomFormat::ALL {

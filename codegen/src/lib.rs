@@ -13,6 +13,7 @@ pub mod error;
 pub mod generate;
 pub mod input;
 pub mod job;
+pub mod junit;
 pub mod package;
 pub mod plot;
 pub mod report;

@@ -1,26 +1,34 @@
-//! Running a package's testbench in a simulator (through the package's own Makefile, so the
-//! commands `gyrofx verify` runs are exactly those a user runs without gyrofx).
+//! Running a package's testbenches in a simulator (through the package's own Makefile, one
+//! `make <simulator>-<block>` per block, so the commands `gyrofx verify` runs are exactly those a
+//! user runs without gyrofx).
 
 use std::path::Path;
 use std::process::Command;
+use std::time::Instant;
 
 use crate::error::{Error, Result};
 
 /// A supported simulator.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Simulator {
-    /// Icarus Verilog (`iverilog` + `vvp`).
+    /// Icarus Verilog (`iverilog` + `vvp`), the Verilog RTL.
     Icarus,
-    /// Verilator (`--binary --timing`).
+    /// Verilator (`--binary --timing`), the Verilog RTL.
     Verilator,
+    /// GHDL (`--std=08`), the VHDL RTL and testbenches.
+    Ghdl,
 }
 
 impl Simulator {
-    /// CLI name.
+    /// Every simulator.
+    pub const ALL: [Simulator; 3] = [Simulator::Icarus, Simulator::Verilator, Simulator::Ghdl];
+
+    /// CLI name (also the Makefile's target prefix).
     pub fn name(self) -> &'static str {
         match self {
             Simulator::Icarus => "iverilog",
             Simulator::Verilator => "verilator",
+            Simulator::Ghdl => "ghdl",
         }
     }
 
@@ -29,14 +37,7 @@ impl Simulator {
         match self {
             Simulator::Icarus => &["iverilog", "vvp", "make"],
             Simulator::Verilator => &["verilator", "make"],
-        }
-    }
-
-    /// Makefile target.
-    fn target(self) -> &'static str {
-        match self {
-            Simulator::Icarus => "sim-iverilog",
-            Simulator::Verilator => "sim-verilator",
+            Simulator::Ghdl => &["ghdl", "make"],
         }
     }
 }
@@ -47,23 +48,75 @@ impl std::str::FromStr for Simulator {
         match text {
             "iverilog" | "icarus" => Ok(Simulator::Icarus),
             "verilator" => Ok(Simulator::Verilator),
+            "ghdl" => Ok(Simulator::Ghdl),
             other => Err(Error::Simulation(format!(
-                "simulator {other:?} is not supported: use iverilog or verilator"
+                "simulator {other:?} is not supported: use iverilog, verilator or ghdl"
             ))),
         }
     }
 }
 
-/// The outcome of one simulation.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Outcome {
-    /// Whether every block's testbench passed (exit 0 and a `PASS` line for each).
+/// Testbench options (the Makefile's `MASK`, `MAX_REPORTED`, `MAX_MISMATCHES`, `WAVES`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Options {
+    /// Samples not compared at the start and from every reset sample on.
+    pub mask: u64,
+    /// Mismatches printed per testbench.
+    pub max_reported: u64,
+    /// Stop a testbench at this many mismatches (0: never).
+    pub max_mismatches: u64,
+    /// Write a VCD per testbench.
+    pub waves: bool,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            mask: 0,
+            max_reported: u64::from(crate::testbench::MAX_REPORTED),
+            max_mismatches: 0,
+            waves: false,
+        }
+    }
+}
+
+/// The outcome of one block's testbench.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BlockOutcome {
+    /// The block (folder) name.
+    pub block: String,
+    /// Exit 0 and a `PASS` line.
     pub passed: bool,
-    /// The testbenches' report: `== <block>` headers and their `PASS`, `FAIL` and `MISMATCH`
-    /// lines.
+    /// Its `PASS`, `FAIL` and `MISMATCH` lines.
     pub report: Vec<String>,
-    /// Everything it printed (stdout then stderr).
+    /// Everything make printed for it (stdout then stderr).
     pub log: String,
+    /// Wall-clock seconds, build included.
+    pub seconds: f64,
+}
+
+/// The outcome of one simulator over every block.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Outcome {
+    /// The simulator.
+    pub simulator: Simulator,
+    /// Per block, in the Makefile's order.
+    pub blocks: Vec<BlockOutcome>,
+}
+
+impl Outcome {
+    /// Whether every block passed.
+    pub fn passed(&self) -> bool {
+        !self.blocks.is_empty() && self.blocks.iter().all(|b| b.passed)
+    }
+
+    /// `== <block>` headers and each block's report lines.
+    pub fn report(&self) -> Vec<String> {
+        self.blocks
+            .iter()
+            .flat_map(|b| std::iter::once(format!("== {}", b.block)).chain(b.report.clone()))
+            .collect()
+    }
 }
 
 fn on_path(program: &str) -> bool {
@@ -72,19 +125,39 @@ fn on_path(program: &str) -> bool {
         .unwrap_or(false)
 }
 
-/// Runs the package in `out` under `simulator`.
+/// The blocks the package's Makefile runs under `simulator` (its `sim-<simulator>:` line).
+fn blocks(out: &Path, simulator: Simulator) -> Result<Vec<String>> {
+    let makefile = std::fs::read_to_string(out.join("Makefile")).map_err(|e| {
+        Error::Simulation(format!(
+            "{} is not a gyrofx package (no readable Makefile: {e}): run gyrofx generate --out {} first",
+            out.display(),
+            out.display()
+        ))
+    })?;
+    let rule = format!("sim-{}:", simulator.name());
+    let prefix = format!("{}-", simulator.name());
+    let line = makefile
+        .lines()
+        .find(|l| l.starts_with(&rule))
+        .ok_or_else(|| {
+            Error::Simulation(format!(
+                "{}/Makefile has no {rule} target: regenerate the package with this gyrofx",
+                out.display()
+            ))
+        })?;
+    Ok(line[rule.len()..]
+        .split_whitespace()
+        .filter_map(|t| t.strip_prefix(&prefix).map(str::to_string))
+        .collect())
+}
+
+/// Runs every block of the package in `out` under `simulator`.
 ///
 /// # Errors
 /// [`Error::Simulation`] when the folder is not a package or a program is missing (a missing
 /// simulator is an error, never a skipped check).
-pub fn run(out: &Path, simulator: Simulator) -> Result<Outcome> {
-    if !out.join("Makefile").is_file() || !out.join("kf").is_dir() {
-        return Err(Error::Simulation(format!(
-            "{} is not a gyrofx package (no Makefile or kf/): run gyrofx generate --out {} first",
-            out.display(),
-            out.display()
-        )));
-    }
+pub fn run(out: &Path, simulator: Simulator, options: &Options) -> Result<Outcome> {
+    let names = blocks(out, simulator)?;
     for program in simulator.programs() {
         if !on_path(program) {
             return Err(Error::Simulation(format!(
@@ -93,33 +166,36 @@ pub fn run(out: &Path, simulator: Simulator) -> Result<Outcome> {
             )));
         }
     }
-    // -k: a failing block does not hide the others.
-    let output = Command::new("make")
-        .arg("--no-print-directory")
-        .arg("-k")
-        .arg("-C")
-        .arg(out)
-        .arg(simulator.target())
-        .output()
-        .map_err(|e| Error::Simulation(format!("cannot run make: {e}")))?;
-    let mut log = String::from_utf8_lossy(&output.stdout).into_owned();
-    log.push_str(&String::from_utf8_lossy(&output.stderr));
-    let report: Vec<String> = log
-        .lines()
-        .filter(|l| {
-            l.starts_with("== ")
-                || l.starts_with("PASS")
-                || l.starts_with("FAIL")
-                || l.starts_with("MISMATCH")
-        })
-        .map(str::to_string)
-        .collect();
-    let blocks = report.iter().filter(|l| l.starts_with("== ")).count();
-    let passes = report.iter().filter(|l| l.starts_with("PASS ")).count();
-    let passed = output.status.success() && blocks > 0 && passes == blocks;
-    Ok(Outcome {
-        passed,
-        report,
-        log,
-    })
+    let mut blocks = Vec::with_capacity(names.len());
+    for block in names {
+        let start = Instant::now();
+        let output = Command::new("make")
+            .arg("--no-print-directory")
+            .arg("-C")
+            .arg(out)
+            .arg(format!("{}-{block}", simulator.name()))
+            .arg(format!("MASK={}", options.mask))
+            .arg(format!("MAX_REPORTED={}", options.max_reported))
+            .arg(format!("MAX_MISMATCHES={}", options.max_mismatches))
+            .arg(format!("WAVES={}", u8::from(options.waves)))
+            .output()
+            .map_err(|e| Error::Simulation(format!("cannot run make: {e}")))?;
+        let seconds = start.elapsed().as_secs_f64();
+        let mut log = String::from_utf8_lossy(&output.stdout).into_owned();
+        log.push_str(&String::from_utf8_lossy(&output.stderr));
+        let report: Vec<String> = log
+            .lines()
+            .filter(|l| l.starts_with("PASS") || l.starts_with("FAIL") || l.starts_with("MISMATCH"))
+            .map(str::to_string)
+            .collect();
+        let passed = output.status.success() && report.iter().any(|l| l.starts_with("PASS "));
+        blocks.push(BlockOutcome {
+            block,
+            passed,
+            report,
+            log,
+            seconds,
+        });
+    }
+    Ok(Outcome { simulator, blocks })
 }

@@ -33,6 +33,37 @@ pub const RTL_SOURCES: [(&str, &str); 6] = [
     ("gyrofx_top.v", include_str!("../../hdl/gyrofx_top.v")),
 ];
 
+/// The reference RTL in VHDL-2008, in compile order (packages first), and the package the VHDL
+/// testbenches share (last: simulation only).
+pub const VHDL_SOURCES: [(&str, &str); 8] = [
+    (
+        "gyrofx_mem_pkg.vhd",
+        include_str!("../../hdl/gyrofx_mem_pkg.vhd"),
+    ),
+    (
+        "gyrofx_quantize.vhd",
+        include_str!("../../hdl/gyrofx_quantize.vhd"),
+    ),
+    ("gyrofx_kf.vhd", include_str!("../../hdl/gyrofx_kf.vhd")),
+    (
+        "gyrofx_sequencer.vhd",
+        include_str!("../../hdl/gyrofx_sequencer.vhd"),
+    ),
+    (
+        "gyrofx_bias_estimator.vhd",
+        include_str!("../../hdl/gyrofx_bias_estimator.vhd"),
+    ),
+    (
+        "gyrofx_calibration.vhd",
+        include_str!("../../hdl/gyrofx_calibration.vhd"),
+    ),
+    ("gyrofx_top.vhd", include_str!("../../hdl/gyrofx_top.vhd")),
+    (
+        "gyrofx_testbench_pkg.vhd",
+        include_str!("../../hdl/gyrofx_testbench_pkg.vhd"),
+    ),
+];
+
 /// Where generated files come from: printed at the top of each.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Provenance {
@@ -219,43 +250,62 @@ pub fn vector_csv(block: &Block, provenance: &Provenance) -> String {
     csv
 }
 
-/// The Makefile: `sim-iverilog` / `sim-verilator` run every block's testbench, and
-/// `iverilog-<block>` / `verilator-<block>` one. Each recipe runs in the block's folder.
+/// The Makefile: `sim-iverilog` / `sim-verilator` / `sim-ghdl` run every block's testbench, and
+/// `<simulator>-<block>` one; `MASK`, `MAX_REPORTED`, `MAX_MISMATCHES` and `WAVES` set the
+/// testbench options in every simulator (plusargs in Verilog, generics in VHDL). Each recipe runs
+/// in the block's folder.
 pub fn makefile(blocks: &[Block], provenance: &Provenance) -> String {
-    let rtl: Vec<String> = RTL_SOURCES
-        .iter()
-        .map(|(n, _)| format!("../hdl/{n}"))
-        .collect();
+    let sources = |list: &[(&str, &str)]| -> String {
+        list.iter()
+            .map(|(n, _)| format!("../hdl/{n}"))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
     let names: Vec<&str> = blocks.iter().map(|b| b.name).collect();
+    let targets = |simulator: &str| -> String {
+        names
+            .iter()
+            .map(|n| format!(" {simulator}-{n}"))
+            .collect::<String>()
+    };
     let mut out = format!(
         "{header}
-# Runs the testbenches in each simulator, without gyrofx: make sim-iverilog, make sim-verilator
-# (every block), or make iverilog-<block> / verilator-<block>. Blocks: {list}.
+# Runs the testbenches without gyrofx: make sim-iverilog, make sim-verilator, make sim-ghdl (every
+# block), or make <simulator>-<block>. Blocks: {list}.
+# Options, the same in every simulator: MASK=<n> (latency mask: the first n samples of the run
+# and from every reset on are not compared), MAX_REPORTED=<n> (mismatches printed),
+# MAX_MISMATCHES=<n> (stop at the n-th; 0: never), WAVES=1 (VCD dump: tb_<module>.vcd).
+# PLUSARGS / GHDL_RUN_FLAGS pass anything else to the Verilog / GHDL simulation.
 IVERILOG ?= iverilog
 VVP ?= vvp
 VERILATOR ?= verilator
+GHDL ?= ghdl
+MASK ?= 0
+MAX_REPORTED ?= 10
+MAX_MISMATCHES ?= 0
+WAVES ?= 0
 RTL := {rtl}
+VHDL := {vhdl}
+TB_PLUSARGS = +mask=$(MASK) +max_reported=$(MAX_REPORTED) +max_mismatches=$(MAX_MISMATCHES) $(if $(filter 1,$(WAVES)),+dump) $(PLUSARGS)
+TB_GENERICS = -gMASK_SAMPLES=$(MASK) -gMAX_REPORTED=$(MAX_REPORTED) -gMAX_MISMATCHES=$(MAX_MISMATCHES)
 
-.PHONY: all sim-iverilog sim-verilator clean{phony}
-all: sim-iverilog sim-verilator
+.PHONY: all sim-iverilog sim-verilator sim-ghdl clean{phony}
+all: sim-iverilog sim-verilator sim-ghdl
 sim-iverilog:{iverilog}
 sim-verilator:{verilator}
+sim-ghdl:{ghdl}
 ",
         header = provenance.line("#"),
         list = names.join(", "),
-        rtl = rtl.join(" "),
+        rtl = sources(&RTL_SOURCES),
+        vhdl = sources(&VHDL_SOURCES),
         phony = names
             .iter()
-            .map(|n| format!(" iverilog-{n} verilator-{n}"))
+            .map(|n| format!(" iverilog-{n} verilator-{n} ghdl-{n}"))
             .collect::<String>(),
-        iverilog = names
-            .iter()
-            .map(|n| format!(" iverilog-{n}"))
-            .collect::<String>(),
-        verilator = names
-            .iter()
-            .map(|n| format!(" verilator-{n}"))
-            .collect::<String>(),
+        iverilog = targets("iverilog"),
+        verilator = targets("verilator"),
+        ghdl = targets("ghdl"),
     );
     for b in blocks {
         let tb = format!("tb_{}", b.module);
@@ -264,12 +314,17 @@ sim-verilator:{verilator}
             "
 iverilog-{name}:
 \t@echo \"== {name}\"
-\tcd {name} && $(IVERILOG) -g2005 -Wall -o {tb}.vvp $(RTL) {tb}.v && $(VVP) -n {tb}.vvp $(PLUSARGS)
+\tcd {name} && $(IVERILOG) -g2005 -Wall -s {tb} -o {tb}.vvp $(RTL) {tb}.v && $(VVP) -n {tb}.vvp $(TB_PLUSARGS)
 
 verilator-{name}:
 \t@echo \"== {name}\"
-\tcd {name} && $(VERILATOR) --binary --timing -Wall -Wno-DECLFILENAME -Wno-UNUSEDSIGNAL -Wno-fatal -j 2 --top-module {tb} -Mdir obj_verilator $(RTL) {tb}.v >verilator_build.log 2>&1 || (cat verilator_build.log; exit 1)
-\tcd {name} && ./obj_verilator/V{tb} $(PLUSARGS)
+\tcd {name} && $(VERILATOR) --binary --timing $(if $(filter 1,$(WAVES)),--trace) -Wall -Wno-DECLFILENAME -Wno-UNUSEDSIGNAL -Wno-fatal -j 2 --top-module {tb} -Mdir obj_verilator $(RTL) {tb}.v >verilator_build.log 2>&1 || (cat verilator_build.log; exit 1)
+\tcd {name} && ./obj_verilator/V{tb} $(TB_PLUSARGS)
+
+ghdl-{name}:
+\t@echo \"== {name}\"
+\tcd {name} && mkdir -p ghdl_work && $(GHDL) -a --std=08 -Werror --workdir=ghdl_work $(VHDL) {tb}.vhd
+\tcd {name} && $(GHDL) --elab-run --std=08 --workdir=ghdl_work {tb} $(TB_GENERICS) $(if $(filter 1,$(WAVES)),--vcd={tb}.vcd) $(GHDL_RUN_FLAGS)
 ",
             name = b.name,
         );
@@ -282,7 +337,9 @@ clean:
 ",
         names
             .iter()
-            .map(|n| format!("{n}/*.vvp {n}/obj_verilator {n}/verilator_build.log {n}/*.vcd"))
+            .map(|n| format!(
+                "{n}/*.vvp {n}/obj_verilator {n}/verilator_build.log {n}/ghdl_work {n}/*.vcd"
+            ))
             .collect::<Vec<_>>()
             .join(" ")
     );
@@ -300,10 +357,15 @@ testbench per block. Run it without gyrofx:
 
     make sim-iverilog      # Icarus Verilog, every block
     make sim-verilator     # Verilator (--binary --timing), every block
+    make sim-ghdl          # GHDL (--std=08), the VHDL RTL and testbenches, every block
     make iverilog-top      # one block
 
 Each testbench prints `PASS n=<N>` or the first mismatches and `FAIL ...`, and exits non-zero on
-any mismatch, timeout or unreadable vector file. `make PLUSARGS=+dump iverilog-kf` writes a VCD.
+any mismatch, timeout or unreadable vector file. Options, the same in every simulator:
+`MASK=<n>` (latency mask: the first n samples of the run and from every reset sample on are
+driven but not compared), `MAX_REPORTED=<n>` (mismatches printed, default 10),
+`MAX_MISMATCHES=<n>` (stop at the n-th), `WAVES=1` (a VCD per testbench), e.g.
+`make WAVES=1 MASK=4 ghdl-kf`. `gyrofx verify --junit <file>` writes a JUnit XML summary.
 
 | folder | DUT | vectors |
 |--------|-----|---------|
@@ -326,7 +388,8 @@ any mismatch, timeout or unreadable vector file. `make PLUSARGS=+dump iverilog-k
 In each folder: `<block>_params.vh` (the DUT's parameters, the vector count and file names),
 `<block>_stimulus.hex` (`rst` and the inputs per line), `<block>_expected.hex` (the outputs per
 line), `<block>_vectors.csv` (the same with integer codes and real values in °/s) and the
-testbench `tb_<module>.v`; the ROM images the DUT reads. Line 2 of each hex file names every
+testbenches `tb_<module>.v` (Verilog) and `tb_<module>.vhd` (VHDL-2008); the ROM images the DUT
+reads. `hdl/` holds the RTL in both languages. Line 2 of each hex file names every
 field and its format. `report.md` has the Allan table; `manifest.json` the config, formats,
 SHA-256 of every file, overflow counts and fixed-vs-float error statistics.
 

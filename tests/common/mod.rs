@@ -120,3 +120,6 @@ pub fn flip_expected_bit(package: &Path, block: &str, sample: usize) -> String {
 
 /// The blocks of a package, in Makefile order.
 pub const BLOCKS: [&str; 4] = ["sequencer", "estimator", "kf", "top"];
+
+/// Every simulator `gyrofx verify` runs.
+pub const SIMULATORS: [&str; 3] = ["iverilog", "verilator", "ghdl"];

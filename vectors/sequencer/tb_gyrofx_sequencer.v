@@ -11,18 +11,19 @@
  * formats declared on line 2 and checked here), drives one sample per ce with an
  * idle clock after every fourth, and compares combinational outputs before the
  * clock edge and registered outputs 1 clock after it. Prints the first
- * 10 mismatches, then PASS n=<N> or FAIL mismatches=<M> n=<N> first=<index>,
+ * mismatches, then PASS n=<N> [masked=<M>] or FAIL mismatches=<M> n=<N> first=<index>,
  * and exits non-zero ($fatal) on a mismatch, a timeout or a bad vector file.
- * Plusargs: +dump writes tb_gyrofx_sequencer.vcd.
+ * Plusargs: +dump writes tb_gyrofx_sequencer.vcd; +mask=<n> does not compare the first n samples
+ * of the run and from every reset sample on (latency mask); +max_reported=<n>
+ * prints n mismatches (default 10); +max_mismatches=<n> stops at the n-th.
  */
 module tb_gyrofx_sequencer;
 
 `include "sequencer_params.vh"
 
-localparam integer MAX_REPORTED = 10;
 localparam integer CLOCK_PERIOD_NS = 10;
 // 64-bit: long vector sets overflow a 32-bit integer.
-localparam [63:0] TIMEOUT_NS = (64'd3 * VECTOR_COUNT + 64'd100) * CLOCK_PERIOD_NS;
+localparam [63:0] TIMEOUT_NS = 64'd30103 * CLOCK_PERIOD_NS;
 
 reg clk = 1'b0;
 always #(CLOCK_PERIOD_NS / 2) clk <= ~clk;
@@ -68,6 +69,13 @@ integer fields;
 integer index = 0;
 integer mismatches = 0;
 integer first_mismatch = -1;
+integer mask_samples = 0;
+integer max_reported = 10;
+integer max_mismatches = 0;
+integer since_reset = 0;
+integer masked_count = 0;
+reg masked = 1'b0;
+reg stop_at_cap = 1'b0;
 reg [8*1024-1:0] line;
 reg [8*400-1:0] message;
 reg vector_rst;
@@ -112,6 +120,10 @@ initial begin
 end
 
 initial begin
+    if ($value$plusargs("mask=%d", mask_samples) && mask_samples > 0)
+        $display("mask: %0d samples after each reset", mask_samples);
+    if ($value$plusargs("max_reported=%d", max_reported)) begin end
+    if ($value$plusargs("max_mismatches=%d", max_mismatches)) begin end
     stimulus_fd = $fopen(STIMULUS_FILE, "r");
     if (stimulus_fd == 0) begin
         $sformat(message, "cannot open %0s", STIMULUS_FILE);
@@ -152,70 +164,83 @@ initial begin
             $sformat(message, "%0s: line for sample %0d is missing or malformed", EXPECTED_FILE, index);
             fail_setup;
         end
+        if (vector_rst) since_reset = 0;
+        masked = since_reset < mask_samples;
+        if (masked) masked_count = masked_count + 1;
+        since_reset = since_reset + 1;
         rst = vector_rst;
         ce = 1'b1;
         #1;
-        if (!vector_rst) begin
+        if (!vector_rst && !masked) begin
         if (mode_a !== expected_mode_a) begin
             mismatches = mismatches + 1;
             if (first_mismatch < 0) first_mismatch = index;
-            if (mismatches <= MAX_REPORTED)
+            if (max_mismatches > 0 && mismatches >= max_mismatches) stop_at_cap = 1'b1;
+            if (mismatches <= max_reported)
                 $display("MISMATCH sample %0d signal mode_a expected %h (%.9g) actual %h (%.9g)",
                     index, expected_mode_a, expected_mode_a * 1.0, mode_a, mode_a * 1.0);
         end
         if (mode_b !== expected_mode_b) begin
             mismatches = mismatches + 1;
             if (first_mismatch < 0) first_mismatch = index;
-            if (mismatches <= MAX_REPORTED)
+            if (max_mismatches > 0 && mismatches >= max_mismatches) stop_at_cap = 1'b1;
+            if (mismatches <= max_reported)
                 $display("MISMATCH sample %0d signal mode_b expected %h (%.9g) actual %h (%.9g)",
                     index, expected_mode_b, expected_mode_b * 1.0, mode_b, mode_b * 1.0);
         end
         if (blank_a !== expected_blank_a) begin
             mismatches = mismatches + 1;
             if (first_mismatch < 0) first_mismatch = index;
-            if (mismatches <= MAX_REPORTED)
+            if (max_mismatches > 0 && mismatches >= max_mismatches) stop_at_cap = 1'b1;
+            if (mismatches <= max_reported)
                 $display("MISMATCH sample %0d signal blank_a expected %h (%.9g) actual %h (%.9g)",
                     index, expected_blank_a, expected_blank_a * 1.0, blank_a, blank_a * 1.0);
         end
         if (blank_b !== expected_blank_b) begin
             mismatches = mismatches + 1;
             if (first_mismatch < 0) first_mismatch = index;
-            if (mismatches <= MAX_REPORTED)
+            if (max_mismatches > 0 && mismatches >= max_mismatches) stop_at_cap = 1'b1;
+            if (mismatches <= max_reported)
                 $display("MISMATCH sample %0d signal blank_b expected %h (%.9g) actual %h (%.9g)",
                     index, expected_blank_b, expected_blank_b * 1.0, blank_b, blank_b * 1.0);
         end
         if (interval_a !== expected_interval_a) begin
             mismatches = mismatches + 1;
             if (first_mismatch < 0) first_mismatch = index;
-            if (mismatches <= MAX_REPORTED)
+            if (max_mismatches > 0 && mismatches >= max_mismatches) stop_at_cap = 1'b1;
+            if (mismatches <= max_reported)
                 $display("MISMATCH sample %0d signal interval_a expected %h (%.9g) actual %h (%.9g)",
                     index, expected_interval_a, expected_interval_a * 1.0, interval_a, interval_a * 1.0);
         end
         if (interval_b !== expected_interval_b) begin
             mismatches = mismatches + 1;
             if (first_mismatch < 0) first_mismatch = index;
-            if (mismatches <= MAX_REPORTED)
+            if (max_mismatches > 0 && mismatches >= max_mismatches) stop_at_cap = 1'b1;
+            if (mismatches <= max_reported)
                 $display("MISMATCH sample %0d signal interval_b expected %h (%.9g) actual %h (%.9g)",
                     index, expected_interval_b, expected_interval_b * 1.0, interval_b, interval_b * 1.0);
         end
         if (done_a !== expected_done_a) begin
             mismatches = mismatches + 1;
             if (first_mismatch < 0) first_mismatch = index;
-            if (mismatches <= MAX_REPORTED)
+            if (max_mismatches > 0 && mismatches >= max_mismatches) stop_at_cap = 1'b1;
+            if (mismatches <= max_reported)
                 $display("MISMATCH sample %0d signal done_a expected %h (%.9g) actual %h (%.9g)",
                     index, expected_done_a, expected_done_a * 1.0, done_a, done_a * 1.0);
         end
         if (done_b !== expected_done_b) begin
             mismatches = mismatches + 1;
             if (first_mismatch < 0) first_mismatch = index;
-            if (mismatches <= MAX_REPORTED)
+            if (max_mismatches > 0 && mismatches >= max_mismatches) stop_at_cap = 1'b1;
+            if (mismatches <= max_reported)
                 $display("MISMATCH sample %0d signal done_b expected %h (%.9g) actual %h (%.9g)",
                     index, expected_done_b, expected_done_b * 1.0, done_b, done_b * 1.0);
         end
         if (window_done !== expected_window_done) begin
             mismatches = mismatches + 1;
             if (first_mismatch < 0) first_mismatch = index;
-            if (mismatches <= MAX_REPORTED)
+            if (max_mismatches > 0 && mismatches >= max_mismatches) stop_at_cap = 1'b1;
+            if (mismatches <= max_reported)
                 $display("MISMATCH sample %0d signal window_done expected %h (%.9g) actual %h (%.9g)",
                     index, expected_window_done, expected_window_done * 1.0, window_done, window_done * 1.0);
         end
@@ -226,10 +251,17 @@ initial begin
         if (index % 4 == 3) begin
             @(negedge clk);
         end
+        if (stop_at_cap) begin
+            $display("FAIL mismatches=%0d n=%0d first=%0d (stopped at max_mismatches)", mismatches, index + 1, first_mismatch);
+            $fatal(1, "tb_gyrofx_sequencer: stopped at %0d mismatches", mismatches);
+        end
     end
 
     if (mismatches == 0) begin
-        $display("PASS n=%0d", VECTOR_COUNT);
+        if (masked_count > 0)
+            $display("PASS n=%0d masked=%0d", VECTOR_COUNT, masked_count);
+        else
+            $display("PASS n=%0d", VECTOR_COUNT);
         $finish;
     end else begin
         $display("FAIL mismatches=%0d n=%0d first=%0d", mismatches, VECTOR_COUNT, first_mismatch);

@@ -11,18 +11,19 @@
  * formats declared on line 2 and checked here), drives one sample per ce with an
  * idle clock after every fourth, and compares combinational outputs before the
  * clock edge and registered outputs 1 clock after it. Prints the first
- * 10 mismatches, then PASS n=<N> or FAIL mismatches=<M> n=<N> first=<index>,
+ * mismatches, then PASS n=<N> [masked=<M>] or FAIL mismatches=<M> n=<N> first=<index>,
  * and exits non-zero ($fatal) on a mismatch, a timeout or a bad vector file.
- * Plusargs: +dump writes tb_gyrofx_top.vcd.
+ * Plusargs: +dump writes tb_gyrofx_top.vcd; +mask=<n> does not compare the first n samples
+ * of the run and from every reset sample on (latency mask); +max_reported=<n>
+ * prints n mismatches (default 10); +max_mismatches=<n> stops at the n-th.
  */
 module tb_gyrofx_top;
 
 `include "top_params.vh"
 
-localparam integer MAX_REPORTED = 10;
 localparam integer CLOCK_PERIOD_NS = 10;
 // 64-bit: long vector sets overflow a 32-bit integer.
-localparam [63:0] TIMEOUT_NS = (64'd3 * VECTOR_COUNT + 64'd100) * CLOCK_PERIOD_NS;
+localparam [63:0] TIMEOUT_NS = 64'd30103 * CLOCK_PERIOD_NS;
 
 reg clk = 1'b0;
 always #(CLOCK_PERIOD_NS / 2) clk <= ~clk;
@@ -98,6 +99,13 @@ integer fields;
 integer index = 0;
 integer mismatches = 0;
 integer first_mismatch = -1;
+integer mask_samples = 0;
+integer max_reported = 10;
+integer max_mismatches = 0;
+integer since_reset = 0;
+integer masked_count = 0;
+reg masked = 1'b0;
+reg stop_at_cap = 1'b0;
 reg [8*1024-1:0] line;
 reg [8*400-1:0] message;
 reg vector_rst;
@@ -141,6 +149,10 @@ initial begin
 end
 
 initial begin
+    if ($value$plusargs("mask=%d", mask_samples) && mask_samples > 0)
+        $display("mask: %0d samples after each reset", mask_samples);
+    if ($value$plusargs("max_reported=%d", max_reported)) begin end
+    if ($value$plusargs("max_mismatches=%d", max_mismatches)) begin end
     // $readmemh in the DUT only warns about a missing file (Icarus): check it here.
     rom_fd = $fopen("estimator_gains.mem", "r");
     if (rom_fd == 0) begin
@@ -195,24 +207,30 @@ initial begin
             $sformat(message, "%0s: line for sample %0d is missing or malformed", EXPECTED_FILE, index);
             fail_setup;
         end
+        if (vector_rst) since_reset = 0;
+        masked = since_reset < mask_samples;
+        if (masked) masked_count = masked_count + 1;
+        since_reset = since_reset + 1;
         rst = vector_rst;
         ce = 1'b1;
         bw_sel = vector_bw_sel;
         y_a = vector_y_a;
         y_b = vector_y_b;
         #1;
-        if (!vector_rst) begin
+        if (!vector_rst && !masked) begin
         if (mode_a !== expected_mode_a) begin
             mismatches = mismatches + 1;
             if (first_mismatch < 0) first_mismatch = index;
-            if (mismatches <= MAX_REPORTED)
+            if (max_mismatches > 0 && mismatches >= max_mismatches) stop_at_cap = 1'b1;
+            if (mismatches <= max_reported)
                 $display("MISMATCH sample %0d signal mode_a expected %h (%.9g) actual %h (%.9g)",
                     index, expected_mode_a, expected_mode_a * 1.0, mode_a, mode_a * 1.0);
         end
         if (mode_b !== expected_mode_b) begin
             mismatches = mismatches + 1;
             if (first_mismatch < 0) first_mismatch = index;
-            if (mismatches <= MAX_REPORTED)
+            if (max_mismatches > 0 && mismatches >= max_mismatches) stop_at_cap = 1'b1;
+            if (mismatches <= max_reported)
                 $display("MISMATCH sample %0d signal mode_b expected %h (%.9g) actual %h (%.9g)",
                     index, expected_mode_b, expected_mode_b * 1.0, mode_b, mode_b * 1.0);
         end
@@ -220,77 +238,93 @@ initial begin
         @(negedge clk);
         rst = 1'b0;
         ce = 1'b0;
-        if (out_valid !== expected_out_valid) begin
+        if (!masked && out_valid !== expected_out_valid) begin
             mismatches = mismatches + 1;
             if (first_mismatch < 0) first_mismatch = index;
-            if (mismatches <= MAX_REPORTED)
+            if (max_mismatches > 0 && mismatches >= max_mismatches) stop_at_cap = 1'b1;
+            if (mismatches <= max_reported)
                 $display("MISMATCH sample %0d signal out_valid expected %h (%.9g) actual %h (%.9g)",
                     index, expected_out_valid, expected_out_valid * 1.0, out_valid, out_valid * 1.0);
         end
-        if (expected_out_valid == 1'b1 && rate_out !== expected_rate_out) begin
+        if (!masked && expected_out_valid == 1'b1 && rate_out !== expected_rate_out) begin
             mismatches = mismatches + 1;
             if (first_mismatch < 0) first_mismatch = index;
-            if (mismatches <= MAX_REPORTED)
+            if (max_mismatches > 0 && mismatches >= max_mismatches) stop_at_cap = 1'b1;
+            if (mismatches <= max_reported)
                 $display("MISMATCH sample %0d signal rate_out expected %h (%.9g) actual %h (%.9g)",
                     index, expected_rate_out, $signed(expected_rate_out) / (2.0 ** 14), rate_out, $signed(rate_out) / (2.0 ** 14));
         end
-        if (bias_a !== expected_bias_a) begin
+        if (!masked && bias_a !== expected_bias_a) begin
             mismatches = mismatches + 1;
             if (first_mismatch < 0) first_mismatch = index;
-            if (mismatches <= MAX_REPORTED)
+            if (max_mismatches > 0 && mismatches >= max_mismatches) stop_at_cap = 1'b1;
+            if (mismatches <= max_reported)
                 $display("MISMATCH sample %0d signal bias_a expected %h (%.9g) actual %h (%.9g)",
                     index, expected_bias_a, $signed(expected_bias_a) / (2.0 ** 18), bias_a, $signed(bias_a) / (2.0 ** 18));
         end
-        if (bias_b !== expected_bias_b) begin
+        if (!masked && bias_b !== expected_bias_b) begin
             mismatches = mismatches + 1;
             if (first_mismatch < 0) first_mismatch = index;
-            if (mismatches <= MAX_REPORTED)
+            if (max_mismatches > 0 && mismatches >= max_mismatches) stop_at_cap = 1'b1;
+            if (mismatches <= max_reported)
                 $display("MISMATCH sample %0d signal bias_b expected %h (%.9g) actual %h (%.9g)",
                     index, expected_bias_b, $signed(expected_bias_b) / (2.0 ** 18), bias_b, $signed(bias_b) / (2.0 ** 18));
         end
-        if (estimated !== expected_estimated) begin
+        if (!masked && estimated !== expected_estimated) begin
             mismatches = mismatches + 1;
             if (first_mismatch < 0) first_mismatch = index;
-            if (mismatches <= MAX_REPORTED)
+            if (max_mismatches > 0 && mismatches >= max_mismatches) stop_at_cap = 1'b1;
+            if (mismatches <= max_reported)
                 $display("MISMATCH sample %0d signal estimated expected %h (%.9g) actual %h (%.9g)",
                     index, expected_estimated, expected_estimated * 1.0, estimated, estimated * 1.0);
         end
         if (index % 4 == 3) begin
             @(negedge clk);
             expected_out_valid = {1{1'b0}};
-            if (out_valid !== expected_out_valid) begin
+            if (!masked && out_valid !== expected_out_valid) begin
             mismatches = mismatches + 1;
                 if (first_mismatch < 0) first_mismatch = index;
-                if (mismatches <= MAX_REPORTED)
+                if (max_mismatches > 0 && mismatches >= max_mismatches) stop_at_cap = 1'b1;
+                if (mismatches <= max_reported)
                     $display("MISMATCH sample %0d signal out_valid expected %h (%.9g) actual %h (%.9g)",
                         index, expected_out_valid, expected_out_valid * 1.0, out_valid, out_valid * 1.0);
             end
-            if (bias_a !== expected_bias_a) begin
+            if (!masked && bias_a !== expected_bias_a) begin
             mismatches = mismatches + 1;
                 if (first_mismatch < 0) first_mismatch = index;
-                if (mismatches <= MAX_REPORTED)
+                if (max_mismatches > 0 && mismatches >= max_mismatches) stop_at_cap = 1'b1;
+                if (mismatches <= max_reported)
                     $display("MISMATCH sample %0d signal bias_a expected %h (%.9g) actual %h (%.9g)",
                         index, expected_bias_a, $signed(expected_bias_a) / (2.0 ** 18), bias_a, $signed(bias_a) / (2.0 ** 18));
             end
-            if (bias_b !== expected_bias_b) begin
+            if (!masked && bias_b !== expected_bias_b) begin
             mismatches = mismatches + 1;
                 if (first_mismatch < 0) first_mismatch = index;
-                if (mismatches <= MAX_REPORTED)
+                if (max_mismatches > 0 && mismatches >= max_mismatches) stop_at_cap = 1'b1;
+                if (mismatches <= max_reported)
                     $display("MISMATCH sample %0d signal bias_b expected %h (%.9g) actual %h (%.9g)",
                         index, expected_bias_b, $signed(expected_bias_b) / (2.0 ** 18), bias_b, $signed(bias_b) / (2.0 ** 18));
             end
-            if (estimated !== expected_estimated) begin
+            if (!masked && estimated !== expected_estimated) begin
             mismatches = mismatches + 1;
                 if (first_mismatch < 0) first_mismatch = index;
-                if (mismatches <= MAX_REPORTED)
+                if (max_mismatches > 0 && mismatches >= max_mismatches) stop_at_cap = 1'b1;
+                if (mismatches <= max_reported)
                     $display("MISMATCH sample %0d signal estimated expected %h (%.9g) actual %h (%.9g)",
                         index, expected_estimated, expected_estimated * 1.0, estimated, estimated * 1.0);
             end
         end
+        if (stop_at_cap) begin
+            $display("FAIL mismatches=%0d n=%0d first=%0d (stopped at max_mismatches)", mismatches, index + 1, first_mismatch);
+            $fatal(1, "tb_gyrofx_top: stopped at %0d mismatches", mismatches);
+        end
     end
 
     if (mismatches == 0) begin
-        $display("PASS n=%0d", VECTOR_COUNT);
+        if (masked_count > 0)
+            $display("PASS n=%0d masked=%0d", VECTOR_COUNT, masked_count);
+        else
+            $display("PASS n=%0d", VECTOR_COUNT);
         $finish;
     end else begin
         $display("FAIL mismatches=%0d n=%0d first=%0d", mismatches, VECTOR_COUNT, first_mismatch);

@@ -1,23 +1,11 @@
-//! The self-checking testbench of a [`Block`], generated (Verilog 2001 plus `$fatal`, run by
-//! Icarus and Verilator).
-//!
-//! It reads `<block>_stimulus.hex` and `<block>_expected.hex` (one line per clock-enable;
-//! line 1 a generated-by comment, line 2 the fields and formats, checked against the
-//! testbench's own), drives one sample per `ce` with an idle clock after every fourth, and
-//! compares: combinational outputs before the clock edge (not on reset samples), registered
-//! outputs 1 clock after it (gated ones only where their gate is expected 1), and on idle
-//! clocks pulses low and other registered outputs held. It prints the first mismatches with
-//! sample index, signal, expected and actual (hex and real), then one summary line
-//! `PASS n=<N>` or `FAIL mismatches=<M> n=<N> first=<index>`, and exits non-zero (`$fatal`)
-//! on a mismatch, a timeout, or a missing, short or mis-declared vector file or ROM image.
+//! The Verilog 2001 testbench (plus `$fatal`, supported by Icarus and Verilator); the behaviour
+//! and the options are those of [`crate::testbench`].
 
 use std::fmt::Write as _;
 
+use super::{header, MAX_REPORTED};
 use crate::block::{Block, Output, Signal, Timing};
 use crate::writers::Provenance;
-
-/// Most mismatches printed.
-const MAX_REPORTED: u32 = 10;
 
 fn declaration(kind: &str, s: &Signal, prefix: &str, init: bool) -> String {
     let signed = if s.format.signed { "signed " } else { "" };
@@ -34,16 +22,6 @@ fn declaration(kind: &str, s: &Signal, prefix: &str, init: bool) -> String {
     format!("{kind} {signed}{range}{prefix}{}{init};", s.name)
 }
 
-/// Field header of a vector file: `// rst:u1.0 name:format ...`.
-pub fn header(fields: &[&Signal], with_rst: bool) -> String {
-    let mut parts: Vec<String> = Vec::new();
-    if with_rst {
-        parts.push("rst:u1.0".into());
-    }
-    parts.extend(fields.iter().map(|s| format!("{}:{}", s.name, s.format)));
-    format!("// {}", parts.join(" "))
-}
-
 fn real_of(s: &Signal, expr: &str) -> String {
     if s.is_real() {
         format!("$signed({expr}) / (2.0 ** {})", s.format.frac)
@@ -57,7 +35,8 @@ fn mismatch(o: &Output) -> String {
     format!(
         "            mismatches = mismatches + 1;
             if (first_mismatch < 0) first_mismatch = index;
-            if (mismatches <= MAX_REPORTED)
+            if (max_mismatches > 0 && mismatches >= max_mismatches) stop_at_cap = 1'b1;
+            if (mismatches <= max_reported)
                 $display(\"MISMATCH sample %0d signal {name} expected %h (%.9g) actual %h (%.9g)\",
                     index, expected_{name}, {expected_real}, {name}, {actual_real});",
         name = s.name,
@@ -90,18 +69,19 @@ pub fn testbench(block: &Block, provenance: &Provenance) -> String {
  * formats declared on line 2 and checked here), drives one sample per ce with an
  * idle clock after every fourth, and compares combinational outputs before the
  * clock edge and registered outputs 1 clock after it. Prints the first
- * {max} mismatches, then PASS n=<N> or FAIL mismatches=<M> n=<N> first=<index>,
+ * mismatches, then PASS n=<N> [masked=<M>] or FAIL mismatches=<M> n=<N> first=<index>,
  * and exits non-zero ($fatal) on a mismatch, a timeout or a bad vector file.
- * Plusargs: +dump writes {tb}.vcd.
+ * Plusargs: +dump writes {tb}.vcd; +mask=<n> does not compare the first n samples
+ * of the run and from every reset sample on (latency mask); +max_reported=<n>
+ * prints n mismatches (default {max}); +max_mismatches=<n> stops at the n-th.
  */
 module {tb};
 
 `include \"{params}\"
 
-localparam integer MAX_REPORTED = {max};
 localparam integer CLOCK_PERIOD_NS = 10;
 // 64-bit: long vector sets overflow a 32-bit integer.
-localparam [63:0] TIMEOUT_NS = (64'd3 * VECTOR_COUNT + 64'd100) * CLOCK_PERIOD_NS;
+localparam [63:0] TIMEOUT_NS = 64'd{timeout_clocks} * CLOCK_PERIOD_NS;
 
 reg clk = 1'b0;
 always #(CLOCK_PERIOD_NS / 2) clk <= ~clk;
@@ -111,6 +91,7 @@ reg ce = 1'b0;",
         title = block.title,
         max = MAX_REPORTED,
         params = block.file("params.vh"),
+        timeout_clocks = super::timeout_clocks(block.len()),
     );
     for s in &block.inputs {
         let _ = writeln!(out, "{}", declaration("reg", s, "", true));
@@ -155,6 +136,13 @@ integer fields;
 integer index = 0;
 integer mismatches = 0;
 integer first_mismatch = -1;
+integer mask_samples = 0;
+integer max_reported = {MAX_REPORTED};
+integer max_mismatches = 0;
+integer since_reset = 0;
+integer masked_count = 0;
+reg masked = 1'b0;
+reg stop_at_cap = 1'b0;
 reg [8*1024-1:0] line;
 reg [8*400-1:0] message;
 reg vector_rst;"
@@ -194,7 +182,11 @@ initial begin
     $fatal(1, \"{tb}: timeout\");
 end
 
-initial begin"
+initial begin
+    if ($value$plusargs(\"mask=%d\", mask_samples) && mask_samples > 0)
+        $display(\"mask: %0d samples after each reset\", mask_samples);
+    if ($value$plusargs(\"max_reported=%d\", max_reported)) begin end
+    if ($value$plusargs(\"max_mismatches=%d\", max_mismatches)) begin end"
     );
     for (rom, _) in &block.roms {
         let _ = writeln!(
@@ -272,6 +264,10 @@ initial begin"
             $sformat(message, \"%0s: line for sample %0d is missing or malformed\", EXPECTED_FILE, index);
             fail_setup;
         end
+        if (vector_rst) since_reset = 0;
+        masked = since_reset < mask_samples;
+        if (masked) masked_count = masked_count + 1;
+        since_reset = since_reset + 1;
         rst = vector_rst;
         ce = 1'b1;",
         inputs = input_targets.join(", "),
@@ -288,7 +284,10 @@ initial begin"
         .filter(|o| o.timing == Timing::Combinational)
         .collect();
     if !combinational.is_empty() {
-        let _ = writeln!(out, "        #1;\n        if (!vector_rst) begin");
+        let _ = writeln!(
+            out,
+            "        #1;\n        if (!vector_rst && !masked) begin"
+        );
         for o in &combinational {
             let _ = writeln!(
                 out,
@@ -310,10 +309,10 @@ initial begin"
     {
         let condition = match o.gate {
             Some(gate) => format!(
-                "expected_{gate} == 1'b1 && {0} !== expected_{0}",
+                "!masked && expected_{gate} == 1'b1 && {0} !== expected_{0}",
                 o.signal.name
             ),
-            None => format!("{0} !== expected_{0}", o.signal.name),
+            None => format!("!masked && {0} !== expected_{0}", o.signal.name),
         };
         let _ = writeln!(
             out,
@@ -340,7 +339,7 @@ initial begin"
         }
         let _ = writeln!(
             out,
-            "            if ({0} !== expected_{0}) begin\n{1}\n            end",
+            "            if (!masked && {0} !== expected_{0}) begin\n{1}\n            end",
             o.signal.name,
             mismatch(o).replace("\n            ", "\n                ")
         );
@@ -348,10 +347,17 @@ initial begin"
     let _ = writeln!(
         out,
         "        end
+        if (stop_at_cap) begin
+            $display(\"FAIL mismatches=%0d n=%0d first=%0d (stopped at max_mismatches)\", mismatches, index + 1, first_mismatch);
+            $fatal(1, \"{tb}: stopped at %0d mismatches\", mismatches);
+        end
     end
 
     if (mismatches == 0) begin
-        $display(\"PASS n=%0d\", VECTOR_COUNT);
+        if (masked_count > 0)
+            $display(\"PASS n=%0d masked=%0d\", VECTOR_COUNT, masked_count);
+        else
+            $display(\"PASS n=%0d\", VECTOR_COUNT);
         $finish;
     end else begin
         $display(\"FAIL mismatches=%0d n=%0d first=%0d\", mismatches, VECTOR_COUNT, first_mismatch);
