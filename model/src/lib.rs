@@ -11,6 +11,7 @@ pub mod estimator;
 pub mod examples;
 pub mod fx;
 pub mod kf;
+pub mod mean_filter;
 pub mod plant;
 pub mod sequencer;
 pub mod stimulus;
