@@ -6,6 +6,7 @@
 #![warn(missing_docs)]
 
 pub mod analysis;
+pub mod ar_kf;
 pub mod chain;
 pub mod estimator;
 pub mod examples;

@@ -1,8 +1,9 @@
 //! Noise analysis of rate records (f64): the Allan family of deviations with confidence
 //! intervals ([`allan`]), the χ² distribution they need ([`chi2`]), and the five-term noise
-//! identification ([`noise`]).
+//! identification ([`noise`]), autoregressive models ([`ar`]).
 
 pub mod allan;
+pub mod ar;
 pub mod chi2;
 pub mod davar;
 pub mod noise;
