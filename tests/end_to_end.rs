@@ -26,7 +26,7 @@ fn default_package_passes_in_every_simulator_and_a_flipped_bit_fails_every_testb
     for sim in SIMULATORS {
         let log = ok(&["verify", "--out", &out, "--sim", sim]);
         let lines = pass_lines(&log);
-        assert_eq!(lines.len(), 8, "{sim}: {log}");
+        assert_eq!(lines.len(), 2 * BLOCKS.len(), "{sim}: {log}");
         for (pair, block) in lines.chunks(2).zip(BLOCKS) {
             assert_eq!(pair[0], format!("== {block}"), "{sim}: {log}");
             assert!(pair[1].starts_with("PASS n="), "{sim} {block}: {log}");
@@ -42,18 +42,22 @@ fn default_package_passes_in_every_simulator_and_a_flipped_bit_fails_every_testb
     }
 
     for block in BLOCKS {
-        let signal = flip_expected_bit(root, block, 1234);
+        let (signal, sample) = flip_checked_bit(root, block, 1234);
         for sim in SIMULATORS {
             let log = fails(&["verify", "--out", &out, "--sim", sim]);
             assert!(
-                log.contains(&format!("MISMATCH sample 1234 signal {signal}")),
+                log.contains(&format!("MISMATCH sample {sample} signal {signal}")),
                 "{sim} {block}: {log}"
             );
             assert!(log.contains("FAIL mismatches=1 n="), "{sim} {block}: {log}");
             // The other blocks still pass: verify runs them all.
-            assert_eq!(log.matches("PASS n=").count(), 3, "{sim} {block}: {log}");
+            assert_eq!(
+                log.matches("PASS n=").count(),
+                BLOCKS.len() - 1,
+                "{sim} {block}: {log}"
+            );
         }
-        flip_expected_bit(root, block, 1234);
+        flip_expected_bit(root, block, sample);
     }
     ok(&["verify", "--out", &out, "--sim", "iverilog"]);
 }
@@ -153,7 +157,11 @@ fn every_rounding_mode_and_wrapping_overflow_pass_in_icarus_and_ghdl() {
             "--sim",
             "iverilog,ghdl",
         ]);
-        assert_eq!(log.matches("PASS n=").count(), 8, "{name}: {log}");
+        assert_eq!(
+            log.matches("PASS n=").count(),
+            2 * BLOCKS.len(),
+            "{name}: {log}"
+        );
     }
 }
 
@@ -403,7 +411,11 @@ fn every_preset_generates_and_passes_in_icarus_and_ghdl() {
             "--sim",
             "iverilog,ghdl",
         ]);
-        assert_eq!(log.matches("PASS n=").count(), 8, "{preset}: {log}");
+        assert_eq!(
+            log.matches("PASS n=").count(),
+            2 * BLOCKS.len(),
+            "{preset}: {log}"
+        );
         let manifest = std::fs::read_to_string(out.join("manifest.json")).unwrap();
         assert!(manifest.contains(&format!("--preset {preset}")), "{preset}");
     }

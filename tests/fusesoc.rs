@@ -100,9 +100,12 @@ fn the_core_lists_every_rtl_file_and_lints_clean_in_fusesoc() {
         )
         .unwrap();
     }
-    for rom in ["kf_coefficients.mem", "estimator_gains.mem"] {
-        let from = root().join("vectors/roms").join(rom);
-        std::fs::copy(from, copy.path().join("vectors/roms").join(rom)).unwrap();
+    for entry in std::fs::read_dir(root().join("vectors/roms")).unwrap() {
+        let from = entry.unwrap().path();
+        if from.extension().is_some_and(|e| e == "mem") {
+            let name = from.file_name().unwrap();
+            std::fs::copy(&from, copy.path().join("vectors/roms").join(name)).unwrap();
+        }
     }
     let without_kf = core.replace("      - hdl/gyrofx_kf.v\n", "");
     assert_ne!(without_kf, core);

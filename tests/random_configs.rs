@@ -1,6 +1,7 @@
 //! Bit-exactness over breadth: random configs (formats, rounding and overflow modes, sequencer
-//! pattern, window and stagger, smoothing, KF bandwidths, rate scenario), each generated with
-//! 10⁵ samples and run through every block's testbench in Icarus.
+//! pattern, window and stagger, smoothing, KF bandwidths, rate scenario, mean-filter window,
+//! threshold and formats), each generated with 10⁵ samples and run through every block's
+//! testbench in Icarus.
 //!
 //! CI runs 20 configs (four tests of five, so the test harness spreads them over the cores).
 //! A longer run: `GYROFX_RANDOM_CONFIGS=<per test> GYROFX_RANDOM_SAMPLES=<n>
@@ -77,6 +78,8 @@ fn random_config(index: u64, samples: usize) -> String {
         .map(|_| format!("{}", c.real(0.02 * fs, highest * fs)))
         .collect();
     let scenario = c.pick(&["static", "constant", "sine", "steps", "ramp"]);
+    let mean_filter_frac = input_frac + c.int(-2, 4);
+    let mean_filter_width = input_integer + c.int(0, 2) + mean_filter_frac;
     format!(
         "# random config {index}
 samples = {samples}
@@ -122,6 +125,12 @@ input_format = \"s{input_width}.{input_frac}\"
 state_format = \"s{state_width}.{state_frac}\"
 output_format = \"s{output_width}.{output_frac}\"
 coefficient_width = {coefficient_width}
+
+[mean_filter]
+window = {window}
+threshold_dps = {threshold:?}
+output_format = \"s{mean_filter_width}.{mean_filter_frac}\"
+reciprocal_width = {mean_filter_reciprocal}
 ",
         seed = c.int(1, 1 << 40),
         rounding = c.pick(&["floor", "ceil", "zero", "nearest", "round", "convergent"]),
@@ -139,6 +148,9 @@ coefficient_width = {coefficient_width}
         smoothing = c.int(0, 3),
         bandwidths = bandwidths.join(", "),
         coefficient_width = c.int(14, 25),
+        window = c.int(2, 64),
+        threshold = c.real(0.0, 4.0),
+        mean_filter_reciprocal = c.int(12, 30),
     )
 }
 
@@ -176,7 +188,7 @@ fn generate_and_verify(first: u64) {
         let verified = gyrofx(&["verify", "--out", out, "--sim", &simulators]);
         let log = text(&verified);
         assert!(
-            verified.status.success() && log.matches("PASS n=").count() == 4 * runs,
+            verified.status.success() && log.matches("PASS n=").count() == BLOCKS.len() * runs,
             "random config {index} is not bit-exact in {simulators}:\n{toml}\n{log}"
         );
     }
@@ -221,6 +233,9 @@ fn the_random_configs_vary_every_knob() {
         "mean_format",
         "coefficient_width",
         "scenario",
+        "window",
+        "threshold_dps",
+        "reciprocal_width",
     ] {
         let mut values: Vec<&str> = configs
             .iter()

@@ -50,14 +50,54 @@ fn verilator_lint_is_clean_for_several_parameter_sets() {
     }
 }
 
-const ALL_RTL: [&str; 6] = [
+const ALL_RTL: [&str; 7] = [
     "gyrofx_quantize.v",
     "gyrofx_kf.v",
     "gyrofx_sequencer.v",
     "gyrofx_bias_estimator.v",
     "gyrofx_calibration.v",
     "gyrofx_top.v",
+    "gyrofx_mean_filter.v",
 ];
+
+#[test]
+fn the_mean_filter_lints_clean_for_several_parameter_sets() {
+    let dir = tempfile::tempdir().unwrap();
+    let sources = [hdl("gyrofx_quantize.v"), hdl("gyrofx_mean_filter.v")];
+    let sources: Vec<&str> = sources.iter().map(|p| p.to_str().unwrap()).collect();
+    let parameter_sets: [&[&str]; 3] = [
+        &[],
+        // The smallest window, floor rounding, wrapping.
+        &[
+            "-GWINDOW=2",
+            "-GCOUNT_W=2",
+            "-GSUM_W=25",
+            "-GDEV_W=27",
+            "-GSCALED_THRESHOLD=27'd100",
+            "-GROUNDING=0",
+            "-GSATURATE=0",
+        ],
+        // A window that fills its count exactly (31 of 5 bits), a narrow reciprocal.
+        &[
+            "-GWINDOW=31",
+            "-GSUM_W=29",
+            "-GRECIP_W=10",
+            "-GRECIP_F=8",
+            "-GOUT_W=30",
+            "-GOUT_F=20",
+        ],
+    ];
+    for params in parameter_sets {
+        let mut args = vec!["--lint-only", "-Wall", "--top-module", "gyrofx_mean_filter"];
+        args.extend_from_slice(params);
+        args.extend_from_slice(&sources);
+        let (ok, text) = run_tool("verilator", &args, dir.path());
+        assert!(
+            ok && text.trim().is_empty(),
+            "verilator -Wall {params:?}:\n{text}"
+        );
+    }
+}
 
 #[test]
 fn the_whole_chain_lints_clean_for_several_parameter_sets() {
@@ -115,6 +155,7 @@ fn icarus_compiles_without_warnings() {
             hdl("gyrofx_bias_estimator.v").to_str().unwrap(),
             hdl("gyrofx_calibration.v").to_str().unwrap(),
             hdl("gyrofx_top.v").to_str().unwrap(),
+            hdl("gyrofx_mean_filter.v").to_str().unwrap(),
         ],
         dir.path(),
     );
@@ -137,6 +178,19 @@ fn yosys_synthesizes_without_latches() {
     let (ok, text) = run_tool("yosys", &["-q", "-p", &script], dir.path());
     assert!(ok, "yosys:\n{text}");
     assert!(!text.to_lowercase().contains("latch inferred"), "{text}");
+
+    // The mean filter, with a ROM image of its 21 reciprocals.
+    let rom: String = (0..=20u32)
+        .map(|n| format!("{:05x}\n", (1u32 << 16) / n.max(1)))
+        .collect();
+    std::fs::write(dir.path().join("mean_filter_reciprocals.mem"), rom).unwrap();
+    let script = format!(
+        "read_verilog {} {}; synth -top gyrofx_mean_filter -run :coarse; proc; select -assert-none t:$dlatch t:$adlatch t:$dlatchsr; synth -top gyrofx_mean_filter; check -assert; stat",
+        hdl("gyrofx_quantize.v").display(),
+        hdl("gyrofx_mean_filter.v").display()
+    );
+    let (ok, text) = run_tool("yosys", &["-q", "-p", &script], dir.path());
+    assert!(ok, "yosys (mean filter):\n{text}");
 }
 
 /// Drives every input code of small formats through `gyrofx_quantize` in Icarus and compares
@@ -216,7 +270,7 @@ endmodule
 }
 
 /// The VHDL RTL in compile order (packages first).
-const VHDL_RTL: [&str; 7] = [
+const VHDL_RTL: [&str; 8] = [
     "gyrofx_mem_pkg.vhd",
     "gyrofx_quantize.vhd",
     "gyrofx_kf.vhd",
@@ -224,6 +278,7 @@ const VHDL_RTL: [&str; 7] = [
     "gyrofx_bias_estimator.vhd",
     "gyrofx_calibration.vhd",
     "gyrofx_top.vhd",
+    "gyrofx_mean_filter.vhd",
 ];
 
 /// GHDL's warnings that apply to this code, all as errors.
@@ -326,6 +381,35 @@ fn ghdl_analyses_the_vhdl_without_warnings_and_elaborates_several_parameter_sets
         !ok && text.contains("gains_2.mem holds 8 words; 16 are needed"),
         "{text}"
     );
+
+    // The mean filter: the default and the smallest window.
+    std::fs::write(dir.path().join("recip_20.mem"), zero_rom(21, 18)).unwrap();
+    std::fs::write(dir.path().join("recip_2.mem"), zero_rom(3, 12)).unwrap();
+    let mean_filter_sets: [&[&str]; 2] = [
+        &["-gROM_FILE=recip_20.mem"],
+        &[
+            "-gWINDOW=2",
+            "-gCOUNT_W=2",
+            "-gSUM_W=25",
+            "-gDEV_W=27",
+            "-gSCALED_THRESHOLD=000000000000000000001100100",
+            "-gRECIP_W=12",
+            "-gRECIP_F=10",
+            "-gROM_FILE=recip_2.mem",
+        ],
+    ];
+    for params in mean_filter_sets {
+        let mut args = vec![
+            "--elab-run",
+            "--std=08",
+            "--workdir=work",
+            "gyrofx_mean_filter",
+        ];
+        args.extend_from_slice(params);
+        args.push("--no-run");
+        let (ok, text) = run_tool("ghdl", &args, dir.path());
+        assert!(ok && text.trim().is_empty(), "ghdl {params:?}:\n{text}");
+    }
 }
 
 /// Drives every input code of small formats through the VHDL `gyrofx_quantize` in GHDL and

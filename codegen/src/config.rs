@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 use gyrofx_model::estimator::Spec as EstimatorSpec;
 use gyrofx_model::fx::{CoefficientFormat, Format, Overflow, Rounding};
 use gyrofx_model::kf::design::{Convergence, Method};
+use gyrofx_model::mean_filter::Spec as MeanFilterSpec;
 use gyrofx_model::plant::{GyroErrors, Plant};
 use gyrofx_model::sequencer::{Pattern, Schedule, ScheduleError};
 use gyrofx_model::stimulus::Scenario;
@@ -49,6 +50,9 @@ pub struct Config {
     pub estimator: EstimatorConfig,
     /// The Kalman filter.
     pub kf: KfConfig,
+    /// The mean filter with gross-error rejection (paper 003; a block of its own, beside the
+    /// chain).
+    pub mean_filter: MeanFilterConfig,
 }
 
 /// `[stimulus]`: the true rate Ω.
@@ -153,6 +157,20 @@ pub struct KfConfig {
     pub g2_format: Option<String>,
 }
 
+/// `[mean_filter]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeanFilterConfig {
+    /// L, samples per block.
+    pub window: u32,
+    /// r, °/s.
+    pub threshold_dps: f64,
+    /// Output format.
+    pub output_format: String,
+    /// Width of the 1/n codes.
+    pub reciprocal_width: u32,
+}
+
 /// Where the true rate comes from, validated.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Source {
@@ -201,6 +219,8 @@ pub struct Settings {
     pub estimator: EstimatorSpec,
     /// The KF.
     pub kf: KfSettings,
+    /// The mean filter (its input format is the KF's).
+    pub mean_filter: MeanFilterSpec,
 }
 
 /// The names of the presets, in the order `gyrofx init --preset` lists them.
@@ -583,11 +603,22 @@ impl Config {
                 "0..=32",
             ));
         }
+        let m = &self.mean_filter;
+        let mean_filter = MeanFilterSpec {
+            input,
+            output: parse_format("mean_filter.output_format", &m.output_format)?,
+            window: m.window,
+            threshold_dps: m.threshold_dps,
+            reciprocal_width: m.reciprocal_width,
+            rounding,
+            overflow,
+        };
         Ok(Settings {
             source,
             plant,
             estimator,
             kf,
+            mean_filter,
         })
     }
 }

@@ -41,6 +41,9 @@ pub enum Error {
     /// The estimator's plan is refused.
     #[error("estimator: {0}")]
     Estimator(gyrofx_model::estimator::PlanError),
+    /// The mean filter's plan is refused (the message names the `mean_filter.` field).
+    #[error("{0}")]
+    MeanFilter(gyrofx_model::mean_filter::PlanError),
     /// A bad input file (CSV).
     #[error("{path}: {message}")]
     Input {

@@ -142,20 +142,21 @@ pub fn build_package(
     progress("chain run");
     let kf = job.kf();
     let est = &job.chain.estimator;
+    let mf = &job.mean_filter;
     let kf_rom = Rom::kf(kf);
     let estimator_rom = Rom::estimator(est);
-    let kf_rom_file = RomFormat::Mem.file_name(&kf_rom.name);
-    let estimator_rom_file = RomFormat::Mem.file_name(&estimator_rom.name);
+    let mean_filter_rom = Rom::mean_filter(&job.mean_filter);
+    let image = |rom: &Rom| {
+        (
+            RomFormat::Mem.file_name(&rom.name),
+            rom::write(rom, RomFormat::Mem, provenance),
+        )
+    };
     let run = vectors::run(
         job,
-        (
-            kf_rom_file.clone(),
-            rom::write(&kf_rom, RomFormat::Mem, provenance),
-        ),
-        (
-            estimator_rom_file.clone(),
-            rom::write(&estimator_rom, RomFormat::Mem, provenance),
-        ),
+        image(&kf_rom),
+        image(&estimator_rom),
+        image(&mean_filter_rom),
     )?;
     progress("files");
     let mut package = Package::new();
@@ -165,7 +166,7 @@ pub fn build_package(
     for (name, source) in writers::RTL_SOURCES.iter().chain(&writers::VHDL_SOURCES) {
         package.add(format!("hdl/{name}"), *source);
     }
-    for rom in [&kf_rom, &estimator_rom] {
+    for rom in [&kf_rom, &estimator_rom, &mean_filter_rom] {
         for format in RomFormat::ALL {
             package.add(
                 format!("{ROM_FOLDER}/{}", format.file_name(&rom.name)),
@@ -222,7 +223,7 @@ pub fn build_package(
             "latency_clocks": 1,
             "designs": report::designs(&job.designs, kf),
             "coefficients": report::coefficients(kf),
-            "rom": {"file": kf_rom_file, "depth": kf.rom.len(), "word_bits": kf_rom.width(), "all_formats": ROM_FOLDER,
+            "rom": {"file": RomFormat::Mem.file_name(&kf_rom.name), "depth": kf.rom.len(), "word_bits": kf_rom.width(), "all_formats": ROM_FOLDER,
                     "packing": "word = {g1, g2}: g1 in the high bits; address = bw_sel"},
             "tie_cases": run.ties,
             "fixed_vs_float": run.kf_stats,
@@ -248,9 +249,28 @@ pub fn build_package(
             },
             "reciprocal": {"value": 1.0 / est.schedule.valid_count() as f64, "quantized": est.quantized_reciprocal(), "code": est.reciprocal_code as i64},
             "gains": {"designed": est.gains, "quantized": est.quantized_gains(), "all_shifts": est.gains_are_shifts(),
-                      "rom": {"file": estimator_rom_file, "word_bits": estimator_rom.width(), "all_formats": ROM_FOLDER, "order": "bias_a row over [mA0, mB0, mA1, ...], then bias_b row"}},
+                      "rom": {"file": RomFormat::Mem.file_name(&estimator_rom.name), "word_bits": estimator_rom.width(), "all_formats": ROM_FOLDER, "order": "bias_a row over [mA0, mB0, mA1, ...], then bias_b row"}},
             "smoothing_shift": est.smoothing_shift,
             "fixed_vs_float_bias": run.bias_stats,
+        },
+        "mean_filter": {
+            "window": mf.window,
+            "threshold_dps": job.config.mean_filter.threshold_dps,
+            "threshold_quantized_dps": mf.threshold_dps(),
+            "threshold_code": mf.threshold_code as i64,
+            "formats": {
+                "input": mf.input.to_string(),
+                "output": mf.output.to_string(),
+                "sum": mf.sum.to_string(),
+                "deviation": mf.deviation.to_string(),
+                "reciprocal": mf.reciprocal.to_string(),
+                "product": mf.product.to_string(),
+            },
+            "rom": {"file": RomFormat::Mem.file_name(&mean_filter_rom.name), "depth": mf.rom.len(), "word_bits": mean_filter_rom.width(), "all_formats": ROM_FOLDER,
+                    "order": "address = samples kept n: 1/n; address 0: 1/L (every sample rejected)"},
+            "stimulus": "gyro A's ADC samples with a gross error of 8 r every 53rd sample, the chain's reset, then directed blocks (samples at exactly r, at r + 1 LSB, all rejected, full scale, a full-scale spike)",
+            "latency_clocks": 1,
+            "fixed_vs_float": run.mean_filter_stats,
         },
         "chain": {
             "rounding": est.rounding.name(),

@@ -6,6 +6,7 @@ use gyrofx_model::chain;
 use gyrofx_model::estimator;
 use gyrofx_model::kf::design::{design_for_bandwidth, Design, Noise};
 use gyrofx_model::kf::{Plan, Spec};
+use gyrofx_model::mean_filter;
 
 use crate::config::{Config, KfSettings, Settings, Source};
 use crate::error::{Error, Result};
@@ -22,6 +23,8 @@ pub struct Job {
     pub designs: Vec<Design>,
     /// The chain's plans (estimator with the sequencer's schedule, and the KF).
     pub chain: chain::Plan,
+    /// The mean filter's plan.
+    pub mean_filter: mean_filter::Plan,
 }
 
 /// Designs one filter per bandwidth of `settings` at `fs_hz` for the noise model (°/√h, °/h/√h).
@@ -91,11 +94,14 @@ impl Job {
             value: String::new(),
             allowed: e.to_string(),
         })?;
+        let mean_filter =
+            mean_filter::Plan::new(&settings.mean_filter).map_err(Error::MeanFilter)?;
         Ok(Job {
             config,
             settings,
             designs,
             chain,
+            mean_filter,
         })
     }
 

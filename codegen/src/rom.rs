@@ -10,6 +10,7 @@ use std::fmt::Write as _;
 use gyrofx_model::estimator;
 use gyrofx_model::fx::Format;
 use gyrofx_model::kf::{Plan, COEFFICIENT_NAMES};
+use gyrofx_model::mean_filter;
 
 use crate::writers::Provenance;
 
@@ -96,6 +97,31 @@ impl Rom {
                 format: plan.gain,
             }],
             codes,
+            notes,
+        }
+    }
+
+    /// The mean filter's reciprocal ROM: `1/n` at address `n` (the kept count), and at
+    /// address 0 `1/L` (every sample rejected: the plain mean).
+    pub fn mean_filter(plan: &mean_filter::Plan) -> Rom {
+        let notes = (0..=plan.window as usize)
+            .map(|n| {
+                let divisor = if n == 0 { plan.window as usize } else { n };
+                let what = if n == 0 { "none kept: 1/L" } else { "1/n" };
+                format!("{what} = 1/{divisor}: {}", plan.reciprocal_at(n))
+            })
+            .collect();
+        Rom {
+            name: "mean_filter_reciprocals".into(),
+            description: format!(
+                "mean-filter reciprocals 1/n ({}), address = samples kept (0: 1/L)",
+                plan.reciprocal
+            ),
+            fields: vec![Field {
+                name: "recip".into(),
+                format: plan.reciprocal,
+            }],
+            codes: plan.rom.iter().map(|c| vec![*c]).collect(),
             notes,
         }
     }

@@ -66,8 +66,16 @@ fn chparams(block: &Block) -> String {
         .collect()
 }
 
+/// The RTL of `gyrofx_top`: every source but the mean filter, a block beside the chain (yosys
+/// would otherwise load its ROM image while reading it).
+fn chain_sources() -> impl Iterator<Item = &'static (&'static str, &'static str)> {
+    writers::RTL_SOURCES
+        .iter()
+        .filter(|(name, _)| *name != "gyrofx_mean_filter.v")
+}
+
 fn read_sources() -> String {
-    let names: Vec<&str> = writers::RTL_SOURCES.iter().map(|(n, _)| *n).collect();
+    let names: Vec<&str> = chain_sources().map(|(n, _)| *n).collect();
     format!("read_verilog {}\n", names.join(" "))
 }
 
@@ -219,10 +227,10 @@ pub fn synthesize(job: &Job, out: &Path, provenance: &Provenance) -> Result<Reso
     let estimator_rom = Rom::estimator(&job.chain.estimator);
     let kf_name = RomFormat::Mem.file_name(&kf_rom.name);
     let estimator_name = RomFormat::Mem.file_name(&estimator_rom.name);
-    let [_, _, _, top] = empty_blocks(job, &kf_name, &estimator_name);
+    // The chain only: the mean filter is a block beside it, not part of gyrofx_top.
+    let [_, _, _, top, _] = empty_blocks(job, &kf_name, &estimator_name, "");
 
-    let mut inputs: Vec<(String, String)> = writers::RTL_SOURCES
-        .iter()
+    let mut inputs: Vec<(String, String)> = chain_sources()
         .map(|(n, s)| (n.to_string(), s.to_string()))
         .collect();
     inputs.push((kf_name, rom::write(&kf_rom, RomFormat::Mem, provenance)));

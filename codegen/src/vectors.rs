@@ -11,6 +11,7 @@ use gyrofx_model::chain::{FixedChain, FloatChain};
 use gyrofx_model::estimator::OverflowCounts as EstimatorOverflows;
 use gyrofx_model::kf::bound::rate_error_bound_lsb;
 use gyrofx_model::kf::{FixedKf, FloatKf, OverflowCounts, Plan};
+use gyrofx_model::mean_filter::{self, FixedMeanFilter, FloatMeanFilter};
 use gyrofx_model::sequencer::Sequencer;
 use gyrofx_model::stimulus::adc;
 use serde::Serialize;
@@ -108,6 +109,8 @@ pub struct Overflows {
     pub kf_chain: KfCounts,
     /// The KF's directed segment (full scale included).
     pub kf_directed: KfCounts,
+    /// The mean filter's output (its full-scale blocks may round past the range).
+    pub mean_filter: u64,
 }
 
 /// Estimator overflow counts (serializable mirror).
@@ -181,7 +184,7 @@ pub struct Report {
 /// Everything the run produced.
 #[derive(Clone, Debug)]
 pub struct Run {
-    /// The blocks' vectors: sequencer, estimator, kf, top.
+    /// The blocks' vectors: sequencer, estimator, kf, top, mean_filter.
     pub blocks: Vec<Block>,
     /// KF block: fixed vs float on its own inputs (chain part), in output LSB.
     pub kf_stats: ErrorStats,
@@ -189,6 +192,9 @@ pub struct Run {
     pub chain_stats: ErrorStats,
     /// Bias estimates: fixed vs float, in LSB of the bias format.
     pub bias_stats: ErrorStats,
+    /// Mean filter outputs that fit: fixed vs float (same quantized r), in output LSB; ideal:
+    /// r unquantized.
+    pub mean_filter_stats: ErrorStats,
     /// Overflow counts.
     pub overflows: Overflows,
     /// KF tie cases found.
@@ -212,9 +218,14 @@ fn mode_bit(p: i8) -> i128 {
     i128::from(p > 0)
 }
 
-/// The blocks (sequencer, estimator, KF, top) with their parameters and ROM file names, without
-/// vectors.
-pub fn empty_blocks(job: &Job, rom_kf: &str, rom_estimator: &str) -> [Block; 4] {
+/// The blocks (sequencer, estimator, KF, top, mean filter) with their parameters and ROM file
+/// names, without vectors.
+pub fn empty_blocks(
+    job: &Job,
+    rom_kf: &str,
+    rom_estimator: &str,
+    rom_mean_filter: &str,
+) -> [Block; 5] {
     let est = &job.chain.estimator;
     let kf = job.kf();
     let schedule = &est.schedule;
@@ -424,8 +435,172 @@ pub fn empty_blocks(job: &Job, rom_kf: &str, rom_estimator: &str) -> [Block; 4] 
     );
     top.params
         .push(Param::string("KF_ROM_FILE", rom_kf, "KF coefficient ROM"));
-    top.params.extend(modes);
-    [sequencer, estimator, kf_block, top]
+    top.params.extend(modes.clone());
+    let mean_filter = mean_filter_block(&job.mean_filter, modes.to_vec(), rom_mean_filter);
+    [sequencer, estimator, kf_block, top, mean_filter]
+}
+
+/// The mean filter's block (no vectors): parameters from its plan.
+fn mean_filter_block(plan: &mean_filter::Plan, modes: Vec<Param>, rom: &str) -> Block {
+    let mut block = Block::new(
+        "mean_filter",
+        "gyrofx_mean_filter",
+        "mean filter with gross-error rejection (paper 003)",
+        vec![Signal::new("x", plan.input)],
+        vec![
+            Output::pulse(Signal::flag("y_valid")),
+            Output::gated(Signal::new("y", plan.output), "y_valid"),
+            Output::gated(Signal::index("kept", plan.count_bits), "y_valid"),
+        ],
+    );
+    block
+        .params
+        .extend(Param::format("IN", plan.input, "input x"));
+    block
+        .params
+        .extend(Param::format("OUT", plan.output, "output y"));
+    block.params.push(Param::integer(
+        "WINDOW",
+        plan.window.into(),
+        "L: samples per block",
+    ));
+    block.params.push(Param::integer(
+        "COUNT_W",
+        plan.count_bits.into(),
+        "kept count width",
+    ));
+    block.params.push(Param::integer(
+        "SUM_W",
+        plan.sum.width.into(),
+        format!("block sum: {}", plan.sum),
+    ));
+    block.params.push(Param::integer(
+        "DEV_W",
+        plan.deviation.width.into(),
+        format!("L*x - sum: {}", plan.deviation),
+    ));
+    block.params.push(Param::bits(
+        "SCALED_THRESHOLD",
+        plan.deviation.width,
+        plan.scaled_threshold as u128,
+        format!("L*r in input LSB (r = {} °/s)", plan.threshold_dps()),
+    ));
+    block
+        .params
+        .extend(Param::format("RECIP", plan.reciprocal, "reciprocals 1/n"));
+    block.params.extend(modes);
+    block
+        .params
+        .push(Param::string("ROM_FILE", rom, "reciprocal ROM"));
+    block
+}
+
+/// Gross errors added to gyro A's samples for the mean filter's vectors (the plant has none):
+/// every `GROSS_ERROR_PERIOD`-th sample, ±`GROSS_ERROR_SCALE`·r, alternating in sign.
+const GROSS_ERROR_PERIOD: usize = 53;
+const GROSS_ERROR_SCALE: i128 = 8;
+
+/// Fills the mean filter's block: gyro A's ADC samples `x` with gross errors added, a reset at
+/// `reset_at`, then a directed segment (see [`mean_filter_directed`]). Returns the fixed vs
+/// float statistics and the output overflows.
+fn mean_filter_vectors(
+    plan: &mean_filter::Plan,
+    x: &[i64],
+    reset_at: Option<usize>,
+    block: &mut Block,
+) -> (ErrorStats, u64) {
+    let mut fixed = FixedMeanFilter::new(plan);
+    let mut float = FloatMeanFilter::new(plan);
+    let mut ideal = FloatMeanFilter::with_threshold(plan.window, plan.threshold_dps());
+    let mut acc = Accumulator::default();
+    let mut overflows = 0u64;
+    let lsb = plan.output.lsb();
+    let (min, max) = (plan.input.min_code(), plan.input.max_code());
+    let mut samples: Vec<Option<i64>> = x
+        .iter()
+        .enumerate()
+        .map(|(k, &code)| {
+            let gross = if k % GROSS_ERROR_PERIOD == GROSS_ERROR_PERIOD / 3 {
+                let sign = if (k / GROSS_ERROR_PERIOD).is_multiple_of(2) {
+                    1
+                } else {
+                    -1
+                };
+                sign * GROSS_ERROR_SCALE * plan.threshold_code.max(1)
+            } else {
+                0
+            };
+            Some((i128::from(code) + gross).clamp(min, max) as i64)
+        })
+        .collect();
+    if let Some(at) = reset_at {
+        samples.insert(at.min(samples.len()), None);
+    }
+    samples.extend(mean_filter_directed(plan));
+    block.reserve(samples.len());
+    for sample in samples {
+        let Some(code) = sample else {
+            fixed.reset();
+            float.reset();
+            ideal.reset();
+            block.push(true, &[0], &[0, 0, 0]);
+            continue;
+        };
+        let real = plan.input.to_f64(i128::from(code));
+        let a = fixed.step(code);
+        let b = float.step(real);
+        let c = ideal.step(real);
+        match (a, b, c) {
+            (Some(a), Some((b, _)), Some((c, _))) => {
+                // The bound holds where the output fits (full scale may round past it).
+                if a.overflowed {
+                    overflows += 1;
+                } else {
+                    acc.add(plan.output.to_f64(i128::from(a.y)), b, c, lsb);
+                }
+                block.push(
+                    false,
+                    &[i128::from(code)],
+                    &[1, i128::from(a.y), i128::from(a.kept)],
+                );
+            }
+            _ => block.push(false, &[i128::from(code)], &[0, 0, 0]),
+        }
+    }
+    (acc.finish(plan.error_bound_lsb()), overflows)
+}
+
+/// The mean filter's directed blocks, after a reset: every sample kept at exactly `±r` from
+/// the mean and every one rejected one LSB farther, every sample rejected (two clusters: the
+/// plain mean), full scale positive and negative, and one gross error at full scale.
+fn mean_filter_directed(plan: &mean_filter::Plan) -> Vec<Option<i64>> {
+    let window = plan.window as usize;
+    let r = plan.threshold_code as i64;
+    let (min, max) = (plan.input.min_code() as i64, plan.input.max_code() as i64);
+    let alternating = |offset: i64| -> Vec<Option<i64>> {
+        (0..window)
+            .map(|i| {
+                let sign = if i.is_multiple_of(2) { 1 } else { -1 };
+                // An odd window's last sample sits on the mean.
+                let value = if !window.is_multiple_of(2) && i == window - 1 {
+                    0
+                } else {
+                    sign * offset
+                };
+                Some(value.clamp(min, max))
+            })
+            .collect()
+    };
+    let mut samples = vec![None];
+    samples.extend(alternating(r));
+    samples.extend(alternating(r + 1));
+    samples.extend(alternating(3 * r + 2));
+    samples.extend(vec![Some(max); window]);
+    samples.extend(vec![Some(min); window]);
+    let mut spike = vec![Some(0); window];
+    spike[window / 2] = Some(max);
+    samples.extend(spike);
+    samples
 }
 
 /// Runs the chain for `job` and builds every block's vectors. `rom_kf` / `rom_estimator` are
@@ -433,7 +608,12 @@ pub fn empty_blocks(job: &Job, rom_kf: &str, rom_estimator: &str) -> [Block; 4] 
 ///
 /// # Errors
 /// Stimulus errors (a bad CSV file).
-pub fn run(job: &Job, rom_kf: (String, String), rom_estimator: (String, String)) -> Result<Run> {
+pub fn run(
+    job: &Job,
+    rom_kf: (String, String),
+    rom_estimator: (String, String),
+    rom_mean_filter: (String, String),
+) -> Result<Run> {
     let plan = &job.chain;
     let kf = job.kf();
     let est = &plan.estimator;
@@ -461,8 +641,9 @@ pub fn run(job: &Job, rom_kf: (String, String), rom_estimator: (String, String))
     let (ya, sat_a) = adc(&record.y[0], est.input);
     let (yb, sat_b) = adc(&record.y[1], est.input);
 
-    let [mut seq_block, mut est_block, mut kf_block, mut top_block] =
-        empty_blocks(job, &rom_kf.0, &rom_estimator.0);
+    let [mut seq_block, mut est_block, mut kf_block, mut top_block, mut mean_filter_block] =
+        empty_blocks(job, &rom_kf.0, &rom_estimator.0, &rom_mean_filter.0);
+    mean_filter_block.roms.push(rom_mean_filter);
     for block in [
         &mut seq_block,
         &mut est_block,
@@ -652,6 +833,9 @@ pub fn run(job: &Job, rom_kf: (String, String), rom_estimator: (String, String))
             ("true_rate_dps", extra_true),
         ];
 
+        let (mean_filter_stats, mean_filter_overflows) =
+            mean_filter_vectors(&job.mean_filter, &ya, reset_at, &mut mean_filter_block);
+
         let raw = raw_record
             .join()
             .expect("the plant simulation does not panic");
@@ -670,15 +854,17 @@ pub fn run(job: &Job, rom_kf: (String, String), rom_estimator: (String, String))
             ],
         );
         Ok(Run {
-            blocks: vec![seq_block, est_block, kf_block, top_block],
+            blocks: vec![seq_block, est_block, kf_block, top_block, mean_filter_block],
             kf_stats,
             chain_stats,
             bias_stats,
+            mean_filter_stats,
             overflows: Overflows {
                 adc: [sat_a, sat_b],
                 estimator: estimator_overflows.into(),
                 kf_chain: kf_chain_overflows.into(),
                 kf_directed: directed_overflows.into(),
+                mean_filter: mean_filter_overflows,
             },
             ties,
             report,
@@ -812,10 +998,14 @@ mod tests {
             &job,
             ("kf.mem".into(), String::new()),
             ("est.mem".into(), String::new()),
+            ("mf.mem".into(), String::new()),
         )
         .unwrap();
         let names: Vec<&str> = run.blocks.iter().map(|b| b.name).collect();
-        assert_eq!(names, ["sequencer", "estimator", "kf", "top"]);
+        assert_eq!(
+            names,
+            ["sequencer", "estimator", "kf", "top", "mean_filter"]
+        );
         // One row per sample plus the reset, in every chain block.
         for b in [&run.blocks[0], &run.blocks[1], &run.blocks[3]] {
             assert_eq!(b.len(), 4001, "{}", b.name);
@@ -834,5 +1024,49 @@ mod tests {
             .map(|k| run.blocks[3].row(k)[1])
             .collect();
         assert_eq!(sels.len(), 3);
+    }
+
+    /// The mean filter's vectors: one output per block of 20, kept counts from 0 (every
+    /// sample rejected) to 20, the gross errors rejected, and fixed within the bound of float.
+    #[test]
+    fn the_mean_filter_vectors_cover_every_case_within_the_bound() {
+        let mut config = Config::embedded();
+        config.samples = 4000;
+        // r = 3 °/s, about 2.6 sigma of the default gyro: only the gross errors (8 r) go.
+        config.mean_filter.threshold_dps = 3.0;
+        let job = Job::new(config).unwrap();
+        let run = run(
+            &job,
+            ("kf.mem".into(), String::new()),
+            ("est.mem".into(), String::new()),
+            ("mf.mem".into(), String::new()),
+        )
+        .unwrap();
+        let block = &run.blocks[4];
+        // rst, x, y_valid, y, kept
+        let outputs: Vec<&[i64]> = (0..block.len())
+            .map(|k| block.row(k))
+            .filter(|row| row[2] == 1)
+            .collect();
+        // 4000 samples with a reset at 3600: 180 + 20 blocks, then 6 directed ones.
+        assert_eq!(outputs.len(), 180 + 20 + 6);
+        let kept: std::collections::BTreeSet<i64> = outputs.iter().map(|row| row[4]).collect();
+        assert!(
+            kept.contains(&0) && kept.contains(&20) && kept.contains(&19),
+            "{kept:?}"
+        );
+        // Every block with a gross error (before the reset, blocks start at multiples of 20)
+        // drops at least that sample.
+        let gross_blocks: Vec<usize> = (0..180)
+            .filter(|b| {
+                (20 * b..20 * b + 20).any(|k| k % GROSS_ERROR_PERIOD == GROSS_ERROR_PERIOD / 3)
+            })
+            .collect();
+        assert!(gross_blocks.len() > 50, "{}", gross_blocks.len());
+        for b in gross_blocks {
+            assert!(outputs[b][4] < 20, "block {b} kept its gross error");
+        }
+        assert!(run.mean_filter_stats.max_lsb <= run.mean_filter_stats.bound_lsb);
+        assert!(run.mean_filter_stats.samples >= 200);
     }
 }

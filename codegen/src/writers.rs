@@ -12,7 +12,7 @@ use crate::testbench::header;
 use crate::vectors::Run;
 
 /// The reference RTL, embedded so that every package is self-contained.
-pub const RTL_SOURCES: [(&str, &str); 6] = [
+pub const RTL_SOURCES: [(&str, &str); 7] = [
     (
         "gyrofx_quantize.v",
         include_str!("../../hdl/gyrofx_quantize.v"),
@@ -31,11 +31,15 @@ pub const RTL_SOURCES: [(&str, &str); 6] = [
         include_str!("../../hdl/gyrofx_calibration.v"),
     ),
     ("gyrofx_top.v", include_str!("../../hdl/gyrofx_top.v")),
+    (
+        "gyrofx_mean_filter.v",
+        include_str!("../../hdl/gyrofx_mean_filter.v"),
+    ),
 ];
 
 /// The reference RTL in VHDL-2008, in compile order (packages first), and the package the VHDL
 /// testbenches share (last: simulation only).
-pub const VHDL_SOURCES: [(&str, &str); 8] = [
+pub const VHDL_SOURCES: [(&str, &str); 9] = [
     (
         "gyrofx_mem_pkg.vhd",
         include_str!("../../hdl/gyrofx_mem_pkg.vhd"),
@@ -58,6 +62,10 @@ pub const VHDL_SOURCES: [(&str, &str); 8] = [
         include_str!("../../hdl/gyrofx_calibration.vhd"),
     ),
     ("gyrofx_top.vhd", include_str!("../../hdl/gyrofx_top.vhd")),
+    (
+        "gyrofx_mean_filter.vhd",
+        include_str!("../../hdl/gyrofx_mean_filter.vhd"),
+    ),
     (
         "gyrofx_testbench_pkg.vhd",
         include_str!("../../hdl/gyrofx_testbench_pkg.vhd"),
@@ -394,7 +402,8 @@ field and its format. `report.md` has the Allan table; `manifest.json` the confi
 SHA-256 of every file, overflow counts and fixed-vs-float error statistics.
 
 Fixed vs float (same quantized coefficients): KF max {kf:.3} LSB (bound {kfb:.3}), chain max
-{ch:.3} LSB (bound {chb:.3}), bias estimates max {bi:.3} LSB (bound {bib:.3}).
+{ch:.3} LSB (bound {chb:.3}), bias estimates max {bi:.3} LSB (bound {bib:.3}), mean filter max
+{mf:.3} LSB (bound {mfb:.3}).
 ",
         kf = run.kf_stats.max_lsb,
         kfb = run.kf_stats.bound_lsb,
@@ -402,6 +411,8 @@ Fixed vs float (same quantized coefficients): KF max {kf:.3} LSB (bound {kfb:.3}
         chb = run.chain_stats.bound_lsb,
         bi = run.bias_stats.max_lsb,
         bib = run.bias_stats.bound_lsb,
+        mf = run.mean_filter_stats.max_lsb,
+        mfb = run.mean_filter_stats.bound_lsb,
     );
     out
 }

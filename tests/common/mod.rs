@@ -118,8 +118,26 @@ pub fn flip_expected_bit(package: &Path, block: &str, sample: usize) -> String {
     signal
 }
 
+/// Like [`flip_expected_bit`], at the first sample from `from` whose outputs are compared:
+/// where a block's first field is a `*_valid` strobe, a line with it 1 (its other outputs are
+/// gated by it). Returns the field flipped and the sample.
+pub fn flip_checked_bit(package: &Path, block: &str, from: usize) -> (String, usize) {
+    let path = package.join(block).join(format!("{block}_expected.hex"));
+    let content = std::fs::read_to_string(&path).unwrap();
+    let lines: Vec<&str> = content.lines().collect();
+    let gated = lines[1]
+        .trim_start_matches("// ")
+        .split(' ')
+        .next()
+        .is_some_and(|first| first.split(':').next().unwrap().ends_with("valid"));
+    let sample = (from..lines.len() - 2)
+        .find(|k| !gated || lines[2 + k].starts_with('1'))
+        .expect("a compared sample");
+    (flip_expected_bit(package, block, sample), sample)
+}
+
 /// The blocks of a package, in Makefile order.
-pub const BLOCKS: [&str; 4] = ["sequencer", "estimator", "kf", "top"];
+pub const BLOCKS: [&str; 5] = ["sequencer", "estimator", "kf", "top", "mean_filter"];
 
 /// Every simulator `gyrofx verify` runs.
 pub const SIMULATORS: [&str; 3] = ["iverilog", "verilator", "ghdl"];
