@@ -12,6 +12,7 @@ use gyrofx_codegen::input::{read_column, read_column_with_gaps};
 use gyrofx_codegen::job::{design_bandwidths, plan_for, Job};
 use gyrofx_codegen::junit;
 use gyrofx_codegen::report;
+use gyrofx_codegen::reproduce;
 use gyrofx_codegen::simulate::{self, Simulator};
 use gyrofx_model::fx::{from_f64, Overflow, Rounding};
 use gyrofx_model::kf::design::{design, design_for_bandwidth, Convergence, Method, Noise};
@@ -203,6 +204,22 @@ enum Command {
         #[arg(long)]
         output: PathBuf,
     },
+    /// Run a paper's pipeline on simulated data and print its tables beside gyrofx's, with
+    /// the differences explained (markdown). Implemented: 003.
+    Reproduce {
+        /// The paper: 003 (000, 002 and 004 are not implemented yet).
+        #[arg(long)]
+        paper: String,
+        /// Samples to simulate (default: the paper's record length).
+        #[arg(long)]
+        samples: Option<usize>,
+        /// Seed of the simulation.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Also write the report to this markdown file.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
 }
 
 fn main() -> ExitCode {
@@ -227,6 +244,12 @@ fn run(cli: Cli) -> Result<ExitCode> {
             json,
             plot,
         } => run_allan(&input, &column, rate, &taus, &kind, json, plot.as_deref()),
+        Command::Reproduce {
+            paper,
+            samples,
+            seed,
+            out,
+        } => run_reproduce(&paper, samples, seed, out.as_deref()),
         Command::Davar {
             input,
             column,
@@ -503,6 +526,27 @@ fn run_generate(
             adev.join(" ")
         );
     }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn run_reproduce(
+    paper: &str,
+    samples: Option<usize>,
+    seed: u64,
+    out: Option<&Path>,
+) -> Result<ExitCode> {
+    let report = match paper {
+        "003" => reproduce::paper_003(samples.unwrap_or(reproduce::SAMPLES), seed)?.markdown(),
+        "000" | "002" | "004" => bail!(
+            "--paper {paper}: not implemented yet (reproduce covers 003; 000, 002 and 004 are open work)"
+        ),
+        other => bail!("--paper {other:?} is not one of the papers: use 000, 002, 003 or 004"),
+    };
+    if let Some(path) = out {
+        std::fs::write(path, &report)
+            .with_context(|| format!("cannot write the report {}", path.display()))?;
+    }
+    print!("{report}");
     Ok(ExitCode::SUCCESS)
 }
 

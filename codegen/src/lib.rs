@@ -17,6 +17,7 @@ pub mod junit;
 pub mod package;
 pub mod plot;
 pub mod report;
+pub mod reproduce;
 pub mod rom;
 pub mod simulate;
 pub mod synth;
