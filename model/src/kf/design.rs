@@ -132,7 +132,7 @@ pub enum DesignError {
         tolerance: f64,
     },
     /// The target bandwidth cannot be reached at this sample rate.
-    #[error("bandwidth {target_hz} Hz cannot be designed at fs = {fs_hz} Hz with this method: it reaches at most {max_hz} Hz (the direct method fs/2; the paper's discretisation saturates lower), and the target must be > 0")]
+    #[error("bandwidth {target_hz} Hz cannot be designed at fs = {fs_hz} Hz with this method: it reaches at most {max_hz} Hz (the direct method fs/2 = {} Hz; the paper's discretisation saturates lower), and the target must be > 0", .fs_hz / 2.0)]
     BandwidthUnreachable {
         /// The bandwidth asked for, Hz.
         target_hz: f64,
