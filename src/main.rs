@@ -56,6 +56,22 @@ enum Command {
         #[arg(long)]
         plot: Option<PathBuf>,
     },
+    /// AR(1..p) models of a record by Yule–Walker (Levinson–Durbin), each with its AIC, and the
+    /// order AIC picks (paper 003).
+    Ar {
+        /// CSV file with a header line; `#` lines and empty cells are skipped.
+        #[arg(long)]
+        input: PathBuf,
+        /// Column to model.
+        #[arg(long, default_value = "rate_dps")]
+        column: String,
+        /// Largest order.
+        #[arg(long, default_value_t = 3)]
+        max_order: usize,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// Dynamic Allan deviation: the ADEV of a window sliding along the record, fixed or
     /// PID-adapted (paper 002), with the noise coefficients over time and the disturbances.
     Davar {
@@ -244,6 +260,12 @@ fn run(cli: Cli) -> Result<ExitCode> {
             json,
             plot,
         } => run_allan(&input, &column, rate, &taus, &kind, json, plot.as_deref()),
+        Command::Ar {
+            input,
+            column,
+            max_order,
+            json,
+        } => run_ar(&input, &column, max_order, json),
         Command::Reproduce {
             paper,
             samples,
@@ -525,6 +547,45 @@ fn run_generate(
             line.bias_error_dps,
             adev.join(" ")
         );
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn run_ar(input: &Path, column: &str, max_order: usize, json: bool) -> Result<ExitCode> {
+    use gyrofx_model::analysis::ar;
+    let (values, _) = read_column_with_gaps(input, column)?;
+    let models = ar::fit_orders(&values, max_order)
+        .map_err(|e| anyhow::anyhow!("{}, column {column}: {e}", input.display()))?;
+    let chosen = ar::select_by_aic(&models).order;
+    if json {
+        let value = serde_json::json!({
+            "samples": values.len(),
+            "aic_order": chosen,
+            "models": models.iter().map(|m| serde_json::json!({
+                "order": m.order,
+                "coefficients": m.coefficients,
+                "noise_variance": m.noise_variance,
+                "aic": m.aic,
+            })).collect::<Vec<_>>(),
+        });
+        println!("{}", serde_json::to_string_pretty(&value)?);
+    } else {
+        println!(
+            "{} samples of {column}; AIC = N ln(sigma_a^2) + 2n",
+            values.len()
+        );
+        println!("order  sigma_a^2      AIC            coefficients (phi1..phip)");
+        for m in &models {
+            let phi: Vec<String> = m.coefficients.iter().map(|c| format!("{c:+.5}")).collect();
+            let mark = if m.order == chosen { "  <- AIC" } else { "" };
+            println!(
+                "{:>5}  {:<13.6e}  {:<13.4}  {}{mark}",
+                m.order,
+                m.noise_variance,
+                m.aic,
+                phi.join(" ")
+            );
+        }
     }
     Ok(ExitCode::SUCCESS)
 }

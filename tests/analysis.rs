@@ -1,4 +1,5 @@
-//! `gyrofx allan`: JSON fields, agreement with the library on a known record, and bad input.
+//! `gyrofx allan` and `gyrofx ar`: JSON fields, agreement with the library on a known record,
+//! and bad input.
 
 mod common;
 
@@ -346,4 +347,68 @@ fn plots_are_written_as_png_or_svg() {
             .any(|n| n.contains("refused") || n.starts_with(".gyrofx-plot")),
         "{names:?}"
     );
+}
+
+/// An AR(1) record x_k = φ x_{k−1} + u_k with φ = −0.2855 (paper 003's drift) and uniform u
+/// from the same LCG, written as a CSV.
+fn ar1_csv(dir: &std::path::Path, samples: usize) -> String {
+    let mut n: u64 = 42;
+    let mut x = 0.0;
+    let mut text = String::from("k,drift\n");
+    for k in 0..samples {
+        n = 16807 * n % 2_147_483_647;
+        x = -0.2855 * x + (n as f64 / 2_147_483_647.0 - 0.5);
+        text.push_str(&format!("{k},{x}\n"));
+    }
+    let path = dir.join("ar1.csv");
+    std::fs::write(&path, text).unwrap();
+    path.to_string_lossy().into_owned()
+}
+
+#[test]
+fn ar_fits_the_orders_and_names_the_aic_choice() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = ar1_csv(dir.path(), 20_000);
+    let out = ok(&["ar", "--input", &csv, "--column", "drift", "--json"]);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["samples"], 20_000);
+    let models = v["models"].as_array().unwrap();
+    assert_eq!(models.len(), 3);
+    let phi = models[0]["coefficients"][0].as_f64().unwrap();
+    assert!((phi + 0.2855).abs() < 0.02, "{phi}");
+    // Uniform u on [−1/2, 1/2): variance 1/12.
+    let variance = models[0]["noise_variance"].as_f64().unwrap();
+    assert!((variance * 12.0 - 1.0).abs() < 0.03, "{variance}");
+    let chosen = v["aic_order"].as_u64().unwrap() as usize;
+    let smallest = models
+        .iter()
+        .min_by(|a, b| {
+            a["aic"]
+                .as_f64()
+                .unwrap()
+                .total_cmp(&b["aic"].as_f64().unwrap())
+        })
+        .unwrap();
+    assert_eq!(smallest["order"].as_u64().unwrap() as usize, chosen);
+    let table = ok(&["ar", "--input", &csv, "--column", "drift"]);
+    assert!(
+        table.contains("<- AIC") && table.contains("20000 samples"),
+        "{table}"
+    );
+
+    let log = fails(&[
+        "ar",
+        "--input",
+        &csv,
+        "--column",
+        "drift",
+        "--max-order",
+        "0",
+    ]);
+    assert!(log.contains("at least 1"), "{log}");
+    let short = ar1_csv(dir.path(), 4);
+    let log = fails(&["ar", "--input", &short, "--column", "drift"]);
+    assert!(log.contains("4 samples are too few for AR(3)"), "{log}");
+    let log = fails(&["ar", "--input", &csv, "--column", "rate"]);
+    assert!(log.contains("rate"), "{log}");
 }
