@@ -193,32 +193,40 @@ fn yosys_synthesizes_without_latches() {
     assert!(ok, "yosys (mean filter):\n{text}");
 }
 
+/// Small requantizations (input width, fraction, output width, fraction) checked exhaustively:
+/// fewer, more and equal fraction bits, wrapping into fewer integer bits.
+const QUANTIZER_CASES: [(u32, i32, u32, i32); 4] =
+    [(7, 3, 4, 0), (6, 4, 6, 3), (8, 5, 3, 1), (5, 2, 5, 2)];
+
+/// Every code of `from` with `fx::requantize`'s result in `to`: one line per code, input and
+/// output as zero-padded hex and the overflow flag.
+fn requantizer_vectors(from: Format, to: Format, rounding: Rounding, overflow: Overflow) -> String {
+    (from.min_code()..=from.max_code())
+        .map(|code| {
+            let q = requantize(code, from.frac, to, rounding, overflow);
+            format!(
+                "{:0iw$x} {:0ow$x} {}\n",
+                from.to_bits(code),
+                to.to_bits(q.code),
+                u8::from(q.overflowed),
+                iw = from.hex_digits(),
+                ow = to.hex_digits(),
+            )
+        })
+        .collect()
+}
+
 /// Drives every input code of small formats through `gyrofx_quantize` in Icarus and compares
 /// with `fx::requantize`, for all six rounding modes and both overflow modes.
 #[test]
 fn requantizer_rtl_matches_the_model_exhaustively() {
     let dir = tempfile::tempdir().unwrap();
-    let cases = [
-        (7u32, 3i32, 4u32, 0i32),
-        (6, 4, 6, 3),
-        (8, 5, 3, 1),
-        (5, 2, 5, 2),
-    ];
-    for (in_w, in_f, out_w, out_f) in cases {
+    for (in_w, in_f, out_w, out_f) in QUANTIZER_CASES {
         let from = Format::signed(in_w, in_f).unwrap();
         let to = Format::signed(out_w, out_f).unwrap();
         for rounding in Rounding::ALL {
             for overflow in Overflow::ALL {
-                let mut expected = String::new();
-                for code in from.min_code()..=from.max_code() {
-                    let q = requantize(code, in_f, to, rounding, overflow);
-                    expected.push_str(&format!(
-                        "{:x} {:x} {}\n",
-                        from.to_bits(code),
-                        to.to_bits(q.code),
-                        u8::from(q.overflowed)
-                    ));
-                }
+                let expected = requantizer_vectors(from, to, rounding, overflow);
                 std::fs::write(dir.path().join("expected.txt"), &expected).unwrap();
                 let tb = format!(
                     "`timescale 1ns/1ps
@@ -489,29 +497,12 @@ end architecture;
             "tb_quantize.vhd".into(),
         ],
     );
-    let cases = [
-        (7u32, 3i32, 4u32, 0i32),
-        (6, 4, 6, 3),
-        (8, 5, 3, 1),
-        (5, 2, 5, 2),
-    ];
-    for (in_w, in_f, out_w, out_f) in cases {
+    for (in_w, in_f, out_w, out_f) in QUANTIZER_CASES {
         let from = Format::signed(in_w, in_f).unwrap();
         let to = Format::signed(out_w, out_f).unwrap();
         for rounding in Rounding::ALL {
             for overflow in Overflow::ALL {
-                let mut expected = String::new();
-                for code in from.min_code()..=from.max_code() {
-                    let q = requantize(code, in_f, to, rounding, overflow);
-                    expected.push_str(&format!(
-                        "{:0iw$x} {:0ow$x} {}\n",
-                        from.to_bits(code),
-                        to.to_bits(q.code),
-                        u8::from(q.overflowed),
-                        iw = in_w.div_ceil(4) as usize,
-                        ow = out_w.div_ceil(4) as usize,
-                    ));
-                }
+                let expected = requantizer_vectors(from, to, rounding, overflow);
                 std::fs::write(dir.path().join("expected.txt"), &expected).unwrap();
                 let generics = [
                     format!("-gIN_W={in_w}"),
