@@ -221,9 +221,9 @@ enum Command {
         output: PathBuf,
     },
     /// Run a paper's pipeline on simulated data and print its tables beside gyrofx's, with
-    /// the differences explained (markdown). Implemented: 003.
+    /// the differences explained (markdown). Implemented: 000, 003.
     Reproduce {
-        /// The paper: 003 (000, 002 and 004 are not implemented yet).
+        /// The paper: 000 or 003 (002 and 004 are not implemented yet).
         #[arg(long)]
         paper: String,
         /// Samples to simulate (default: the paper's record length).
@@ -597,9 +597,10 @@ fn run_reproduce(
     out: Option<&Path>,
 ) -> Result<ExitCode> {
     let report = match paper {
+        "000" => reproduce::paper_000(samples.unwrap_or(reproduce::SAMPLES_000), seed)?.markdown(),
         "003" => reproduce::paper_003(samples.unwrap_or(reproduce::SAMPLES), seed)?.markdown(),
-        "000" | "002" | "004" => bail!(
-            "--paper {paper}: not implemented yet (reproduce covers 003; 000, 002 and 004 are open work)"
+        "002" | "004" => bail!(
+            "--paper {paper}: not implemented yet (reproduce covers 000 and 003; 002 and 004 are open work)"
         ),
         other => bail!("--paper {other:?} is not one of the papers: use 000, 002, 003 or 004"),
     };

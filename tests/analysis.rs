@@ -412,3 +412,32 @@ fn ar_fits_the_orders_and_names_the_aic_choice() {
     let log = fails(&["ar", "--input", &csv, "--column", "rate"]);
     assert!(log.contains("rate"), "{log}");
 }
+
+#[test]
+fn reproduce_prints_and_writes_the_papers_tables_and_refuses_the_rest() {
+    let dir = tempfile::tempdir().unwrap();
+    let report = dir.path().join("003.md");
+    let out = ok(&[
+        "reproduce",
+        "--paper",
+        "003",
+        "--out",
+        report.to_str().unwrap(),
+    ]);
+    assert_eq!(std::fs::read_to_string(&report).unwrap(), out);
+    assert!(
+        out.contains("| paper | 0.0667 | 0.0528 | 0.0021 |"),
+        "{out}"
+    );
+    let out = ok(&["reproduce", "--paper", "000", "--samples", "50000"]);
+    assert!(
+        out.contains("## Table 4") && out.contains("unity DC gain"),
+        "{out}"
+    );
+    let log = fails(&["reproduce", "--paper", "004"]);
+    assert!(log.contains("not implemented yet"), "{log}");
+    let log = fails(&["reproduce", "--paper", "7"]);
+    assert!(log.contains("\"7\" is not one of the papers"), "{log}");
+    let log = fails(&["reproduce", "--paper", "000", "--samples", "100"]);
+    assert!(log.contains("--samples 100 is too few"), "{log}");
+}
