@@ -20,6 +20,8 @@ pub enum Stream {
     RateRandomWalk(u8),
     /// Gauss–Markov process `index` of a gyro's bias instability.
     BiasInstability(u8, u8),
+    /// Noise realization `index` of an ensemble decomposition (ICEEMDAN).
+    DecompositionNoise(u32),
 }
 
 impl Stream {
@@ -29,6 +31,8 @@ impl Stream {
             Stream::AngleRandomWalk(g) => (1, g),
             Stream::RateRandomWalk(g) => (2, g),
             Stream::BiasInstability(g, j) => (16 + u64::from(j), g),
+            // Above every plant stream (those stay below 1024 · 256).
+            Stream::DecompositionNoise(i) => return (1 << 32) + u64::from(i),
         };
         source + 1024 * u64::from(gyro)
     }

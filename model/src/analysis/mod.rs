@@ -1,11 +1,14 @@
 //! Noise analysis of rate records (f64): the Allan family of deviations with confidence
 //! intervals ([`allan`]), the χ² distribution they need ([`chi2`]), and the five-term noise
-//! identification ([`noise`]), autoregressive models ([`ar`]).
+//! identification ([`noise`]), autoregressive models ([`ar`]), ICEEMDAN ([`emd`]) and threshold
+//! denoising on it ([`denoise`]).
 
 pub mod allan;
 pub mod ar;
 pub mod chi2;
 pub mod davar;
+pub mod denoise;
+pub mod emd;
 pub mod noise;
 pub mod spectrum;
 
