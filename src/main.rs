@@ -221,9 +221,9 @@ enum Command {
         output: PathBuf,
     },
     /// Run a paper's pipeline on simulated data and print its tables beside gyrofx's, with
-    /// the differences explained (markdown). Implemented: 000, 003.
+    /// the differences explained (markdown). Implemented: 000, 003, 004.
     Reproduce {
-        /// The paper: 000 or 003 (002 and 004 are not implemented yet).
+        /// The paper: 000, 003 or 004 (002 is not implemented yet).
         #[arg(long)]
         paper: String,
         /// Samples to simulate (default: the paper's record length).
@@ -599,8 +599,9 @@ fn run_reproduce(
     let report = match paper {
         "000" => reproduce::paper_000(samples.unwrap_or(reproduce::SAMPLES_000), seed)?.markdown(),
         "003" => reproduce::paper_003(samples.unwrap_or(reproduce::SAMPLES), seed)?.markdown(),
-        "002" | "004" => bail!(
-            "--paper {paper}: not implemented yet (reproduce covers 000 and 003; 002 and 004 are open work)"
+        "004" => reproduce::paper_004(samples.unwrap_or(reproduce::SAMPLES_004), seed)?.markdown(),
+        "002" => bail!(
+            "--paper 002: not implemented yet (reproduce covers 000, 003 and 004; 002 is open work)"
         ),
         other => bail!("--paper {other:?} is not one of the papers: use 000, 002, 003 or 004"),
     };

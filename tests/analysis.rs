@@ -434,10 +434,19 @@ fn reproduce_prints_and_writes_the_papers_tables_and_refuses_the_rest() {
         out.contains("## Table 4") && out.contains("unity DC gain"),
         "{out}"
     );
-    let log = fails(&["reproduce", "--paper", "004"]);
+    let log = fails(&["reproduce", "--paper", "002"]);
     assert!(log.contains("not implemented yet"), "{log}");
     let log = fails(&["reproduce", "--paper", "7"]);
     assert!(log.contains("\"7\" is not one of the papers"), "{log}");
     let log = fails(&["reproduce", "--paper", "000", "--samples", "100"]);
+    assert!(log.contains("--samples 100 is too few"), "{log}");
+}
+
+#[test]
+fn reproduce_paper_004_compares_its_table_2() {
+    let out = ok(&["reproduce", "--paper", "004", "--samples", "20000"]);
+    assert!(out.contains("| N (°/√s) | 1.180e-4 \\|"), "{out}");
+    assert!(out.contains("ADEV at 1 s"), "{out}");
+    let log = fails(&["reproduce", "--paper", "004", "--samples", "100"]);
     assert!(log.contains("--samples 100 is too few"), "{log}");
 }
