@@ -221,9 +221,9 @@ enum Command {
         output: PathBuf,
     },
     /// Run a paper's pipeline on simulated data and print its tables beside gyrofx's, with
-    /// the differences explained (markdown). Implemented: 000, 003, 004.
+    /// the differences explained (markdown): 000, 002, 003, 004.
     Reproduce {
-        /// The paper: 000, 003 or 004 (002 is not implemented yet).
+        /// The paper: 000, 002, 003 or 004.
         #[arg(long)]
         paper: String,
         /// Samples to simulate (default: the paper's record length).
@@ -600,9 +600,7 @@ fn run_reproduce(
         "000" => reproduce::paper_000(samples.unwrap_or(reproduce::SAMPLES_000), seed)?.markdown(),
         "003" => reproduce::paper_003(samples.unwrap_or(reproduce::SAMPLES), seed)?.markdown(),
         "004" => reproduce::paper_004(samples.unwrap_or(reproduce::SAMPLES_004), seed)?.markdown(),
-        "002" => bail!(
-            "--paper 002: not implemented yet (reproduce covers 000, 003 and 004; 002 is open work)"
-        ),
+        "002" => reproduce::paper_002(samples.unwrap_or(reproduce::SAMPLES_002), seed)?.markdown(),
         other => bail!("--paper {other:?} is not one of the papers: use 000, 002, 003 or 004"),
     };
     if let Some(path) = out {

@@ -434,8 +434,8 @@ fn reproduce_prints_and_writes_the_papers_tables_and_refuses_the_rest() {
         out.contains("## Table 4") && out.contains("unity DC gain"),
         "{out}"
     );
-    let log = fails(&["reproduce", "--paper", "002"]);
-    assert!(log.contains("not implemented yet"), "{log}");
+    let out = ok(&["reproduce", "--paper", "002"]);
+    assert!(out.contains("| adaptive | 235.5–285.4 |"), "{out}");
     let log = fails(&["reproduce", "--paper", "7"]);
     assert!(log.contains("\"7\" is not one of the papers"), "{log}");
     let log = fails(&["reproduce", "--paper", "000", "--samples", "100"]);
