@@ -232,7 +232,7 @@ enum Command {
         /// Seed of the simulation.
         #[arg(long, default_value_t = 1)]
         seed: u64,
-        /// Also write the report to this markdown file.
+        /// Also write report.md, allan.png (and davar.png for 002) into this folder.
         #[arg(long)]
         out: Option<PathBuf>,
     },
@@ -596,18 +596,31 @@ fn run_reproduce(
     seed: u64,
     out: Option<&Path>,
 ) -> Result<ExitCode> {
-    let report = match paper {
-        "000" => reproduce::paper_000(samples.unwrap_or(reproduce::SAMPLES_000), seed)?.markdown(),
-        "003" => reproduce::paper_003(samples.unwrap_or(reproduce::SAMPLES), seed)?.markdown(),
-        "004" => reproduce::paper_004(samples.unwrap_or(reproduce::SAMPLES_004), seed)?.markdown(),
-        "002" => reproduce::paper_002(samples.unwrap_or(reproduce::SAMPLES_002), seed)?.markdown(),
+    let (report, curves, davar) = match paper {
+        "000" => {
+            let p = reproduce::paper_000(samples.unwrap_or(reproduce::SAMPLES_000), seed)?;
+            (p.markdown(), p.curves, None)
+        }
+        "002" => {
+            let p = reproduce::paper_002(samples.unwrap_or(reproduce::SAMPLES_002), seed)?;
+            (p.markdown(), Vec::new(), Some(p.adaptive))
+        }
+        "003" => {
+            let p = reproduce::paper_003(samples.unwrap_or(reproduce::SAMPLES), seed)?;
+            (p.markdown(), p.curves, None)
+        }
+        "004" => {
+            let p = reproduce::paper_004(samples.unwrap_or(reproduce::SAMPLES_004), seed)?;
+            (p.markdown(), p.curves, None)
+        }
         other => bail!("--paper {other:?} is not one of the papers: use 000, 002, 003 or 004"),
     };
-    if let Some(path) = out {
-        std::fs::write(path, &report)
-            .with_context(|| format!("cannot write the report {}", path.display()))?;
-    }
     print!("{report}");
+    if let Some(folder) = out {
+        let davar = davar.as_ref().map(|(d, c)| (d, c));
+        let files = reproduce::write(folder, paper, seed, &report, &curves, davar)?;
+        eprintln!("wrote {} in {}", files.join(", "), folder.display());
+    }
     Ok(ExitCode::SUCCESS)
 }
 

@@ -416,15 +416,43 @@ fn ar_fits_the_orders_and_names_the_aic_choice() {
 #[test]
 fn reproduce_prints_and_writes_the_papers_tables_and_refuses_the_rest() {
     let dir = tempfile::tempdir().unwrap();
-    let report = dir.path().join("003.md");
-    let out = ok(&[
+    let folder = dir.path().join("003");
+    let output = gyrofx(&[
         "reproduce",
         "--paper",
         "003",
         "--out",
-        report.to_str().unwrap(),
+        folder.to_str().unwrap(),
     ]);
-    assert_eq!(std::fs::read_to_string(&report).unwrap(), out);
+    assert!(output.status.success(), "{}", text(&output));
+    let out = String::from_utf8_lossy(&output.stdout).into_owned();
+    assert_eq!(
+        std::fs::read_to_string(folder.join("report.md")).unwrap(),
+        out
+    );
+    let png = std::fs::read(folder.join("allan.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG"), "allan.png is a PNG");
+    let manifest = std::fs::read_to_string(folder.join("manifest.json")).unwrap();
+    assert!(
+        manifest.contains("allan.png") && manifest.contains("--paper 003"),
+        "{manifest}"
+    );
+    // A folder that is not a gyrofx output is not replaced.
+    let foreign = dir.path().join("foreign");
+    std::fs::create_dir(&foreign).unwrap();
+    std::fs::write(foreign.join("notes.txt"), "mine").unwrap();
+    let log = fails(&[
+        "reproduce",
+        "--paper",
+        "003",
+        "--out",
+        foreign.to_str().unwrap(),
+    ]);
+    assert!(log.contains("not a gyrofx output"), "{log}");
+    assert_eq!(
+        std::fs::read_to_string(foreign.join("notes.txt")).unwrap(),
+        "mine"
+    );
     assert!(
         out.contains("| paper | 0.0667 | 0.0528 | 0.0021 |"),
         "{out}"

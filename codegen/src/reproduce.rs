@@ -17,7 +17,7 @@
 
 use std::fmt::Write as _;
 
-use gyrofx_model::analysis::allan::{self, Grid, Kind};
+use gyrofx_model::analysis::allan::{self, Grid, Kind, Point};
 use gyrofx_model::analysis::ar::{self, ArModel};
 use gyrofx_model::analysis::denoise;
 use gyrofx_model::analysis::emd::Ensemble;
@@ -31,6 +31,9 @@ use gyrofx_model::mean_filter::{self, FloatMeanFilter};
 use gyrofx_model::plant::{GyroErrors, Plant};
 
 use crate::error::{Error, Result};
+
+/// Labelled Allan curves, for the report's plot.
+pub type Curves = Vec<(String, Vec<Point>)>;
 
 /// Paper 003's sample rate, Hz.
 pub const FS_HZ: f64 = 50.0;
@@ -85,6 +88,8 @@ pub struct Paper003 {
     pub paper_ratio_r: Option<(f64, f64)>,
     /// Noise terms (as [`PAPER_TERMS_RAW`]) of the raw record and of the KF output.
     pub terms: [[f64; 5]; 2],
+    /// Allan curves of the raw record and the KF output.
+    pub curves: Curves,
 }
 
 /// A static gyro with Table 2's ARW, bias instability, RRW and rate ramp.
@@ -251,6 +256,16 @@ pub fn paper_003(samples: usize, seed: u64) -> Result<Paper003> {
         dc_gain,
         paper_ratio_r,
         terms: [terms(&raw, FS_HZ), terms(&kf_output, filtered_rate)],
+        curves: vec![
+            (
+                "raw (50 Hz)".into(),
+                allan::curve(Kind::Overlapping, &raw, FS_HZ, Grid::Octave),
+            ),
+            (
+                "mean filter + AR(1) KF (2.5 Hz)".into(),
+                allan::curve(Kind::Overlapping, &kf_output, filtered_rate, Grid::Octave),
+            ),
+        ],
     })
 }
 
@@ -436,6 +451,8 @@ pub struct Paper000 {
     pub constant_rows: Vec<[f64; 5]>,
     /// Table 4 rows: frequency, amplitude before/after, STD error before/after.
     pub swing_rows: Vec<[f64; 5]>,
+    /// Allan curves of the static test: raw and KF 10, 20, 30 Hz.
+    pub curves: Curves,
 }
 
 /// The float steady-state KF of paper 000 designed for `bandwidth_hz` (direct method, the
@@ -533,9 +550,20 @@ pub fn paper_000(samples: usize, seed: u64) -> Result<Paper000> {
         [low, whole, at_one_second * 60.0, floor / 0.6643 * 3600.0]
     };
     let mut static_rows = vec![static_row(&static_record)];
+    let curve = |signal: &[f64]| {
+        allan::curve(
+            Kind::Overlapping,
+            &signal[settle..],
+            FS_000_HZ,
+            Grid::Octave,
+        )
+    };
+    let mut curves = vec![("raw".to_string(), curve(&static_record))];
     for bandwidth in [10.0, 20.0, 30.0] {
         let mut kf = paper_000_kf(bandwidth)?;
-        static_rows.push(static_row(&filter_all(&mut kf, &static_record)));
+        let filtered = filter_all(&mut kf, &static_record);
+        static_rows.push(static_row(&filtered));
+        curves.push((format!("KF {bandwidth} Hz"), curve(&filtered)));
     }
 
     let mut constant_rows = Vec::new();
@@ -575,6 +603,7 @@ pub fn paper_000(samples: usize, seed: u64) -> Result<Paper000> {
         static_rows,
         constant_rows,
         swing_rows,
+        curves,
     })
 }
 
@@ -687,6 +716,8 @@ pub struct Paper004 {
     pub terms: [[f64; 5]; 4],
     /// ADEV at τ = 1 s of each column (of the 50 Hz signal), °/s.
     pub adev_1s: [f64; 4],
+    /// Allan curves of the four columns (1 s averages).
+    pub curves: Curves,
 }
 
 /// Averages of `block` consecutive samples.
@@ -763,8 +794,19 @@ pub fn paper_004(samples: usize, seed: u64) -> Result<Paper004> {
     let average = fs.round() as usize;
     let mut terms_out = [[0.0; 5]; 4];
     let mut adev_1s = [0.0; 4];
+    let labels = [
+        "gyro A",
+        "gyro B",
+        "mode reversal",
+        "mode reversal + denoising",
+    ];
+    let mut curves = Vec::new();
     for (c, column) in columns.iter().enumerate() {
         let seconds = block_means(column, average);
+        curves.push((
+            labels[c].to_string(),
+            allan::curve(Kind::Overlapping, &seconds, 1.0, Grid::Octave),
+        ));
         let t = terms(&seconds, 1.0);
         // Table 2's units: Q µrad, N °/√s, B °/s, K °/s^1.5, R °/s².
         terms_out[c] = [
@@ -782,6 +824,7 @@ pub fn paper_004(samples: usize, seed: u64) -> Result<Paper004> {
         seed,
         terms: terms_out,
         adev_1s,
+        curves,
     })
 }
 
@@ -899,6 +942,11 @@ pub struct Paper002 {
     /// Per setting (1001, 3001, adaptive): mean N, B, K over the windows, and the disturbances
     /// found (start, end, s).
     pub settings: Vec<([f64; 3], Disturbances)>,
+    /// The adaptive window's DAVAR and coefficients, for the report's plot.
+    pub adaptive: (
+        gyrofx_model::analysis::davar::Davar,
+        gyrofx_model::analysis::davar::Coefficients,
+    ),
 }
 
 /// Runs paper 002's DAVAR comparison on `samples` simulated samples from `seed`.
@@ -963,12 +1011,16 @@ pub fn paper_002(samples: usize, seed: u64) -> Result<Paper002> {
             kd: 0.0,
         }),
     ];
+    let mut adaptive = None;
     let settings = modes
         .iter()
         .map(|mode| {
             let step = 50;
             let d = davar(&disturbed, FS_002_HZ, *mode, step);
             let c = coefficients(&d);
+            if matches!(mode, Window::Adaptive(_)) {
+                adaptive = Some((d.clone(), c.clone()));
+            }
             let mean = |v: &[f64]| {
                 let finite: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
                 finite.iter().sum::<f64>() / finite.len().max(1) as f64
@@ -989,6 +1041,7 @@ pub fn paper_002(samples: usize, seed: u64) -> Result<Paper002> {
         reference: [reference_terms[1], reference_terms[2], reference_terms[3]],
         reference_ramp: reference_terms[4],
         settings,
+        adaptive: adaptive.expect("the adaptive setting ran"),
     })
 }
 
@@ -1114,6 +1167,65 @@ impl Paper002 {
         );
         out
     }
+}
+
+/// Writes `report` (markdown) as `report.md`, the Allan `curves` (if any) as `allan.png` and, when
+/// given, a DAVAR as `davar.png`, with a `manifest.json` naming them, into `out` — all or
+/// nothing, like a package. Returns the files written.
+///
+/// # Errors
+/// A plot error (no font), or the package's output errors.
+pub fn write(
+    out: &std::path::Path,
+    paper: &str,
+    seed: u64,
+    report: &str,
+    curves: &Curves,
+    davar: Option<(
+        &gyrofx_model::analysis::davar::Davar,
+        &gyrofx_model::analysis::davar::Coefficients,
+    )>,
+) -> Result<Vec<String>> {
+    let scratch = tempfile::tempdir().map_err(|e| Error::io(std::env::temp_dir(), e))?;
+    let mut package = crate::package::Package::new();
+    package.add("report.md", report);
+    let series: Vec<crate::plot::AllanSeries> = curves
+        .iter()
+        .map(|(label, points)| crate::plot::AllanSeries {
+            label: label.clone(),
+            points,
+            terms: None,
+        })
+        .collect();
+    if !series.is_empty() {
+        let allan_png = scratch.path().join("allan.png");
+        crate::plot::allan(&allan_png, &series)?;
+        package.add(
+            "allan.png",
+            std::fs::read(&allan_png).map_err(|e| Error::io(&allan_png, e))?,
+        );
+    }
+    if let Some((d, c)) = davar {
+        let davar_png = scratch.path().join("davar.png");
+        crate::plot::davar(&davar_png, d, c)?;
+        package.add(
+            "davar.png",
+            std::fs::read(&davar_png).map_err(|e| Error::io(&davar_png, e))?,
+        );
+    }
+    let mut files = package.paths();
+    files.push("manifest.json".into());
+    let manifest = serde_json::json!({
+        "generator": format!("gyrofx {}", env!("CARGO_PKG_VERSION")),
+        "command": format!("gyrofx reproduce --paper {paper} --seed {seed}"),
+        "files": files,
+    });
+    package.add(
+        "manifest.json",
+        serde_json::to_string_pretty(&manifest).expect("manifest serializes") + "\n",
+    );
+    package.write_atomically(out)?;
+    Ok(files)
 }
 
 #[cfg(test)]
