@@ -14,11 +14,28 @@ fn hdl(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("hdl").join(name)
 }
 
+/// Lints `top` from `sources` (file names in `hdl/`) with `verilator --lint-only -Wall` under
+/// each parameter set; every run must pass and print nothing.
+fn lint_clean(top: &str, sources: &[&str], parameter_sets: &[&[&str]]) {
+    let dir = tempfile::tempdir().unwrap();
+    let paths: Vec<String> = sources
+        .iter()
+        .map(|n| hdl(n).to_string_lossy().into_owned())
+        .collect();
+    for params in parameter_sets {
+        let mut args = vec!["--lint-only", "-Wall", "--top-module", top];
+        args.extend_from_slice(params);
+        args.extend(paths.iter().map(String::as_str));
+        let (ok, text) = run_tool("verilator", &args, dir.path());
+        assert!(
+            ok && text.trim().is_empty(),
+            "verilator -Wall {top} {params:?}:\n{text}"
+        );
+    }
+}
+
 #[test]
 fn verilator_lint_is_clean_for_several_parameter_sets() {
-    let dir = tempfile::tempdir().unwrap();
-    let sources = [hdl("gyrofx_quantize.v"), hdl("gyrofx_kf.v")];
-    let sources: Vec<&str> = sources.iter().map(|p| p.to_str().unwrap()).collect();
     let parameter_sets: [&[&str]; 3] = [
         &[],
         // No guard bits, g1 without fraction bits, floor rounding, wrapping.
@@ -38,16 +55,11 @@ fn verilator_lint_is_clean_for_several_parameter_sets() {
             "-GROUNDING=5",
         ],
     ];
-    for params in parameter_sets {
-        let mut args = vec!["--lint-only", "-Wall", "--top-module", "gyrofx_kf"];
-        args.extend_from_slice(params);
-        args.extend_from_slice(&sources);
-        let (ok, text) = run_tool("verilator", &args, dir.path());
-        assert!(
-            ok && text.trim().is_empty(),
-            "verilator -Wall {params:?}:\n{text}"
-        );
-    }
+    lint_clean(
+        "gyrofx_kf",
+        &["gyrofx_quantize.v", "gyrofx_kf.v"],
+        &parameter_sets,
+    );
 }
 
 const ALL_RTL: [&str; 7] = [
@@ -62,9 +74,6 @@ const ALL_RTL: [&str; 7] = [
 
 #[test]
 fn the_mean_filter_lints_clean_for_several_parameter_sets() {
-    let dir = tempfile::tempdir().unwrap();
-    let sources = [hdl("gyrofx_quantize.v"), hdl("gyrofx_mean_filter.v")];
-    let sources: Vec<&str> = sources.iter().map(|p| p.to_str().unwrap()).collect();
     let parameter_sets: [&[&str]; 3] = [
         &[],
         // The smallest window, floor rounding, wrapping.
@@ -87,25 +96,15 @@ fn the_mean_filter_lints_clean_for_several_parameter_sets() {
             "-GOUT_F=20",
         ],
     ];
-    for params in parameter_sets {
-        let mut args = vec!["--lint-only", "-Wall", "--top-module", "gyrofx_mean_filter"];
-        args.extend_from_slice(params);
-        args.extend_from_slice(&sources);
-        let (ok, text) = run_tool("verilator", &args, dir.path());
-        assert!(
-            ok && text.trim().is_empty(),
-            "verilator -Wall {params:?}:\n{text}"
-        );
-    }
+    lint_clean(
+        "gyrofx_mean_filter",
+        &["gyrofx_quantize.v", "gyrofx_mean_filter.v"],
+        &parameter_sets,
+    );
 }
 
 #[test]
 fn the_whole_chain_lints_clean_for_several_parameter_sets() {
-    let dir = tempfile::tempdir().unwrap();
-    let sources: Vec<String> = ALL_RTL
-        .iter()
-        .map(|n| hdl(n).to_string_lossy().into_owned())
-        .collect();
     let parameter_sets: [&[&str]; 3] = [
         &[],
         // ABBA over 8 intervals with stagger, smoothing and convergent rounding.
@@ -127,16 +126,7 @@ fn the_whole_chain_lints_clean_for_several_parameter_sets() {
             "-GSATURATE=0",
         ],
     ];
-    for params in parameter_sets {
-        let mut args = vec!["--lint-only", "-Wall", "--top-module", "gyrofx_top"];
-        args.extend_from_slice(params);
-        args.extend(sources.iter().map(String::as_str));
-        let (ok, text) = run_tool("verilator", &args, dir.path());
-        assert!(
-            ok && text.trim().is_empty(),
-            "verilator -Wall {params:?}:\n{text}"
-        );
-    }
+    lint_clean("gyrofx_top", &ALL_RTL, &parameter_sets);
 }
 
 #[test]

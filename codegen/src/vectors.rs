@@ -989,18 +989,26 @@ mod tests {
     use super::*;
     use crate::config::Config;
 
-    #[test]
-    fn the_default_run_fills_every_block_and_stays_within_the_bounds() {
+    /// The embedded config with 4000 samples, changed by `edit`, run (ROM images unnamed).
+    fn run_embedded(edit: impl FnOnce(&mut Config)) -> (Job, Run) {
         let mut config = Config::embedded();
         config.samples = 4000;
+        edit(&mut config);
         let job = Job::new(config).unwrap();
+        let unnamed = |name: &str| (name.to_string(), String::new());
         let run = run(
             &job,
-            ("kf.mem".into(), String::new()),
-            ("est.mem".into(), String::new()),
-            ("mf.mem".into(), String::new()),
+            unnamed("kf.mem"),
+            unnamed("est.mem"),
+            unnamed("mf.mem"),
         )
         .unwrap();
+        (job, run)
+    }
+
+    #[test]
+    fn the_default_run_fills_every_block_and_stays_within_the_bounds() {
+        let (job, run) = run_embedded(|_| {});
         let names: Vec<&str> = run.blocks.iter().map(|b| b.name).collect();
         assert_eq!(
             names,
@@ -1030,18 +1038,8 @@ mod tests {
     /// sample rejected) to 20, the gross errors rejected, and fixed within the bound of float.
     #[test]
     fn the_mean_filter_vectors_cover_every_case_within_the_bound() {
-        let mut config = Config::embedded();
-        config.samples = 4000;
         // r = 3 °/s, about 2.6 sigma of the default gyro: only the gross errors (8 r) go.
-        config.mean_filter.threshold_dps = 3.0;
-        let job = Job::new(config).unwrap();
-        let run = run(
-            &job,
-            ("kf.mem".into(), String::new()),
-            ("est.mem".into(), String::new()),
-            ("mf.mem".into(), String::new()),
-        )
-        .unwrap();
+        let (_, run) = run_embedded(|config| config.mean_filter.threshold_dps = 3.0);
         let block = &run.blocks[4];
         // rst, x, y_valid, y, kept
         let outputs: Vec<&[i64]> = (0..block.len())
