@@ -7,6 +7,8 @@
 //! that keeps the Toeplitz matrix positive definite, so every fitted model is stationary).
 //! Levinson–Durbin yields every order up to `p` in one O(p²) pass.
 
+use super::spectrum::autocovariance;
+
 /// One fitted AR model.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ArModel {
@@ -50,23 +52,6 @@ pub enum ArError {
         /// Its value.
         value: f64,
     },
-}
-
-/// Biased autocovariance `c_0..=c_max_lag` of the mean-removed `record`.
-pub fn autocovariance(record: &[f64], max_lag: usize) -> Vec<f64> {
-    let n = record.len();
-    let mean = record.iter().sum::<f64>() / n as f64;
-    let centred: Vec<f64> = record.iter().map(|x| x - mean).collect();
-    (0..=max_lag)
-        .map(|lag| {
-            centred[..n - lag]
-                .iter()
-                .zip(&centred[lag..])
-                .map(|(a, b)| a * b)
-                .sum::<f64>()
-                / n as f64
-        })
-        .collect()
 }
 
 /// AR(1)..AR(`max_order`) of `record` by Yule–Walker (Levinson–Durbin), each with its AIC.

@@ -22,7 +22,7 @@
 //! hosts it beside the mode-reversal logic, and at gyro rates (≤ 1 kHz) block latency of
 //! seconds is the real cost.
 
-use super::emd::{iceemdan, Decomposition, Ensemble};
+use super::emd::{iceemdan, std_dev, Decomposition, Ensemble};
 
 /// Energy ratio between consecutive EMD modes of white noise.
 pub const WHITE_NOISE_MODE_RATIO: f64 = 2.01;
@@ -86,12 +86,6 @@ pub struct BlockReport {
     pub sigma: Vec<f64>,
     /// Threshold of each IMF (`None`: signal-dominated, kept whole).
     pub threshold: Vec<Option<f64>>,
-}
-
-fn std_dev(s: &[f64]) -> f64 {
-    let n = s.len() as f64;
-    let mean = s.iter().sum::<f64>() / n;
-    (s.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / n).sqrt()
 }
 
 /// Thresholds a decomposition and rebuilds the signal.

@@ -173,7 +173,8 @@ pub fn modes(s: &[f64], count: usize) -> Vec<Vec<f64>> {
     out
 }
 
-fn std_dev(s: &[f64]) -> f64 {
+/// Population standard deviation of `s`.
+pub(crate) fn std_dev(s: &[f64]) -> f64 {
     let n = s.len() as f64;
     let mean = s.iter().sum::<f64>() / n;
     (s.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / n).sqrt()

@@ -91,23 +91,35 @@ pub fn welch(rate: &[f64], rate_hz: f64, segment: usize) -> Psd {
     }
 }
 
-/// Normalized autocorrelation `r(k)` for lags `0..=max_lag` (mean removed; r(0) = 1).
-pub fn autocorrelation(rate: &[f64], max_lag: usize) -> Vec<f64> {
+/// Biased autocovariance `c(k) = (1/N) Σ (x_i − x̄)(x_{i+k} − x̄)` for lags `0..=max_lag`
+/// (capped at `N − 1`): the estimator whose Toeplitz matrix stays positive semi-definite.
+pub fn autocovariance(rate: &[f64], max_lag: usize) -> Vec<f64> {
     let n = rate.len();
     let mean = rate.iter().sum::<f64>() / n as f64;
     let centred: Vec<f64> = rate.iter().map(|v| v - mean).collect();
-    let variance: f64 = centred.iter().map(|v| v * v).sum();
     (0..=max_lag.min(n - 1))
         .map(|k| {
-            if variance == 0.0 {
-                return if k == 0 { 1.0 } else { 0.0 };
-            }
             centred[..n - k]
                 .iter()
                 .zip(&centred[k..])
                 .map(|(a, b)| a * b)
                 .sum::<f64>()
-                / variance
+                / n as f64
+        })
+        .collect()
+}
+
+/// Normalized autocorrelation `r(k) = c(k)/c(0)` for lags `0..=max_lag` (mean removed;
+/// r(0) = 1; a constant record gives 1, 0, 0, …).
+pub fn autocorrelation(rate: &[f64], max_lag: usize) -> Vec<f64> {
+    let c = autocovariance(rate, max_lag);
+    let c0 = c[0];
+    c.iter()
+        .enumerate()
+        .map(|(k, ck)| match (c0 == 0.0, k) {
+            (true, 0) => 1.0,
+            (true, _) => 0.0,
+            (false, _) => ck / c0,
         })
         .collect()
 }

@@ -31,11 +31,6 @@ impl FixedMeanFilter {
         }
     }
 
-    /// Its plan.
-    pub fn plan(&self) -> &Plan {
-        &self.plan
-    }
-
     /// Drops the samples of the current block (the RTL's reset).
     pub fn reset(&mut self) {
         self.block.clear();

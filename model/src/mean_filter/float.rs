@@ -14,11 +14,7 @@ pub struct FloatMeanFilter {
 impl FloatMeanFilter {
     /// The golden model of `plan` (its window and quantized threshold).
     pub fn new(plan: &Plan) -> Self {
-        FloatMeanFilter {
-            window: plan.window as usize,
-            threshold: plan.threshold_dps(),
-            block: Vec::with_capacity(plan.window as usize),
-        }
+        FloatMeanFilter::with_threshold(plan.window, plan.threshold_dps())
     }
 
     /// The filter with window `window` and threshold `threshold_dps` as given (the "ideal"
