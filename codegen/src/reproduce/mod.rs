@@ -47,6 +47,19 @@ pub(crate) fn paper_gyro() -> GyroErrors {
 
 /// `values` minus their least-squares line (paper 003's pre-processing: constant and trend
 /// removed).
+/// Gyro A's output (°/s) for the true rate `rate` at `fs_hz`, at rest in one mode (no
+/// reversal), with `gyro`'s errors, from `seed` (bias-instability band 0.5–500 s).
+pub(crate) fn gyro_record(gyro: GyroErrors, fs_hz: f64, rate: &[f64], seed: u64) -> Vec<f64> {
+    let plant = gyrofx_model::plant::Plant {
+        fs_hz,
+        gyros: [gyro, gyro],
+        bi_tau_min_s: 0.5,
+        bi_tau_max_s: 500.0,
+    };
+    let [a, _] = plant.simulate(rate, &vec![[1, 1]; rate.len()], seed).y;
+    a
+}
+
 pub(crate) fn detrend(values: &[f64]) -> Vec<f64> {
     let n = values.len() as f64;
     let mean_t = (n - 1.0) / 2.0;

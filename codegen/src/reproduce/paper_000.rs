@@ -9,9 +9,9 @@ use gyrofx_model::analysis::allan::{self, Grid, Kind};
 use gyrofx_model::analysis::spectrum;
 use gyrofx_model::kf::design::{design_for_bandwidth, Convergence, Method, Noise};
 use gyrofx_model::kf::FloatKf;
-use gyrofx_model::plant::{GyroErrors, Plant};
+use gyrofx_model::plant::GyroErrors;
 
-use super::{paper_gyro, Curves};
+use super::{gyro_record, paper_gyro, Curves};
 use crate::error::{Error, Result};
 
 /// Paper 000's sample rate, Hz.
@@ -89,14 +89,7 @@ fn paper_000_gyro() -> GyroErrors {
 
 /// Simulates paper 000's gyro for `rate` (°/s per sample).
 fn paper_000_record(rate: &[f64], seed: u64) -> Vec<f64> {
-    let plant = Plant {
-        fs_hz: FS_000_HZ,
-        gyros: [paper_000_gyro(), paper_000_gyro()],
-        bi_tau_min_s: 0.5,
-        bi_tau_max_s: 500.0,
-    };
-    let n = rate.len();
-    plant.simulate(rate, &vec![[1, 1]; n], seed).y[0].clone()
+    gyro_record(paper_000_gyro(), FS_000_HZ, rate, seed)
 }
 
 fn filter_all(kf: &mut FloatKf, record: &[f64]) -> Vec<f64> {

@@ -4,9 +4,9 @@
 
 use std::fmt::Write as _;
 
-use gyrofx_model::plant::{GyroErrors, Plant};
+use gyrofx_model::plant::GyroErrors;
 
-use super::{paper_gyro, terms};
+use super::{gyro_record, paper_gyro, terms};
 use crate::error::{Error, Result};
 
 /// Paper 002's record: 60000 samples at 100 Hz, a disturbance from 237.3 s to 286.3 s.
@@ -78,20 +78,11 @@ pub fn paper_002(samples: usize, seed: u64) -> Result<Paper002> {
         rate_ramp_deg_per_h2: 0.0,
         ..paper_gyro()
     };
-    let plant = Plant {
-        fs_hz: FS_002_HZ,
-        gyros: [gyro, gyro],
-        bi_tau_min_s: 0.5,
-        bi_tau_max_s: 500.0,
-    };
-    let clean = plant
-        .simulate(&vec![0.0; samples], &vec![[1, 1]; samples], seed)
-        .y[0]
-        .clone();
+    let clean = gyro_record(gyro, FS_002_HZ, &vec![0.0; samples], seed);
     // The reference from two hours of the same gyro: ten minutes cannot separate B and K.
     let long = REFERENCE_SAMPLES_002;
-    let reference_record = plant.simulate(&vec![0.0; long], &vec![[1, 1]; long], seed + 1);
-    let reference_terms = terms(&reference_record.y[0], FS_002_HZ);
+    let reference_record = gyro_record(gyro, FS_002_HZ, &vec![0.0; long], seed + 1);
+    let reference_terms = terms(&reference_record, FS_002_HZ);
     // The disturbance: extra white noise, (factor − 1)·ARW per √s, on its own stream.
     let mut burst = Gaussian::new(seed, Stream::AngleRandomWalk(7));
     let sigma = (factor - 1.0) * PAPER_002_REFERENCE[0] / 60.0 * FS_002_HZ.sqrt();

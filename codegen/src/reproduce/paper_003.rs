@@ -13,9 +13,8 @@ use gyrofx_model::analysis::ar::{self, ArModel};
 use gyrofx_model::ar_kf::{self, FloatArKf};
 use gyrofx_model::fx::{Format, Overflow, Rounding};
 use gyrofx_model::mean_filter::{self, FloatMeanFilter};
-use gyrofx_model::plant::Plant;
 
-use super::{detrend, paper_gyro, terms, variance, Curves};
+use super::{detrend, gyro_record, paper_gyro, terms, variance, Curves};
 use crate::error::{Error, Result};
 
 /// Paper 003's sample rate, Hz.
@@ -86,14 +85,7 @@ pub fn paper_003(samples: usize, seed: u64) -> Result<Paper003> {
             40 * WINDOW
         )));
     }
-    let plant = Plant {
-        fs_hz: FS_HZ,
-        gyros: [paper_gyro(), paper_gyro()],
-        bi_tau_min_s: 0.5,
-        bi_tau_max_s: 500.0,
-    };
-    let record = plant.simulate(&vec![0.0; samples], &vec![[1, 1]; samples], seed);
-    let raw = detrend(&record.y[0]);
+    let raw = detrend(&gyro_record(paper_gyro(), FS_HZ, &vec![0.0; samples], seed));
 
     // Mean filter (float golden model: r as the input format quantizes it, s24.14).
     let input = Format::signed(24, 14).expect("s24.14");
