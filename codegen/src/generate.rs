@@ -6,11 +6,11 @@ use std::path::Path;
 use serde_json::json;
 
 use crate::block::{Block, Timing};
+use crate::blocks::{RomImages, REGISTRY};
 use crate::error::Result;
 use crate::job::Job;
 use crate::package::{sha256_hex, Package, MANIFEST};
-use crate::report;
-use crate::rom::{self, Rom, RomFormat, ROM_FOLDER};
+use crate::rom::{self, RomFormat, ROM_FOLDER};
 use crate::testbench::{verilog, vhdl};
 use crate::vectors::{self, Run};
 use crate::writers::{self, Provenance};
@@ -140,24 +140,8 @@ pub fn build_package(
     progress: &mut dyn FnMut(&str),
 ) -> Result<(Package, Summary)> {
     progress("chain run");
-    let kf = job.kf();
-    let est = &job.chain.estimator;
-    let mf = &job.mean_filter;
-    let kf_rom = Rom::kf(kf);
-    let estimator_rom = Rom::estimator(est);
-    let mean_filter_rom = Rom::mean_filter(&job.mean_filter);
-    let image = |rom: &Rom| {
-        (
-            RomFormat::Mem.file_name(&rom.name),
-            rom::write(rom, RomFormat::Mem, provenance),
-        )
-    };
-    let run = vectors::run(
-        job,
-        image(&kf_rom),
-        image(&estimator_rom),
-        image(&mean_filter_rom),
-    )?;
+    let roms = RomImages::new(job, provenance);
+    let run = vectors::run(job, &roms)?;
     progress("files");
     let mut package = Package::new();
     package.add("README.md", writers::package_readme(&run, provenance));
@@ -166,11 +150,11 @@ pub fn build_package(
     for (name, source) in writers::RTL_SOURCES.iter().chain(&writers::VHDL_SOURCES) {
         package.add(format!("hdl/{name}"), *source);
     }
-    for rom in [&kf_rom, &estimator_rom, &mean_filter_rom] {
+    for image in roms.iter() {
         for format in RomFormat::ALL {
             package.add(
-                format!("{ROM_FOLDER}/{}", format.file_name(&rom.name)),
-                rom::write(rom, format, provenance),
+                format!("{ROM_FOLDER}/{}", format.file_name(&image.rom.name)),
+                rom::write(&image.rom, format, provenance),
             );
         }
     }
@@ -196,7 +180,7 @@ pub fn build_package(
         .iter()
         .map(|b| (b.name.to_string(), block_manifest(b)))
         .collect();
-    let manifest = json!({
+    let mut manifest = json!({
         "tool": "gyrofx",
         "version": provenance.version,
         "command": provenance.command,
@@ -206,81 +190,16 @@ pub fn build_package(
         "samples": run.samples,
         "encoding": "vector files: one line per clock-enable; fields separated by one space, each a zero-padded two's-complement hex word of its format's width; line 1 is a generated-by comment, line 2 names the fields and formats",
         "blocks": blocks,
-        "kf": {
-            "formats": {
-                "input": kf.input.to_string(),
-                "state": kf.state.to_string(),
-                "output": kf.output.to_string(),
-                "g1": kf.coefficient[0].to_string(),
-                "g2": kf.coefficient[1].to_string(),
-                "error": kf.error.to_string(),
-                "product_g1": kf.product[0].to_string(),
-                "product_g2": kf.product[1].to_string(),
-                "sum_x1": kf.sum[0].to_string(),
-                "sum_x2": kf.sum[1].to_string(),
-            },
-            "guard_bits": kf.guard_bits(),
-            "latency_clocks": 1,
-            "designs": report::designs(&job.designs, kf),
-            "coefficients": report::coefficients(kf),
-            "rom": {"file": RomFormat::Mem.file_name(&kf_rom.name), "depth": kf.rom.len(), "word_bits": kf_rom.width(), "all_formats": ROM_FOLDER,
-                    "packing": "word = {g1, g2}: g1 in the high bits; address = bw_sel"},
-            "tie_cases": run.ties,
-            "fixed_vs_float": run.kf_stats,
-        },
-        "estimator": {
-            "schedule": {
-                "interval_length": est.schedule.interval_length,
-                "intervals": est.schedule.intervals,
-                "pattern": est.schedule.pattern.name(),
-                "blank": est.schedule.blank,
-                "stagger": est.schedule.stagger,
-            },
-            "rate_order": est.rate_order,
-            "formats": {
-                "input": est.input.to_string(),
-                "accumulator": est.accumulator.to_string(),
-                "reciprocal": est.reciprocal.to_string(),
-                "mean": est.mean.to_string(),
-                "gain": est.gain.to_string(),
-                "dot": est.dot.to_string(),
-                "bias": est.bias.to_string(),
-                "calibrated": est.calibrated.to_string(),
-            },
-            "reciprocal": {"value": 1.0 / est.schedule.valid_count() as f64, "quantized": est.quantized_reciprocal(), "code": est.reciprocal_code as i64},
-            "gains": {"designed": est.gains, "quantized": est.quantized_gains(), "all_shifts": est.gains_are_shifts(),
-                      "rom": {"file": RomFormat::Mem.file_name(&estimator_rom.name), "word_bits": estimator_rom.width(), "all_formats": ROM_FOLDER, "order": "bias_a row over [mA0, mB0, mA1, ...], then bias_b row"}},
-            "smoothing_shift": est.smoothing_shift,
-            "fixed_vs_float_bias": run.bias_stats,
-        },
-        "mean_filter": {
-            "window": mf.window,
-            "threshold_dps": job.config.mean_filter.threshold_dps,
-            "threshold_quantized_dps": mf.threshold_dps(),
-            "threshold_code": mf.threshold_code as i64,
-            "formats": {
-                "input": mf.input.to_string(),
-                "output": mf.output.to_string(),
-                "sum": mf.sum.to_string(),
-                "deviation": mf.deviation.to_string(),
-                "reciprocal": mf.reciprocal.to_string(),
-                "product": mf.product.to_string(),
-            },
-            "rom": {"file": RomFormat::Mem.file_name(&mean_filter_rom.name), "depth": mf.rom.len(), "word_bits": mean_filter_rom.width(), "all_formats": ROM_FOLDER,
-                    "order": "address = samples kept n: 1/n; address 0: 1/L (every sample rejected)"},
-            "stimulus": "gyro A's ADC samples with a gross error of 8 r every 53rd sample, the chain's reset, then directed blocks (samples at exactly r, at r + 1 LSB, all rejected, full scale, a full-scale spike)",
-            "latency_clocks": 1,
-            "fixed_vs_float": run.mean_filter_stats,
-        },
-        "chain": {
-            "rounding": est.rounding.name(),
-            "overflow": est.overflow.name(),
-            "fixed_vs_float": run.chain_stats,
-        },
         "overflow_counts": run.overflows,
         "report": run.report,
-        "files": package.entries(),
     });
+    let sections = manifest.as_object_mut().expect("an object");
+    for block in REGISTRY {
+        if let Some((key, section)) = block.manifest(job, &roms, &run) {
+            sections.insert(key.to_string(), section);
+        }
+    }
+    sections.insert("files".to_string(), json!(package.entries()));
     let mut text = serde_json::to_string_pretty(&manifest).expect("manifest serializes");
     text.push('\n');
     package.add(MANIFEST, text);

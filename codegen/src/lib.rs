@@ -2,12 +2,14 @@
 //! simulator runner.
 //!
 //! Data flows one way: [`config::Config`] → [`job::Job`] (designs and every block's plan) →
-//! [`vectors`] (one run of the chain fills every [`block::Block`]) → [`writers`] and
+//! [`vectors`] (one run of the chain, cut into every registered block's [`block::Block`] by
+//! its module in [`blocks`]) → [`writers`] and
 //! [`testbench`] → [`package::Package`], written atomically by [`generate::generate`].
 //! [`simulate`] runs a written package.
 #![warn(missing_docs)]
 
 pub mod block;
+pub mod blocks;
 pub mod config;
 pub mod error;
 pub mod generate;
@@ -20,6 +22,7 @@ pub mod report;
 pub mod reproduce;
 pub mod rom;
 pub mod simulate;
+pub mod stats;
 pub mod synth;
 pub mod testbench;
 pub mod vectors;

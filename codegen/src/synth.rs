@@ -12,15 +12,16 @@ use std::process::Command;
 use serde::Serialize;
 
 use crate::block::Block;
+use crate::blocks::{self, RomImages};
 use crate::error::{Error, Result};
 use crate::job::Job;
 use crate::package::Package;
-use crate::rom::{self, Rom, RomFormat};
-use crate::vectors::empty_blocks;
 use crate::writers::{self, Provenance};
 
 /// Module synthesized: the whole chain.
 pub const TOP: &str = "gyrofx_top";
+/// Its block in the registry.
+const TOP_BLOCK: &str = "top";
 
 /// Generic (technology-independent) resources of the flattened chain.
 #[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
@@ -223,21 +224,13 @@ fn report(top: &Block, resources: &Resources, provenance: &Provenance) -> String
 /// # Errors
 /// A failed check or a missing yosys ([`Error::Synthesis`]), or an I/O error.
 pub fn synthesize(job: &Job, out: &Path, provenance: &Provenance) -> Result<Resources> {
-    let kf_rom = Rom::kf(job.kf());
-    let estimator_rom = Rom::estimator(&job.chain.estimator);
-    let kf_name = RomFormat::Mem.file_name(&kf_rom.name);
-    let estimator_name = RomFormat::Mem.file_name(&estimator_rom.name);
-    // The chain only: the mean filter is a block beside it, not part of gyrofx_top.
-    let [_, _, _, top, _] = empty_blocks(job, &kf_name, &estimator_name, "");
+    let roms = RomImages::new(job, provenance);
+    let top = blocks::find(TOP_BLOCK).block(job, &roms);
 
     let mut inputs: Vec<(String, String)> = chain_sources()
         .map(|(n, s)| (n.to_string(), s.to_string()))
         .collect();
-    inputs.push((kf_name, rom::write(&kf_rom, RomFormat::Mem, provenance)));
-    inputs.push((
-        estimator_name,
-        rom::write(&estimator_rom, RomFormat::Mem, provenance),
-    ));
+    inputs.extend(top.roms.iter().cloned());
     inputs.push(("generic.ys".into(), generic_script(&top)));
     inputs.push(("xilinx.ys".into(), xilinx_script(&top)));
 

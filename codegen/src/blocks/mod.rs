@@ -1,0 +1,192 @@
+//! The block registry: every RTL block of the package, one module each, named after it.
+//!
+//! A block's module owns everything the generator, the writers, `verify` and `synth` need to
+//! know about it: its ports with their formats and its parameters ([`RtlBlock::block`]), the
+//! ROMs it owns ([`RtlBlock::roms`]), how its vectors are cut from the chain run
+//! ([`RtlBlock::vectors`]) and its section of the manifest ([`RtlBlock::manifest`]). Everything
+//! downstream iterates over [`REGISTRY`]; nothing else matches on block names.
+//!
+//! Adding a block: a model module in `gyrofx-model`, a module here implementing [`RtlBlock`],
+//! the RTL pair in `hdl/` (listed in [`crate::writers::RTL_SOURCES`] and
+//! [`crate::writers::VHDL_SOURCES`], which keep VHDL's compile order), a page in `docs/blocks/`
+//! and one line in [`REGISTRY`].
+
+pub mod calibration;
+pub mod estimator;
+pub mod kf;
+pub mod mean_filter;
+pub mod sequencer;
+pub mod top;
+
+use gyrofx_model::chain::{FloatSample, Sample};
+use gyrofx_model::fx::{Overflow, Rounding};
+
+use crate::block::{Block, Param};
+use crate::job::Job;
+use crate::rom::{self, Rom, RomFormat};
+use crate::vectors::{Results, Run};
+use crate::writers::Provenance;
+
+/// One RTL block.
+pub trait RtlBlock: Sync {
+    /// Folder, file prefix and doc page name, e.g. `kf`.
+    fn name(&self) -> &'static str;
+
+    /// The RTL module, e.g. `gyrofx_kf`.
+    fn module(&self) -> &'static str;
+
+    /// What the block is, one line.
+    fn title(&self) -> &'static str;
+
+    /// The ROMs the block owns (the package writes each in every format under `roms/`).
+    fn roms(&self, _job: &Job) -> Vec<Rom> {
+        Vec::new()
+    }
+
+    /// The block for `job` without vectors: its ports (after `clk`, `rst`, `ce`) with their
+    /// formats, its parameters and the ROM images its DUT reads.
+    fn block(&self, job: &Job, roms: &RomImages) -> Block;
+
+    /// The builder of its vectors from the chain run, or `None` for a block that has no
+    /// testbench of its own (its vectors are its parent's).
+    fn vectors<'a>(&self, job: &'a Job, block: Block) -> Option<Box<dyn VectorBuilder + 'a>>;
+
+    /// Its section of the package manifest (key and value), if it has one.
+    fn manifest(
+        &self,
+        _job: &Job,
+        _roms: &RomImages,
+        _run: &Run,
+    ) -> Option<(&'static str, serde_json::Value)> {
+        None
+    }
+}
+
+/// Every block, in the order of the package (the chain's signal flow, then the blocks beside
+/// it).
+pub static REGISTRY: &[&dyn RtlBlock] = &[
+    &sequencer::Sequencer,
+    &estimator::Estimator,
+    &calibration::Calibration,
+    &kf::Kf,
+    &top::Top,
+    &mean_filter::MeanFilter,
+];
+
+/// The registered block called `name`.
+///
+/// # Panics
+/// When no block has that name (a programming error: names are static).
+pub fn find(name: &str) -> &'static dyn RtlBlock {
+    *REGISTRY
+        .iter()
+        .find(|b| b.name() == name)
+        .unwrap_or_else(|| panic!("no block `{name}` in the registry"))
+}
+
+/// One sample of the chain run, as every block's vectors see it.
+pub struct ChainSample<'a> {
+    /// Sample index in the run (resets not counted).
+    pub index: usize,
+    /// KF ROM address in use.
+    pub bw_sel: usize,
+    /// Gyro A's and B's ADC codes (input format).
+    pub y: [i64; 2],
+    /// What the fixed chain did.
+    pub fixed: &'a Sample,
+    /// The float chain with the same quantized coefficients.
+    pub float: &'a FloatSample,
+    /// The float chain with the designed coefficients.
+    pub ideal: &'a FloatSample,
+    /// The estimator's bias registers after the sample (bias format).
+    pub bias_after: [i128; 2],
+    /// Whether a window has produced an estimate since reset, after the sample.
+    pub estimated: bool,
+    /// The true rate, °/s.
+    pub true_rate_dps: f64,
+}
+
+/// Cuts one block's vectors from the chain run, sample by sample.
+pub trait VectorBuilder {
+    /// A synchronous reset of the whole chain before the next sample.
+    fn reset(&mut self);
+
+    /// One sample.
+    fn sample(&mut self, sample: &ChainSample);
+
+    /// After the last sample: appends the block's directed segments, records its statistics
+    /// in `results` and returns its vectors.
+    fn finish(self: Box<Self>, results: &mut Results) -> Block;
+}
+
+/// A ROM's `$readmemh` image: the file a DUT reads.
+#[derive(Clone, Debug)]
+pub struct RomImage {
+    /// The ROM.
+    pub rom: Rom,
+    /// File name of its `.mem` image.
+    pub file: String,
+    /// The image's text.
+    pub text: String,
+}
+
+/// The `.mem` images of every registered block's ROMs.
+#[derive(Clone, Debug)]
+pub struct RomImages(Vec<RomImage>);
+
+impl RomImages {
+    /// The images of every ROM of the registry for `job`, in registry order.
+    pub fn new(job: &Job, provenance: &Provenance) -> Self {
+        RomImages(
+            REGISTRY
+                .iter()
+                .flat_map(|b| b.roms(job))
+                .map(|rom| RomImage {
+                    file: RomFormat::Mem.file_name(&rom.name),
+                    text: rom::write(&rom, RomFormat::Mem, provenance),
+                    rom,
+                })
+                .collect(),
+        )
+    }
+
+    /// The image of the ROM called `name` (e.g. `kf_coefficients`).
+    ///
+    /// # Panics
+    /// When no registered block owns it (a programming error).
+    pub fn get(&self, name: &str) -> &RomImage {
+        self.0
+            .iter()
+            .find(|image| image.rom.name == name)
+            .unwrap_or_else(|| panic!("no block owns the ROM `{name}`"))
+    }
+
+    /// The image's file name and text, as a block carries it.
+    pub fn entry(&self, name: &str) -> (String, String) {
+        let image = self.get(name);
+        (image.file.clone(), image.text.clone())
+    }
+
+    /// Every image, in registry order.
+    pub fn iter(&self) -> impl Iterator<Item = &RomImage> {
+        self.0.iter()
+    }
+}
+
+/// The `ROUNDING` and `SATURATE` parameters every quantizing block takes.
+pub fn mode_params(rounding: Rounding, overflow: Overflow) -> [Param; 2] {
+    [
+        Param::integer("ROUNDING", rounding.rtl_code().into(), rounding.name()),
+        Param::integer("SATURATE", overflow.rtl_code().into(), overflow.name()),
+    ]
+}
+
+/// A flag's code.
+pub(crate) fn flag(b: bool) -> i128 {
+    i128::from(b)
+}
+
+/// A mode's code: 1 normal, 0 reverse.
+pub(crate) fn mode_bit(p: i8) -> i128 {
+    i128::from(p > 0)
+}

@@ -1,0 +1,190 @@
+//! `top` — `gyrofx_top`, the whole mode-reversal chain: sequencer, bias estimator,
+//! calibration and KF (SPEC §1, `docs/blocks/top.md`). Its vectors are the chain run itself,
+//! with the float, ideal and true rates beside the fixed output in the CSV.
+
+use gyrofx_model::chain::Plan;
+use serde_json::json;
+
+use super::{estimator, flag, kf, mode_bit, mode_params, sequencer};
+use super::{ChainSample, RomImages, RtlBlock, VectorBuilder};
+use crate::block::{Block, Output, Param, Signal};
+use crate::job::Job;
+use crate::stats::Accumulator;
+use crate::vectors::{Results, Run};
+
+/// The top block.
+pub struct Top;
+
+impl RtlBlock for Top {
+    fn name(&self) -> &'static str {
+        "top"
+    }
+
+    fn module(&self) -> &'static str {
+        "gyrofx_top"
+    }
+
+    fn title(&self) -> &'static str {
+        "the whole mode-reversal chain"
+    }
+
+    fn block(&self, job: &Job, roms: &RomImages) -> Block {
+        let est = &job.chain.estimator;
+        let kf = job.kf();
+        let mut block = Block::new(
+            self.name(),
+            self.module(),
+            self.title(),
+            vec![
+                Signal::index("bw_sel", kf.select_width()),
+                Signal::new("y_a", est.input),
+                Signal::new("y_b", est.input),
+            ],
+            vec![
+                Output::combinational(Signal::flag("mode_a")),
+                Output::combinational(Signal::flag("mode_b")),
+                Output::pulse(Signal::flag("out_valid")),
+                Output::gated(Signal::new("rate_out", kf.output), "out_valid"),
+                Output::registered(Signal::new("bias_a", est.bias)),
+                Output::registered(Signal::new("bias_b", est.bias)),
+                Output::registered(Signal::flag("estimated")),
+            ],
+        );
+        // The submodules' parameters, each once: the sequencer's schedule, the estimator's
+        // formats (its W and interval width are the sequencer's) and the KF's (its input is
+        // the calibrated output).
+        block.params = sequencer::params(&est.schedule);
+        block.params.extend(
+            estimator::params(est)
+                .into_iter()
+                .filter(|p| p.name != "INTERVALS" && p.name != "INTERVAL_W"),
+        );
+        let gains = roms.entry(estimator::ROM);
+        block.params.push(Param::string(
+            "GAIN_ROM_FILE",
+            &gains.0,
+            "estimator gain ROM",
+        ));
+        block.params.extend(
+            kf::params(kf)
+                .into_iter()
+                .filter(|p| p.name != "IN_W" && p.name != "IN_F"),
+        );
+        let coefficients = roms.entry(kf::ROM);
+        block.params.push(Param::string(
+            "KF_ROM_FILE",
+            &coefficients.0,
+            "KF coefficient ROM",
+        ));
+        block.params.extend(mode_params(est.rounding, est.overflow));
+        block.roms.push(gains);
+        block.roms.push(coefficients);
+        block
+    }
+
+    fn vectors<'a>(&self, job: &'a Job, mut block: Block) -> Option<Box<dyn VectorBuilder + 'a>> {
+        let rows = job.config.samples + 2;
+        block.reserve(rows);
+        Some(Box::new(Vectors {
+            plan: &job.chain,
+            block,
+            errors: Accumulator::default(),
+            switches: 0,
+            previous_sel: None,
+            float: Vec::with_capacity(rows),
+            ideal: Vec::with_capacity(rows),
+            truth: Vec::with_capacity(rows),
+        }))
+    }
+
+    fn manifest(
+        &self,
+        job: &Job,
+        _roms: &RomImages,
+        run: &Run,
+    ) -> Option<(&'static str, serde_json::Value)> {
+        let est = &job.chain.estimator;
+        Some((
+            "chain",
+            json!({
+                "rounding": est.rounding.name(),
+                "overflow": est.overflow.name(),
+                "fixed_vs_float": run.chain_stats,
+            }),
+        ))
+    }
+}
+
+/// The chain's inputs and outputs for every sample, the fixed-vs-float statistics of its
+/// output, and the float, ideal and true rates for the CSV.
+struct Vectors<'a> {
+    plan: &'a Plan,
+    block: Block,
+    errors: Accumulator,
+    /// Changes of `bw_sel` between KF steps (each may add to the error bound).
+    switches: u64,
+    previous_sel: Option<usize>,
+    float: Vec<f64>,
+    ideal: Vec<f64>,
+    truth: Vec<f64>,
+}
+
+impl VectorBuilder for Vectors<'_> {
+    fn reset(&mut self) {
+        self.block.push(true, &[0, 0, 0], &[0; 7]);
+        for extra in [&mut self.float, &mut self.ideal, &mut self.truth] {
+            extra.push(f64::NAN);
+        }
+    }
+
+    fn sample(&mut self, sample: &ChainSample) {
+        let fixed = sample.fixed;
+        let s = &fixed.slot;
+        self.block.push(
+            false,
+            &[
+                sample.bw_sel as i128,
+                i128::from(sample.y[0]),
+                i128::from(sample.y[1]),
+            ],
+            &[
+                mode_bit(s.mode_a),
+                mode_bit(s.mode_b),
+                flag(fixed.rate.is_some()),
+                fixed.rate.map(i128::from).unwrap_or(0),
+                sample.bias_after[0],
+                sample.bias_after[1],
+                flag(sample.estimated),
+            ],
+        );
+        self.float.push(sample.float.rate.unwrap_or(f64::NAN));
+        self.ideal.push(sample.ideal.rate.unwrap_or(f64::NAN));
+        self.truth.push(sample.true_rate_dps);
+        if let Some(code) = fixed.rate {
+            if self.previous_sel.is_some_and(|p| p != sample.bw_sel) {
+                self.switches += 1;
+            }
+            self.previous_sel = Some(sample.bw_sel);
+            let output = self.plan.kf.output;
+            self.errors.add(
+                output.to_f64(i128::from(code)),
+                sample.float.rate.unwrap_or(f64::NAN),
+                sample.ideal.rate.unwrap_or(f64::NAN),
+                output.lsb(),
+            );
+        }
+    }
+
+    fn finish(mut self: Box<Self>, results: &mut Results) -> Block {
+        let bound = self
+            .plan
+            .rate_error_bound_lsb(self.errors.count(), self.switches);
+        results.chain_stats = Some(std::mem::take(&mut self.errors).finish(bound));
+        self.block.extra = vec![
+            ("float_rate_dps", std::mem::take(&mut self.float)),
+            ("ideal_rate_dps", std::mem::take(&mut self.ideal)),
+            ("true_rate_dps", std::mem::take(&mut self.truth)),
+        ];
+        self.block
+    }
+}
