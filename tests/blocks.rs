@@ -1,0 +1,171 @@
+//! The block registry against what is written elsewhere about each block: the RTL module's port
+//! list (`hdl/<module>.v` and `.vhd`) and the doc page's port table (`docs/blocks/<block>.md`),
+//! so that neither can drift from the code.
+
+use std::path::Path;
+
+use gyrofx_codegen::blocks::{RomImages, REGISTRY};
+use gyrofx_codegen::config::Config;
+use gyrofx_codegen::job::Job;
+use gyrofx_codegen::writers::Provenance;
+
+/// A port: name, direction (`in`/`out`) and format (`s24.14`, `u1.0`).
+type Port = (String, String, String);
+
+const CLOCKING: [&str; 3] = ["clk", "rst", "ce"];
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Every registered block's ports for the embedded default (vector-file order), with the
+/// clocking inputs when the block has them (every block but the combinational calibration).
+fn registry_ports() -> Vec<(&'static str, &'static str, Vec<Port>)> {
+    let job = Job::new(Config::embedded()).unwrap();
+    let provenance = Provenance {
+        version: "test".into(),
+        command: "test".into(),
+        config_sha256: "0".repeat(64),
+    };
+    let roms = RomImages::new(&job, &provenance);
+    REGISTRY
+        .iter()
+        .map(|b| {
+            let block = b.block(&job, &roms);
+            let mut ports = Vec::new();
+            if b.name() != "calibration" {
+                ports.extend(
+                    CLOCKING.map(|name| (name.to_string(), "in".to_string(), "u1.0".to_string())),
+                );
+            }
+            ports.extend(
+                block
+                    .inputs
+                    .iter()
+                    .map(|s| (s.name.to_string(), "in".into(), s.format.to_string())),
+            );
+            ports.extend(block.outputs.iter().map(|o| {
+                (
+                    o.signal.name.to_string(),
+                    "out".into(),
+                    o.signal.format.to_string(),
+                )
+            }));
+            (b.name(), b.module(), ports)
+        })
+        .collect()
+}
+
+fn sorted<T: Ord>(mut v: Vec<T>) -> Vec<T> {
+    v.sort();
+    v
+}
+
+/// The rows of the `| Port | Direction | Format | Description |` table of a doc page.
+fn doc_ports(page: &str) -> Vec<Port> {
+    let mut lines = page
+        .lines()
+        .skip_while(|l| !l.starts_with("| Port | Direction | Format |"));
+    lines.next().expect("a port table");
+    lines
+        .skip(1)
+        .take_while(|l| l.starts_with('|'))
+        .map(|l| {
+            let cells: Vec<String> = l
+                .split('|')
+                .map(|c| c.trim().trim_matches('`').to_string())
+                .collect();
+            (cells[1].clone(), cells[2].clone(), cells[3].clone())
+        })
+        .collect()
+}
+
+/// Names and directions of a Verilog module's ports, in order (ANSI header, one per line).
+fn verilog_ports(source: &str) -> Vec<(String, String)> {
+    source
+        .lines()
+        .map(str::trim)
+        .filter_map(|l| {
+            let direction = if l.starts_with("input ") {
+                "in"
+            } else if l.starts_with("output ") {
+                "out"
+            } else {
+                return None;
+            };
+            let name = l
+                .trim_end_matches([',', ')', ';'])
+                .split_whitespace()
+                .last()?
+                .to_string();
+            Some((name, direction.to_string()))
+        })
+        .collect()
+}
+
+/// Names and directions of a VHDL entity's ports, in order (`name : in ...;` lines inside
+/// `port (`).
+fn vhdl_ports(source: &str) -> Vec<(String, String)> {
+    let entity = source
+        .split("\nentity ")
+        .nth(1)
+        .expect("an entity")
+        .split("\nend entity")
+        .next()
+        .unwrap();
+    let ports = entity.split("port (").nth(1).expect("a port clause");
+    ports
+        .lines()
+        .filter_map(|l| {
+            let (name, rest) = l.split_once(':')?;
+            let direction = rest.split_whitespace().next()?;
+            matches!(direction, "in" | "out").then(|| (name.trim().to_string(), direction.into()))
+        })
+        .collect()
+}
+
+#[test]
+fn every_registered_block_has_a_doc_page_whose_port_table_matches_the_registry() {
+    for (name, _, ports) in registry_ports() {
+        let path = root().join(format!("docs/blocks/{name}.md"));
+        let page = std::fs::read_to_string(&path)
+            .unwrap_or_else(|e| panic!("{}: {e} (every block has a page)", path.display()));
+        assert_eq!(
+            sorted(doc_ports(&page)),
+            sorted(ports),
+            "{}: the port table (name, direction, format for the default config) differs from the registry",
+            path.display()
+        );
+    }
+}
+
+#[test]
+fn every_registered_block_declares_exactly_its_rtl_modules_ports_in_both_languages() {
+    for (name, module, ports) in registry_ports() {
+        let declared: Vec<(String, String)> =
+            sorted(ports.into_iter().map(|(n, d, _)| (n, d)).collect());
+        let verilog = std::fs::read_to_string(root().join(format!("hdl/{module}.v"))).unwrap();
+        let verilog = verilog_ports(&verilog);
+        assert_eq!(sorted(verilog.clone()), declared, "{name}: hdl/{module}.v");
+        let vhdl = std::fs::read_to_string(root().join(format!("hdl/{module}.vhd"))).unwrap();
+        assert_eq!(vhdl_ports(&vhdl), verilog, "{name}: hdl/{module}.vhd vs .v");
+        // The page lists the ports in the module's order.
+        let page = std::fs::read_to_string(root().join(format!("docs/blocks/{name}.md"))).unwrap();
+        let documented: Vec<(String, String)> = doc_ports(&page)
+            .into_iter()
+            .map(|(n, d, _)| (n, d))
+            .collect();
+        assert_eq!(documented, verilog, "docs/blocks/{name}.md: port order");
+    }
+}
+
+/// The parsers above can fail: a page whose table lost a row or changed a format is caught.
+#[test]
+fn a_drifted_doc_table_is_caught() {
+    let (name, _, ports) = registry_ports().into_iter().find(|b| b.0 == "kf").unwrap();
+    let page = std::fs::read_to_string(root().join(format!("docs/blocks/{name}.md"))).unwrap();
+    assert_eq!(sorted(doc_ports(&page)), sorted(ports.clone()));
+    let drifted = page.replace("| `z` | in | s24.14 |", "| `z` | in | s24.13 |");
+    assert_ne!(drifted, page, "the kf page documents z as s24.14");
+    assert_ne!(sorted(doc_ports(&drifted)), sorted(ports));
+}
