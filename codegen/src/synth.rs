@@ -67,16 +67,14 @@ fn chparams(block: &Block) -> String {
         .collect()
 }
 
-/// The RTL of `gyrofx_top`: every source but the mean filter, a block beside the chain (yosys
-/// would otherwise load its ROM image while reading it).
-fn chain_sources() -> impl Iterator<Item = &'static (&'static str, &'static str)> {
-    writers::RTL_SOURCES
-        .iter()
-        .filter(|(name, _)| *name != "gyrofx_mean_filter.v")
+/// The RTL of `gyrofx_top`: its file and its submodules' (not the mean filter, a block beside
+/// the chain: yosys would load its ROM image while reading it).
+fn chain_sources() -> Vec<&'static (&'static str, &'static str)> {
+    writers::verilog_sources_of(TOP)
 }
 
 fn read_sources() -> String {
-    let names: Vec<&str> = chain_sources().map(|(n, _)| *n).collect();
+    let names: Vec<&str> = chain_sources().iter().map(|(n, _)| *n).collect();
     format!("read_verilog {}\n", names.join(" "))
 }
 
@@ -228,6 +226,7 @@ pub fn synthesize(job: &Job, out: &Path, provenance: &Provenance) -> Result<Reso
     let top = blocks::find(TOP_BLOCK).block(job, &roms);
 
     let mut inputs: Vec<(String, String)> = chain_sources()
+        .into_iter()
         .map(|(n, s)| (n.to_string(), s.to_string()))
         .collect();
     inputs.extend(top.roms.iter().cloned());
