@@ -1,0 +1,190 @@
+//! `gyrofx allan`: the Allan deviation of rate records with confidence intervals, and the five
+//! noise terms fitted to it.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{bail, Result};
+
+use gyrofx_codegen::input::read_column_with_gaps;
+use gyrofx_model::analysis::{allan, noise};
+
+use super::options::SampleRate;
+
+/// Allan deviation of rate records (°/s) with 1σ confidence intervals, and the five noise
+/// terms fitted to it.
+#[derive(clap::Args)]
+pub struct Args {
+    /// CSV file(s) with a header line; `#` lines are skipped (gyrofx's CSVs work as is).
+    #[arg(long, required = true)]
+    input: Vec<PathBuf>,
+    /// Column(s) of rates in °/s; each input × column is one series.
+    #[arg(long, default_value = "rate_dps")]
+    column: Vec<String>,
+    #[command(flatten)]
+    rate: SampleRate,
+    /// Averaging times: octave, decade or all.
+    #[arg(long, default_value = "octave")]
+    taus: String,
+    /// Deviation: overlapping, nonoverlapping, modified or hadamard.
+    #[arg(long, default_value = "overlapping")]
+    kind: String,
+    /// Print JSON (one object per input; an array for several).
+    #[arg(long)]
+    json: bool,
+    /// Write a log-log plot with confidence bars and fitted terms (.png or .svg).
+    #[arg(long)]
+    plot: Option<PathBuf>,
+}
+
+/// Prints the deviation and the noise terms of every input × column (a table, or JSON), and
+/// writes the plot if asked.
+pub fn run(args: Args) -> Result<ExitCode> {
+    let Args {
+        input: inputs,
+        column: columns,
+        rate,
+        taus,
+        kind,
+        json,
+        plot,
+    } = args;
+    let rate = rate.hz()?;
+    let grid: allan::Grid = taus.parse().map_err(anyhow::Error::msg)?;
+    let kind = match kind.as_str() {
+        "overlapping" => allan::Kind::Overlapping,
+        "nonoverlapping" => allan::Kind::NonOverlapping,
+        "modified" => allan::Kind::Modified,
+        "hadamard" => allan::Kind::Hadamard,
+        other => bail!("--kind {other} is not a deviation: expected overlapping, nonoverlapping, modified or hadamard"),
+    };
+    let mut results = Vec::new();
+    let mut curves = Vec::new();
+    let series: Vec<(&PathBuf, &str)> = inputs
+        .iter()
+        .flat_map(|p| columns.iter().map(move |c| (p, c.as_str())))
+        .collect();
+    for (path, column) in series {
+        let (values, skipped) = read_column_with_gaps(path, column)?;
+        if skipped > 0 && !json {
+            eprintln!(
+                "{}: skipped {skipped} rows with an empty {column} cell",
+                path.display()
+            );
+        }
+        if values.len() < 4 {
+            bail!(
+                "{}: {} samples are too few: an Allan deviation needs at least 4 (τ = 1/rate needs 2 differences)",
+                path.display(),
+                values.len()
+            );
+        }
+        let points = allan::curve(kind, &values, rate, grid);
+        let terms = noise::fit(&points);
+        let report = noise::report(&points, &terms);
+        let label = if columns.len() > 1 {
+            format!("{} [{column}]", path.display())
+        } else {
+            path.display().to_string()
+        };
+        curves.push((label, points.clone(), terms));
+        // Welch with the largest power-of-two segment up to N/8 (at most 4096).
+        let segment = (values.len() / 8).clamp(8, 4096).next_power_of_two() / 2;
+        let density = (segment >= 8)
+            .then(|| gyrofx_model::analysis::spectrum::welch(&values, rate, segment.max(8)))
+            .and_then(|psd| psd.median_density(rate / 50.0, rate / 5.0));
+        if json {
+            results.push(serde_json::json!({
+                "input": path.display().to_string(),
+                "column": column,
+                "samples": values.len(),
+                "skipped_empty_cells": skipped,
+                "rate_hz": rate,
+                "kind": format!("{kind:?}").to_lowercase(),
+                "tau_s": points.iter().map(|p| p.tau_s).collect::<Vec<_>>(),
+                "adev": points.iter().map(|p| p.dev).collect::<Vec<_>>(),
+                "adev_lo": points.iter().map(|p| p.lo).collect::<Vec<_>>(),
+                "adev_hi": points.iter().map(|p| p.hi).collect::<Vec<_>>(),
+                "edf": points.iter().map(|p| p.edf).collect::<Vec<_>>(),
+                "noise_alpha": points.iter().map(|p| p.alpha).collect::<Vec<_>>(),
+                "noise": report,
+                "noise_density_dps_per_sqrt_hz": density,
+            }));
+        } else {
+            println!(
+                "{} ({} samples at {rate} Hz, column {column}), {kind:?} deviation",
+                path.display(),
+                values.len()
+            );
+            println!(
+                "{:>12} {:>13} {:>13} {:>13} {:>6} {:>9}",
+                "tau (s)", "dev (°/s)", "lo", "hi", "alpha", "edf"
+            );
+            for p in &points {
+                println!(
+                    "{:>12.6} {:>13.6e} {:>13.6e} {:>13.6e} {:>6} {:>9.1}",
+                    p.tau_s, p.dev, p.lo, p.hi, p.alpha, p.edf
+                );
+            }
+            let line = |name: &str, e: noise::Estimate, unit: &str| {
+                println!(
+                    "  {name:<28} {:>12.5e} [{:.5e}, {:.5e}] {unit}",
+                    e.value, e.lo, e.hi
+                );
+            };
+            println!("noise terms (weighted non-negative fit, ±1 standard error):");
+            line("quantization Q", report.quantization_urad, "µrad");
+            line("angle random walk N", report.arw_deg_per_sqrt_h, "°/√h");
+            line(
+                "bias instability B",
+                report.bias_instability_deg_per_h,
+                "°/h",
+            );
+            line(
+                "rate random walk K",
+                report.rrw_deg_per_h_per_sqrt_h,
+                "°/h/√h",
+            );
+            line("rate ramp R", report.rate_ramp_deg_per_h2, "°/h²");
+            println!(
+                "  Kalibr: noise density {:.5e} rad/s/√Hz, random walk {:.5e} rad/s²/√Hz",
+                report.kalibr_noise_density_rad_per_s_per_sqrt_hz,
+                report.kalibr_random_walk_rad_per_s2_per_sqrt_hz
+            );
+            let opt = |v: Option<f64>| v.map(|v| format!("{v:.5e}")).unwrap_or_else(|| "-".into());
+            println!(
+                "  noise density (Welch, median over fs/50..fs/5): {} °/s/√Hz",
+                opt(density)
+            );
+            println!(
+                "  slope readings: N {} °/√h (τ = 1 s), K {} °/h/√h (τ = 3 s), B {:.5e} °/h (min/0.6643)",
+                opt(report.slope_arw_deg_per_sqrt_h),
+                opt(report.slope_rrw_deg_per_h_per_sqrt_h),
+                report.slope_bias_instability_deg_per_h
+            );
+        }
+    }
+    if let Some(path) = &plot {
+        let series: Vec<gyrofx_codegen::plot::AllanSeries> = curves
+            .iter()
+            .map(|(label, points, terms)| gyrofx_codegen::plot::AllanSeries {
+                label: label.clone(),
+                points,
+                terms: Some(terms),
+            })
+            .collect();
+        gyrofx_codegen::plot::allan(path, &series)?;
+        if !json {
+            println!("plot: {}", path.display());
+        }
+    }
+    if json {
+        let value = if results.len() == 1 {
+            results.remove(0)
+        } else {
+            serde_json::Value::Array(results)
+        };
+        println!("{}", serde_json::to_string_pretty(&value)?);
+    }
+    Ok(ExitCode::SUCCESS)
+}

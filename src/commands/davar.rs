@@ -1,0 +1,150 @@
+//! `gyrofx davar`: the dynamic Allan deviation of a record, over a fixed or PID-adapted
+//! sliding window, with the noise coefficients over time and the disturbances.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{bail, Result};
+
+use gyrofx_model::analysis::davar::{coefficients, davar, disturbances, Pid, Window};
+
+use super::options::{CsvColumn, SampleRate};
+
+/// Dynamic Allan deviation: the ADEV of a window sliding along the record, fixed or
+/// PID-adapted (paper 002), with the noise coefficients over time and the disturbances.
+#[derive(clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    csv: CsvColumn,
+    #[command(flatten)]
+    rate: SampleRate,
+    /// Window length, samples (the longest window with --adaptive).
+    #[arg(long, default_value_t = 3001)]
+    window: usize,
+    /// Adapt the window with the PID controller.
+    #[arg(long)]
+    adaptive: bool,
+    /// Shortest adaptive window, samples (default: window / 10).
+    #[arg(long)]
+    min_window: Option<usize>,
+    /// PID gains, samples per unit of the deviation index (defaults: window/25, window/50, 0).
+    #[arg(long, allow_negative_numbers = true)]
+    kp: Option<f64>,
+    #[arg(long, allow_negative_numbers = true)]
+    ki: Option<f64>,
+    #[arg(long, allow_negative_numbers = true)]
+    kd: Option<f64>,
+    /// Samples between window centres (default: window / 20).
+    #[arg(long)]
+    step: Option<usize>,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+    /// Write the heatmap and the coefficients over time (.png or .svg).
+    #[arg(long)]
+    plot: Option<PathBuf>,
+}
+
+/// Prints the windows' noise coefficients and the disturbances (a table, or JSON), and writes
+/// the plot if asked.
+pub fn run(args: Args) -> Result<ExitCode> {
+    let Args {
+        csv,
+        rate,
+        window,
+        adaptive,
+        min_window,
+        kp,
+        ki,
+        kd,
+        step,
+        json,
+        plot,
+    } = args;
+    let rate = rate.hz()?;
+    let (values, skipped) = csv.read_with_gaps()?;
+    if window < 4 || window > values.len() {
+        bail!(
+            "--window {window} is not allowed: it must be 4..={} samples (the record's length)",
+            values.len()
+        );
+    }
+    let min = min_window.unwrap_or((window / 10).max(4));
+    if adaptive && !(4..=window).contains(&min) {
+        bail!("--min-window {min} is not allowed: it must be 4..={window}");
+    }
+    let step = step.unwrap_or((window / 20).max(1));
+    if step == 0 {
+        bail!("--step 0 is not allowed: windows move by at least 1 sample");
+    }
+    let mode = if adaptive {
+        Window::Adaptive(Pid {
+            min,
+            max: window,
+            kp: kp.unwrap_or(window as f64 / 25.0),
+            ki: ki.unwrap_or(window as f64 / 50.0),
+            kd: kd.unwrap_or(0.0),
+        })
+    } else {
+        Window::Fixed(window)
+    };
+    let d = davar(&values, rate, mode, step);
+    let c = coefficients(&d);
+    let runs = disturbances(&d, 2.0);
+    if let Some(path) = &plot {
+        gyrofx_codegen::plot::davar(path, &d, &c)?;
+        if !json {
+            println!("plot: {}", path.display());
+        }
+    }
+    if json {
+        let value = serde_json::json!({
+            "input": csv.input.display().to_string(),
+            "column": csv.column,
+            "samples": values.len(),
+            "skipped_empty_cells": skipped,
+            "rate_hz": rate,
+            "adaptive": adaptive,
+            "davar": d,
+            "coefficients": c,
+            "disturbances": runs.iter().map(|(a, b)| serde_json::json!({"start_s": a, "end_s": b})).collect::<Vec<_>>(),
+        });
+        println!("{}", serde_json::to_string_pretty(&value)?);
+    } else {
+        println!(
+            "{}: {} windows of {} samples{} every {step} samples; tau {} .. {} s",
+            csv.input.display(),
+            d.time_s.len(),
+            window,
+            if adaptive {
+                format!(" (adaptive, >= {min})")
+            } else {
+                String::new()
+            },
+            d.tau_s.first().copied().unwrap_or(0.0),
+            d.tau_s.last().copied().unwrap_or(0.0)
+        );
+        let show = d.time_s.len().div_ceil(20).max(1);
+        println!(
+            "{:>10} {:>7} {:>12} {:>12} {:>12}",
+            "time (s)", "window", "N (°/√h)", "B (°/h)", "K (°/h/√h)"
+        );
+        for i in (0..d.time_s.len()).step_by(show) {
+            println!(
+                "{:>10.2} {:>7} {:>12.4e} {:>12.4e} {:>12.4e}",
+                d.time_s[i],
+                d.window[i],
+                c.arw_deg_per_sqrt_h[i],
+                c.bias_instability_deg_per_h[i],
+                c.rrw_deg_per_h_per_sqrt_h[i]
+            );
+        }
+        if runs.is_empty() {
+            println!("no disturbance (shortest-tau deviation never above 2x its median)");
+        }
+        for (a, b) in runs {
+            println!("disturbance from {a:.2} s to {b:.2} s");
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,108 @@
+//! `gyrofx generate`: the verification package (vectors, ROMs, testbenches, RTL, manifest),
+//! written atomically.
+
+use std::process::ExitCode;
+
+use anyhow::Result;
+
+use gyrofx_codegen::generate::{generate, Output};
+use gyrofx_codegen::job::Job;
+
+use super::options::{ConfigSource, OutputFolder};
+
+/// Write the verification package (vectors, ROM, testbench, RTL, manifest) atomically.
+#[derive(clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    out: OutputFolder,
+    #[command(flatten)]
+    source: ConfigSource,
+    /// Samples of the chain run (overrides the config).
+    #[arg(long)]
+    samples: Option<usize>,
+    /// Seed (overrides the config).
+    #[arg(long)]
+    seed: Option<u64>,
+}
+
+/// Writes the package and prints what it holds: the files, the KF plan, the fixed-point
+/// errors, the overflow counts and the noise report.
+pub fn run(args: Args) -> Result<ExitCode> {
+    let Args {
+        out: OutputFolder { out },
+        source,
+        samples,
+        seed,
+    } = args;
+    let out = out.as_path();
+    let mut config = source.load()?;
+    if let Some(n) = samples {
+        config.samples = n;
+    }
+    if let Some(s) = seed {
+        config.seed = s;
+    }
+    let job = Job::new(config)?;
+    let bar = indicatif::ProgressBar::new_spinner();
+    let long = job.config.samples >= 1_000_000;
+    let provenance = source.provenance(&job, Output::Package);
+    let summary = generate(&job, out, &provenance, &mut |phase| {
+        if long {
+            bar.set_message(format!("generate: {phase}"));
+            bar.tick();
+        }
+    })?;
+    bar.finish_and_clear();
+    let run = &summary.run;
+    println!(
+        "wrote {} files to {}: {} chain samples; vectors: {}",
+        summary.files.len(),
+        out.display(),
+        run.samples,
+        run.blocks
+            .iter()
+            .map(|b| format!("{} {}", b.name, b.len()))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    println!("kf plan: {}", job.kf());
+    for (what, s) in [
+        ("kf", &run.kf_stats),
+        ("chain", &run.chain_stats),
+        ("bias", &run.bias_stats),
+    ] {
+        println!(
+            "{what} fixed vs float: max {:.3} LSB, rms {:.3} LSB, bound {:.3} LSB; vs ideal: max {:.3} LSB, SQNR {:.1} dB",
+            s.max_lsb, s.rms_lsb, s.bound_lsb, s.ideal_max_lsb, s.sqnr_db
+        );
+    }
+    let o = &run.overflows;
+    println!(
+        "overflows: ADC {:?}, means {:?}, biases {:?}, calibrated {:?}, combined {}, KF x1 {} x2 {} rate_hat {} (directed segment: x1 {} x2 {} rate_hat {})",
+        o.adc, o.estimator.mean, o.estimator.bias, o.estimator.calibrated, o.estimator.combined,
+        o.kf_chain.x1, o.kf_chain.x2, o.kf_chain.rate_hat, o.kf_directed.x1, o.kf_directed.x2, o.kf_directed.rate_hat
+    );
+    println!(
+        "report ({} s):",
+        run.report
+            .tau_s
+            .iter()
+            .map(|t| t.to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    for line in &run.report.lines {
+        let adev: Vec<String> = line
+            .adev_dps
+            .iter()
+            .map(|a| a.map(|v| format!("{v:.3e}")).unwrap_or_else(|| "-".into()))
+            .collect();
+        println!(
+            "  {:<26} bias error {:>+10.3e} °/s, ADEV {}",
+            line.signal,
+            line.bias_error_dps,
+            adev.join(" ")
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}

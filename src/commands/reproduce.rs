@@ -1,0 +1,64 @@
+//! `gyrofx reproduce`: a paper's pipeline on simulated data, its tables beside gyrofx's, with
+//! the differences explained (markdown).
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{bail, Result};
+
+use gyrofx_codegen::reproduce;
+
+/// Run a paper's pipeline on simulated data and print its tables beside gyrofx's, with
+/// the differences explained (markdown): 000, 002, 003, 004.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The paper: 000, 002, 003 or 004.
+    #[arg(long)]
+    paper: String,
+    /// Samples to simulate (default: the paper's record length).
+    #[arg(long)]
+    samples: Option<usize>,
+    /// Seed of the simulation.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Also write report.md, allan.png (and davar.png for 002) into this folder.
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+/// Prints the report; with `--out`, also writes it and its plots.
+pub fn run(args: Args) -> Result<ExitCode> {
+    let Args {
+        paper,
+        samples,
+        seed,
+        out,
+    } = args;
+    let paper = paper.as_str();
+    let (report, curves, davar) = match paper {
+        "000" => {
+            let p = reproduce::paper_000(samples.unwrap_or(reproduce::SAMPLES_000), seed)?;
+            (p.markdown(), p.curves, None)
+        }
+        "002" => {
+            let p = reproduce::paper_002(samples.unwrap_or(reproduce::SAMPLES_002), seed)?;
+            (p.markdown(), Vec::new(), Some(p.adaptive))
+        }
+        "003" => {
+            let p = reproduce::paper_003(samples.unwrap_or(reproduce::SAMPLES), seed)?;
+            (p.markdown(), p.curves, None)
+        }
+        "004" => {
+            let p = reproduce::paper_004(samples.unwrap_or(reproduce::SAMPLES_004), seed)?;
+            (p.markdown(), p.curves, None)
+        }
+        other => bail!("--paper {other:?} is not one of the papers: use 000, 002, 003 or 004"),
+    };
+    print!("{report}");
+    if let Some(folder) = &out {
+        let davar = davar.as_ref().map(|(d, c)| (d, c));
+        let files = reproduce::write(folder, paper, seed, &report, &curves, davar)?;
+        eprintln!("wrote {} in {}", files.join(", "), folder.display());
+    }
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,51 @@
+//! `gyrofx synth`: the chain through yosys (generic and Xilinx 7-series) as a structural check,
+//! with the resource report, scripts and logs written atomically.
+
+use std::process::ExitCode;
+
+use anyhow::Result;
+
+use gyrofx_codegen::generate::Output;
+use gyrofx_codegen::job::Job;
+use gyrofx_codegen::synth::{synthesize, TOP};
+
+use super::options::{ConfigSource, OutputFolder};
+
+/// Synthesize the chain with the config's widths in yosys (generic and Xilinx 7-series):
+/// fails on a latch, an undriven or multiply-driven net or a missing module; writes the
+/// resource report, scripts and logs atomically.
+#[derive(clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    out: OutputFolder,
+    #[command(flatten)]
+    source: ConfigSource,
+}
+
+/// Synthesizes the chain and prints the resources of both targets.
+pub fn run(args: Args) -> Result<ExitCode> {
+    let Args {
+        out: OutputFolder { out },
+        source,
+    } = args;
+    let out = out.as_path();
+    let config = source.load()?;
+    let job = Job::new(config)?;
+    let provenance = source.provenance(&job, Output::Synthesis);
+    let resources = synthesize(&job, out, &provenance)?;
+    let (g, x) = (&resources.generic, &resources.xilinx);
+    println!(
+        "synthesis check passed: {}; report in {}",
+        TOP,
+        out.join("report.md").display()
+    );
+    println!(
+        "generic: {} cells, {} flip-flops, {} multipliers",
+        g.cells, g.flip_flops, g.multipliers
+    );
+    println!(
+        "xilinx 7-series: {} LUTs, {} flip-flops, {} DSP48E1, {} block RAM",
+        x.luts, x.flip_flops, x.dsp48, x.block_rams
+    );
+    Ok(ExitCode::SUCCESS)
+}

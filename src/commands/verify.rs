@@ -1,0 +1,92 @@
+//! `gyrofx verify`: a generated package's testbenches in one or more simulators, with a
+//! non-zero exit on any failure.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+
+use gyrofx_codegen::junit;
+use gyrofx_codegen::simulate::{self, Simulator};
+
+/// Run a generated package's testbench in a simulator; non-zero exit on failure.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The package folder.
+    #[arg(long)]
+    out: PathBuf,
+    /// Simulators, comma-separated: iverilog, verilator, ghdl (the VHDL RTL), or all.
+    #[arg(long, default_value = "iverilog")]
+    sim: String,
+    /// Latency mask: samples not compared at the start and from every reset sample on.
+    #[arg(long, default_value_t = 0)]
+    mask: u64,
+    /// Mismatches printed per testbench.
+    #[arg(long, default_value_t = 10)]
+    max_reported: u64,
+    /// Stop a testbench at this many mismatches (0: never).
+    #[arg(long, default_value_t = 0)]
+    max_mismatches: u64,
+    /// Write a VCD per testbench (tb_<module>.vcd in each block folder).
+    #[arg(long)]
+    waves: bool,
+    /// Write a JUnit XML summary here (one testsuite per simulator, one testcase per block).
+    #[arg(long)]
+    junit: Option<PathBuf>,
+}
+
+/// Runs every block's testbench in each simulator, prints the mismatches and a verdict per
+/// simulator, and writes the JUnit summary if asked.
+pub fn run(args: Args) -> Result<ExitCode> {
+    let Args {
+        out,
+        sim,
+        mask,
+        max_reported,
+        max_mismatches,
+        waves,
+        junit: junit_path,
+    } = args;
+    let options = simulate::Options {
+        mask,
+        max_reported,
+        max_mismatches,
+        waves,
+    };
+    let simulators: Vec<Simulator> = if sim == "all" {
+        Simulator::ALL.to_vec()
+    } else {
+        sim.split(',')
+            .map(|name| name.trim().parse())
+            .collect::<std::result::Result<_, _>>()?
+    };
+    let mut outcomes = Vec::with_capacity(simulators.len());
+    for simulator in simulators {
+        let outcome = simulate::run(&out, simulator, &options)?;
+        for line in outcome.report() {
+            println!("{line}");
+        }
+        for block in outcome
+            .blocks
+            .iter()
+            .filter(|b| !b.passed && b.report.is_empty())
+        {
+            eprintln!("{}", block.log);
+        }
+        if outcome.passed() {
+            println!("{}: passed", simulator.name());
+        } else {
+            eprintln!("{}: FAILED", simulator.name());
+        }
+        outcomes.push(outcome);
+    }
+    if let Some(path) = &junit_path {
+        std::fs::write(path, junit::report(&outcomes))
+            .with_context(|| format!("cannot write the JUnit summary {}", path.display()))?;
+    }
+    if outcomes.iter().all(simulate::Outcome::passed) {
+        Ok(ExitCode::SUCCESS)
+    } else {
+        Ok(ExitCode::FAILURE)
+    }
+}
