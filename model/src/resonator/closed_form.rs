@@ -54,8 +54,11 @@ pub struct ModeFigures {
     mass: f64,
     k_xy: f64,
     d_xy: f64,
-    /// Ring-down time constant of the driven axis once the drive stops, `2 m / d_aa`, s
-    /// (`= 2 Q_a / w` with the axis's own `Q_a = m w / d_aa`).
+    /// Ring-down time constant of the drive mode once the drive stops, s: `2 m / d_mode`
+    /// with `d_mode = uᵀ D u` the damping along the mode's principal stiffness axis `u`
+    /// (`d1 cos²(ε−θ) + d2 sin²(ε−θ)` normal, `d1 sin²(ε−θ) + d2 cos²(ε−θ)` reverse). This
+    /// is `2 Q1 / w1` (normal) when `θ = ε`; first order in the coupling, so it holds for
+    /// modes split by more than the damping couples them.
     pub ring_down_time_constant: f64,
 }
 
@@ -64,23 +67,31 @@ impl ModeFigures {
     pub fn new(params: &ResonatorParams, mode: Mode) -> Self {
         let m = params.mass_kg;
         let mats = params.matrices();
-        let (k_aa, k_ss, d_aa, d_ss, phase_deg) = match mode {
+        let (k_aa, k_ss, d_ss, phase_deg) = match mode {
             Mode::Normal => (
                 mats.k[0][0],
                 mats.k[1][1],
-                mats.d[0][0],
                 mats.d[1][1],
                 params.phase_error_deg,
             ),
             Mode::Reverse => (
                 mats.k[1][1],
                 mats.k[0][0],
-                mats.d[1][1],
                 mats.d[0][0],
                 params.phase_error_reverse_deg,
             ),
         };
         let (k_xy, d_xy) = (mats.k[0][1], mats.d[0][1]);
+        let misalignment = (params.stiffness_angle_deg - params.damping_angle_deg) * RAD_PER_DEG;
+        let (c2, s2) = (
+            libm::cos(misalignment) * libm::cos(misalignment),
+            libm::sin(misalignment) * libm::sin(misalignment),
+        );
+        let [d1, d2] = mats.d_principal;
+        let d_mode = match mode {
+            Mode::Normal => d1 * c2 + d2 * s2,
+            Mode::Reverse => d1 * s2 + d2 * c2,
+        };
         let w = (k_aa / m).sqrt();
         let z_re = k_ss - m * w * w;
         let z_im = w * d_ss;
@@ -101,7 +112,7 @@ impl ModeFigures {
             mass: m,
             k_xy,
             d_xy,
-            ring_down_time_constant: 2.0 * m / d_aa,
+            ring_down_time_constant: 2.0 * m / d_mode,
         }
     }
 
@@ -274,6 +285,7 @@ mod tests {
         close(n.drive_frequency_hz(), 8195.0, 0.01, "w/2π (Hz)");
         // SPEC prints "2Q/w = 7.2 ms"; 2 · 184 / (2π · 8195 Hz) is 7.147 ms.
         close(n.ring_down_time_constant * 1e3, 7.147, 0.001, "2Q/w (ms)");
+        close(v.ring_down_time_constant * 1e3, 7.623, 0.001, "2Q′/w′ (ms)");
     }
 
     #[test]
