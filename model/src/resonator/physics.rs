@@ -12,6 +12,9 @@ use crate::stimulus::{Gaussian, ResonatorSource, Stream};
 /// Boltzmann's constant, J/K (exact since the 2019 SI).
 pub const BOLTZMANN_J_PER_K: f64 = 1.380_649e-23;
 
+/// 2^63 as f64 (exact): the ADC's scaled input must stay below it for the cast to i64.
+const I64_LIMIT: f64 = 9_223_372_036_854_775_808.0;
+
 /// Neither principal damping drifts below this fraction of its nominal value.
 const DAMPING_FLOOR: f64 = 0.1;
 
@@ -274,7 +277,7 @@ pub struct Resonator {
     state: [f64; 4],
     samples: u64,
     sources: Sources,
-    /// Per-sample σ of the ADC input noise, V; ADC scale, codes per V; code range.
+    /// ADC scale `2^(w−1) / full_scale`, codes per V, and the code range.
     adc_codes_per_volt: f64,
     adc_range: (i64, i64),
     adc_saturations: u64,
@@ -347,7 +350,7 @@ impl Resonator {
                 phase: None,
             }
         };
-        let half_range = crate::fx::pow2(settings.adc_width as i32 - 1);
+        let half_range = 1i128 << (settings.adc_width - 1);
         let mut resonator = Resonator {
             params: *params,
             settings: *settings,
@@ -365,14 +368,10 @@ impl Resonator {
             state: [0.0; 4],
             samples: 0,
             sources,
-            adc_codes_per_volt: half_range / settings.adc_full_scale_v,
-            adc_range: (-(half_range as i64), (half_range as i64).wrapping_sub(1)),
+            adc_codes_per_volt: half_range as f64 / settings.adc_full_scale_v,
+            adc_range: ((-half_range) as i64, (half_range - 1) as i64),
             adc_saturations: 0,
         };
-        // i64::MIN..=i64::MAX for a 64-bit ADC: 2^63 as i64 saturates to i64::MAX.
-        if settings.adc_width == 64 {
-            resonator.adc_range = (i64::MIN, i64::MAX);
-        }
         resonator.discretise();
         resonator.update_pickoff();
         Ok(resonator)
@@ -529,8 +528,9 @@ impl Resonator {
             let floor = scaled.floor();
             let code = (floor as i64).saturating_add(i64::from(scaled - floor >= 0.5));
             let clamped = code.clamp(self.adc_range.0, self.adc_range.1);
-            self.adc_saturations +=
-                u64::from(clamped != code || !(-9.2e18..9.2e18).contains(&scaled));
+            // Beyond ±2^63 the cast has saturated already.
+            let beyond_i64 = !(-I64_LIMIT..I64_LIMIT).contains(&scaled);
+            self.adc_saturations += u64::from(clamped != code || beyond_i64);
             clamped
         })
     }

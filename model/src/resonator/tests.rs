@@ -678,6 +678,14 @@ fn dac_and_adc_scale_round_and_saturate() {
     assert_eq!(r.adc_saturations(), 1);
     assert_eq!(r.adc([0.25, -2.0]), [2_097_152, -8_388_608]);
     assert_eq!(r.adc_saturations(), 2);
+    // The widest ADC spans the whole i64 range.
+    let wide = PhysicsSettings {
+        adc_width: 64,
+        ..PhysicsSettings::example().noiseless()
+    };
+    let mut w = Resonator::new(&params, &wide, 0).unwrap();
+    assert_eq!(w.adc([1.0, -1.0]), [i64::MAX, i64::MIN]);
+    assert_eq!(w.adc_saturations(), 1);
     // DAC codes to ADC codes: a held force moves x from rest by Γ·F (positive for a push).
     let codes = r.step_codes([10_000, 0]);
     assert!(codes[0] > 0, "{codes:?}");
