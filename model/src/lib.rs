@@ -14,5 +14,6 @@ pub mod fx;
 pub mod kf;
 pub mod mean_filter;
 pub mod plant;
+pub mod resonator;
 pub mod sequencer;
 pub mod stimulus;

@@ -22,6 +22,24 @@ pub enum Stream {
     BiasInstability(u8, u8),
     /// Noise realization `index` of an ensemble decomposition (ICEEMDAN).
     DecompositionNoise(u32),
+    /// A random source of a simulated resonator ([`crate::resonator`]); the two gyros of a
+    /// pair take different seeds.
+    Resonator(ResonatorSource),
+}
+
+/// The random sources of one simulated resonator, each on its own stream.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ResonatorSource {
+    /// Thermomechanical (Brownian) force on both axes.
+    Thermomechanical,
+    /// Electronic noise of the pick-off of axis `0` (x) or `1` (y).
+    Pickoff(u8),
+    /// Gauss–Markov drift of the damping split `d1 − d2`.
+    DampingSplitDrift,
+    /// Gauss–Markov drift of the damping angle θ.
+    DampingAngleDrift,
+    /// Gauss–Markov drift of the sense channel's phase error.
+    PhaseDrift,
 }
 
 impl Stream {
@@ -33,6 +51,17 @@ impl Stream {
             Stream::BiasInstability(g, j) => (16 + u64::from(j), g),
             // Above every plant stream (those stay below 1024 · 256).
             Stream::DecompositionNoise(i) => return (1 << 32) + u64::from(i),
+            // Above the decomposition streams.
+            Stream::Resonator(source) => {
+                let index = match source {
+                    ResonatorSource::Thermomechanical => 0,
+                    ResonatorSource::Pickoff(axis) => 1 + u64::from(axis),
+                    ResonatorSource::DampingSplitDrift => 1 + 256,
+                    ResonatorSource::DampingAngleDrift => 2 + 256,
+                    ResonatorSource::PhaseDrift => 3 + 256,
+                };
+                return (2 << 32) + index;
+            }
         };
         source + 1024 * u64::from(gyro)
     }
