@@ -8,6 +8,7 @@ use serde_json::json;
 use crate::block::{Block, Timing};
 use crate::blocks::{RomImages, REGISTRY};
 use crate::error::Result;
+use crate::hdl;
 use crate::job::Job;
 use crate::package::{sha256_hex, Package, MANIFEST};
 use crate::rom::{self, RomFormat, ROM_FOLDER};
@@ -147,7 +148,7 @@ pub fn build_package(
     package.add("README.md", writers::package_readme(&run, provenance));
     package.add("Makefile", writers::makefile(&run.blocks, provenance));
     package.add("report.md", writers::report_md(&run, provenance));
-    for (name, source) in writers::RTL_SOURCES.iter().chain(&writers::VHDL_SOURCES) {
+    for (name, source) in hdl::RTL_SOURCES.iter().chain(&hdl::VHDL_SOURCES) {
         package.add(format!("hdl/{name}"), *source);
     }
     for image in roms.iter() {

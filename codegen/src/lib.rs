@@ -13,6 +13,7 @@ pub mod blocks;
 pub mod config;
 pub mod error;
 pub mod generate;
+pub mod hdl;
 pub mod input;
 pub mod job;
 pub mod junit;

@@ -14,9 +14,10 @@ use serde::Serialize;
 use crate::block::Block;
 use crate::blocks::{self, RomImages};
 use crate::error::{Error, Result};
+use crate::hdl;
 use crate::job::Job;
 use crate::package::Package;
-use crate::writers::{self, Provenance};
+use crate::writers::Provenance;
 
 /// Module synthesized: the whole chain.
 pub const TOP: &str = "gyrofx_top";
@@ -70,7 +71,7 @@ fn chparams(block: &Block) -> String {
 /// The RTL of `gyrofx_top`: its file and its submodules' (not the mean filter, a block beside
 /// the chain: yosys would load its ROM image while reading it).
 fn chain_sources() -> Vec<&'static (&'static str, &'static str)> {
-    writers::verilog_sources_of(TOP)
+    hdl::verilog_sources_of(TOP)
 }
 
 fn read_sources() -> String {

@@ -8,97 +8,9 @@ use std::fmt::Write as _;
 use gyrofx_model::fx::Format;
 
 use crate::block::Block;
+use crate::hdl::{RTL_SOURCES, VHDL_SOURCES};
 use crate::testbench::header;
 use crate::vectors::Run;
-
-/// The reference RTL, embedded so that every package is self-contained.
-pub const RTL_SOURCES: [(&str, &str); 7] = [
-    (
-        "gyrofx_quantize.v",
-        include_str!("../../hdl/gyrofx_quantize.v"),
-    ),
-    ("gyrofx_kf.v", include_str!("../../hdl/gyrofx_kf.v")),
-    (
-        "gyrofx_sequencer.v",
-        include_str!("../../hdl/gyrofx_sequencer.v"),
-    ),
-    (
-        "gyrofx_bias_estimator.v",
-        include_str!("../../hdl/gyrofx_bias_estimator.v"),
-    ),
-    (
-        "gyrofx_calibration.v",
-        include_str!("../../hdl/gyrofx_calibration.v"),
-    ),
-    ("gyrofx_top.v", include_str!("../../hdl/gyrofx_top.v")),
-    (
-        "gyrofx_mean_filter.v",
-        include_str!("../../hdl/gyrofx_mean_filter.v"),
-    ),
-];
-
-/// The Verilog sources `module` is made of: its own file and those of every module it
-/// instantiates, transitively, in [`RTL_SOURCES`] order. Found from the RTL text itself (an
-/// instance line starts with the module name and ` #(`), so it cannot drift from the RTL.
-pub fn verilog_sources_of(module: &str) -> Vec<&'static (&'static str, &'static str)> {
-    let file = |m: &str| format!("{m}.v");
-    let mut needed = vec![module.to_string()];
-    let mut next = 0;
-    while next < needed.len() {
-        let name = file(&needed[next]);
-        next += 1;
-        let Some((_, source)) = RTL_SOURCES.iter().find(|(n, _)| *n == name) else {
-            continue;
-        };
-        for line in source.lines() {
-            if let Some((instance, _)) = line.split_once(" #(") {
-                let instance = instance.trim();
-                if instance.starts_with("gyrofx_") && !needed.iter().any(|m| m == instance) {
-                    needed.push(instance.to_string());
-                }
-            }
-        }
-    }
-    RTL_SOURCES
-        .iter()
-        .filter(|(n, _)| needed.iter().any(|m| file(m) == *n))
-        .collect()
-}
-
-/// The reference RTL in VHDL-2008, in compile order (packages first), and the package the VHDL
-/// testbenches share (last: simulation only).
-pub const VHDL_SOURCES: [(&str, &str); 9] = [
-    (
-        "gyrofx_mem_pkg.vhd",
-        include_str!("../../hdl/gyrofx_mem_pkg.vhd"),
-    ),
-    (
-        "gyrofx_quantize.vhd",
-        include_str!("../../hdl/gyrofx_quantize.vhd"),
-    ),
-    ("gyrofx_kf.vhd", include_str!("../../hdl/gyrofx_kf.vhd")),
-    (
-        "gyrofx_sequencer.vhd",
-        include_str!("../../hdl/gyrofx_sequencer.vhd"),
-    ),
-    (
-        "gyrofx_bias_estimator.vhd",
-        include_str!("../../hdl/gyrofx_bias_estimator.vhd"),
-    ),
-    (
-        "gyrofx_calibration.vhd",
-        include_str!("../../hdl/gyrofx_calibration.vhd"),
-    ),
-    ("gyrofx_top.vhd", include_str!("../../hdl/gyrofx_top.vhd")),
-    (
-        "gyrofx_mean_filter.vhd",
-        include_str!("../../hdl/gyrofx_mean_filter.vhd"),
-    ),
-    (
-        "gyrofx_testbench_pkg.vhd",
-        include_str!("../../hdl/gyrofx_testbench_pkg.vhd"),
-    ),
-];
 
 /// Where generated files come from: printed at the top of each.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -484,36 +396,4 @@ the filtered output is the KF's (bw_sel as scheduled).
         out.push('\n');
     }
     out
-}
-
-#[cfg(test)]
-mod tests {
-    use super::verilog_sources_of;
-
-    fn names(module: &str) -> Vec<&'static str> {
-        verilog_sources_of(module).iter().map(|(n, _)| *n).collect()
-    }
-
-    /// The chain's sources are found by following its instances: every submodule and the
-    /// requantizer, not the mean filter beside it; a leaf block needs only itself and the
-    /// requantizer.
-    #[test]
-    fn a_modules_sources_follow_its_instances() {
-        assert_eq!(
-            names("gyrofx_top"),
-            [
-                "gyrofx_quantize.v",
-                "gyrofx_kf.v",
-                "gyrofx_sequencer.v",
-                "gyrofx_bias_estimator.v",
-                "gyrofx_calibration.v",
-                "gyrofx_top.v",
-            ]
-        );
-        assert_eq!(
-            names("gyrofx_mean_filter"),
-            ["gyrofx_quantize.v", "gyrofx_mean_filter.v"]
-        );
-        assert_eq!(names("gyrofx_sequencer"), ["gyrofx_sequencer.v"]);
-    }
 }

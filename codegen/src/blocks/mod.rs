@@ -7,8 +7,8 @@
 //! downstream iterates over [`REGISTRY`]; nothing else matches on block names.
 //!
 //! Adding a block: a model module in `gyrofx-model`, a module here implementing [`RtlBlock`],
-//! the RTL pair in `hdl/` (listed in [`crate::writers::RTL_SOURCES`] and
-//! [`crate::writers::VHDL_SOURCES`], which keep VHDL's compile order), a page in `docs/blocks/`
+//! the RTL pair in `hdl/` (listed in [`crate::hdl::RTL_SOURCES`] and
+//! [`crate::hdl::VHDL_SOURCES`], which keep VHDL's compile order), a page in `docs/blocks/`
 //! and one line in [`REGISTRY`].
 
 pub mod calibration;
