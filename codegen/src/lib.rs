@@ -8,6 +8,8 @@
 #![warn(missing_docs)]
 
 pub mod block;
+/// One folder per RTL block; for now each holds its config section.
+pub mod blocks;
 pub mod config;
 pub mod error;
 pub mod generate;

@@ -1,0 +1,3 @@
+//! The bias estimator: mode-reversal bias estimation and calibration.
+
+pub mod config;

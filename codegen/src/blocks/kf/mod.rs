@@ -1,0 +1,3 @@
+//! The Kalman filter: a ROM of steady-state gains per bandwidth.
+
+pub mod config;

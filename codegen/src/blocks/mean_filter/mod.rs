@@ -1,0 +1,3 @@
+//! The mean filter with gross-error rejection.
+
+pub mod config;

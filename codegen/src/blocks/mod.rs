@@ -1,0 +1,4 @@
+pub mod estimator;
+pub mod kf;
+pub mod mean_filter;
+pub mod sequencer;

@@ -1,0 +1,3 @@
+//! The sequencer: the mode-reversal schedule.
+
+pub mod config;
