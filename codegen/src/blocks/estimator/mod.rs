@@ -1,6 +1,8 @@
 //! `estimator` — `gyrofx_bias_estimator`, the least-squares bias estimator of mode reversal:
 //! interval means and `b = G m` at every window end (SPEC §1.3, `docs/blocks/estimator.md`).
 
+pub mod config;
+
 use gyrofx_model::estimator::Plan;
 use serde_json::json;
 

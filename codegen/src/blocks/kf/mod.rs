@@ -2,6 +2,8 @@
 //! bandwidth (SPEC §1.4, `docs/blocks/kf.md`). Its vectors: the chain's KF inputs, then a
 //! directed segment (rounding ties and full scale, each from reset).
 
+pub mod config;
+
 use gyrofx_model::kf::bound::rate_error_bound_lsb;
 use gyrofx_model::kf::{FixedKf, FloatKf, OverflowCounts, Plan};
 use serde::Serialize;

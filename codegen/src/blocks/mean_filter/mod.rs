@@ -2,6 +2,8 @@
 //! 003, a block beside the chain (SPEC §1.5, `docs/blocks/mean_filter.md`). Its vectors: gyro
 //! A's ADC samples with gross errors added, the chain's reset, then directed blocks.
 
+pub mod config;
+
 use gyrofx_model::mean_filter::{FixedMeanFilter, FloatMeanFilter, Plan};
 use serde_json::json;
 

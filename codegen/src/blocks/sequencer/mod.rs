@@ -2,6 +2,8 @@
 //! mode, blanking, interval index and interval/window strobes (SPEC §1.2,
 //! `docs/blocks/sequencer.md`).
 
+pub mod config;
+
 use gyrofx_model::sequencer::Schedule;
 
 use super::{flag, mode_bit, ChainSample, RomImages, RtlBlock, VectorBuilder};

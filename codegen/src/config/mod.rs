@@ -1,0 +1,400 @@
+//! The TOML config: the annotated embedded default, overlays, and validation into typed values.
+//!
+//! A user config is a partial overlay of the embedded default ([`DEFAULT_TOML`]): keys it
+//! leaves out keep their default. Unknown keys, wrong types and out-of-range values are errors
+//! naming the key, the value and what is allowed.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use gyrofx_model::estimator::Spec as EstimatorSpec;
+use gyrofx_model::fx::{Overflow, Rounding};
+use gyrofx_model::mean_filter::Spec as MeanFilterSpec;
+use gyrofx_model::plant::{GyroErrors, Plant};
+
+use crate::error::{Error, Result};
+
+pub(crate) mod check;
+mod gyro;
+mod stimulus;
+
+pub use crate::blocks::estimator::config::EstimatorConfig;
+pub use crate::blocks::kf::config::{KfConfig, KfSettings};
+pub use crate::blocks::mean_filter::config::MeanFilterConfig;
+pub use crate::blocks::sequencer::config::SequencerConfig;
+pub use gyro::PlantConfig;
+pub use stimulus::{Source, StimulusConfig};
+
+/// Largest `samples`: the vector set and its files are built in memory.
+pub const MAX_SAMPLES: usize = 20_000_000;
+
+/// The embedded, annotated default config (`gyrofx init` prints it).
+pub const DEFAULT_TOML: &str = include_str!("../default.toml");
+
+/// The whole config, as read (after overlaying the default).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Config {
+    /// Seed of every random stream.
+    pub seed: u64,
+    /// Samples of the chain run.
+    pub samples: usize,
+    /// Rounding mode name of every quantization point.
+    pub rounding: String,
+    /// Overflow mode name of every quantization point.
+    pub overflow: String,
+    /// The true rate.
+    pub stimulus: StimulusConfig,
+    /// Gyro A's errors.
+    pub gyro_a: GyroErrors,
+    /// Gyro B's errors.
+    pub gyro_b: GyroErrors,
+    /// Plant-wide settings.
+    pub plant: PlantConfig,
+    /// The sequencer.
+    pub sequencer: SequencerConfig,
+    /// The bias estimator.
+    pub estimator: EstimatorConfig,
+    /// The Kalman filter.
+    pub kf: KfConfig,
+    /// The mean filter with gross-error rejection (paper 003; a block of its own, beside the
+    /// chain).
+    pub mean_filter: MeanFilterConfig,
+}
+
+/// Everything the config says, validated and typed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Settings {
+    /// The true rate.
+    pub source: Source,
+    /// The plant.
+    pub plant: Plant,
+    /// The estimator (with the sequencer's schedule).
+    pub estimator: EstimatorSpec,
+    /// The KF.
+    pub kf: KfSettings,
+    /// The mean filter (its input format is the KF's).
+    pub mean_filter: MeanFilterSpec,
+}
+
+/// The names of the presets, in the order `gyrofx init --preset` lists them.
+pub const PRESETS: [(&str, &str); 3] = [
+    ("gu2019", include_str!("../presets/gu2019.toml")),
+    ("xue2015", include_str!("../presets/xue2015.toml")),
+    ("mpu6050", include_str!("../presets/mpu6050.toml")),
+];
+
+/// The text of preset `name`.
+///
+/// # Errors
+/// [`Error::Config`] for an unknown name, listing the known ones.
+pub fn preset(name: &str) -> Result<&'static str> {
+    PRESETS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, text)| *text)
+        .ok_or_else(|| {
+            let names: Vec<&str> = PRESETS.iter().map(|(n, _)| *n).collect();
+            Error::config(
+                "preset",
+                format!("{name:?}"),
+                format!("one of {}", names.join(", ")),
+            )
+        })
+}
+
+/// Optional keys that the default leaves commented out.
+const OPTIONAL_KEYS: [&str; 4] = [
+    "stimulus.csv_path",
+    "stimulus.csv_column",
+    "kf.g1_format",
+    "kf.g2_format",
+];
+
+/// Refuses a key of `user` that neither the default nor [`OPTIONAL_KEYS`] has, naming it and
+/// the line it stands on.
+fn check_known_keys(
+    user: &toml::Table,
+    default: &toml::Table,
+    prefix: &str,
+    text: &str,
+    origin: &str,
+) -> Result<()> {
+    for (key, value) in user {
+        let path = format!("{prefix}{key}");
+        match (default.get(key), value) {
+            (Some(toml::Value::Table(d)), toml::Value::Table(u)) => {
+                check_known_keys(u, d, &format!("{path}."), text, origin)?
+            }
+            (Some(_), _) => {}
+            (None, _) if OPTIONAL_KEYS.contains(&path.as_str()) => {}
+            (None, _) => {
+                let line = text
+                    .lines()
+                    .position(|l| {
+                        let l = l.trim_start();
+                        l.starts_with(key.as_str())
+                            && l[key.len()..].trim_start().starts_with(['=', '.'])
+                            || l.trim_start_matches('[').starts_with(path.as_str())
+                    })
+                    .map(|i| format!(" (line {})", i + 1))
+                    .unwrap_or_default();
+                let mut known: Vec<String> = default
+                    .keys()
+                    .map(|k| format!("{prefix}{k}"))
+                    .chain(
+                        OPTIONAL_KEYS
+                            .iter()
+                            .filter(|k| k.starts_with(prefix) && !prefix.is_empty())
+                            .map(|k| k.to_string()),
+                    )
+                    .collect();
+                known.sort();
+                return Err(Error::ConfigSyntax {
+                    origin: origin.to_string(),
+                    message: format!(
+                        "unknown key {path}{line}; known keys here: {}",
+                        known.join(", ")
+                    ),
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Merges `overlay` into `base`, table by table.
+fn merge(base: &mut toml::Table, overlay: toml::Table) {
+    for (key, value) in overlay {
+        match (base.get_mut(&key), value) {
+            (Some(toml::Value::Table(b)), toml::Value::Table(o)) => merge(b, o),
+            (_, v) => {
+                base.insert(key, v);
+            }
+        }
+    }
+}
+
+impl Config {
+    /// The embedded default.
+    pub fn embedded() -> Config {
+        Config::from_toml(DEFAULT_TOML, "embedded default").expect("the embedded default is valid")
+    }
+
+    /// Parses a (partial) config text over the embedded default. `origin` names it in errors.
+    ///
+    /// # Errors
+    /// [`Error::ConfigSyntax`] for bad TOML, unknown keys or wrong types.
+    pub fn from_toml(text: &str, origin: &str) -> Result<Config> {
+        Config::from_overlays(&[(text, origin)])
+    }
+
+    /// Parses partial config texts over the embedded default, later ones over earlier ones
+    /// (a preset, then a file). Each `(text, origin)`; `origin` names it in errors.
+    ///
+    /// # Errors
+    /// [`Error::ConfigSyntax`] for bad TOML, unknown keys or wrong types.
+    pub fn from_overlays(overlays: &[(&str, &str)]) -> Result<Config> {
+        let mut merged: toml::Table = toml::from_str(DEFAULT_TOML).expect("default parses");
+        let default = merged.clone();
+        for (text, origin) in overlays {
+            let syntax = |e: toml::de::Error| Error::ConfigSyntax {
+                origin: origin.to_string(),
+                message: e.to_string().trim_end().to_string(),
+            };
+            let user: toml::Table = toml::from_str(text).map_err(syntax)?;
+            check_known_keys(&user, &default, "", text, origin)?;
+            merge(&mut merged, user);
+        }
+        let merged_text = toml::to_string(&merged).expect("a table serializes");
+        let origin = overlays.last().map(|o| o.1).unwrap_or("embedded default");
+        toml::from_str(&merged_text).map_err(|e| Error::ConfigSyntax {
+            origin: origin.to_string(),
+            message: e.to_string().trim_end().to_string(),
+        })
+    }
+
+    /// Reads a config file over the embedded default; a relative `csv_path` is resolved against
+    /// the file's folder.
+    ///
+    /// # Errors
+    /// [`Error::Io`] when the file cannot be read, and those of [`Config::from_toml`].
+    pub fn from_file(path: &Path) -> Result<Config> {
+        Config::from_preset_and_file(None, Some(path))
+    }
+
+    /// The embedded default, overlaid by a preset and then by a config file (either optional).
+    ///
+    /// # Errors
+    /// An unknown preset, and those of [`Config::from_overlays`] and reading the file.
+    pub fn from_preset_and_file(preset_name: Option<&str>, path: Option<&Path>) -> Result<Config> {
+        let mut overlays: Vec<(String, String)> = Vec::new();
+        if let Some(name) = preset_name {
+            overlays.push((preset(name)?.to_string(), format!("preset {name}")));
+        }
+        if let Some(path) = path {
+            let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+            overlays.push((text, path.display().to_string()));
+        }
+        let refs: Vec<(&str, &str)> = overlays
+            .iter()
+            .map(|(t, o)| (t.as_str(), o.as_str()))
+            .collect();
+        let mut config = Config::from_overlays(&refs)?;
+        let Some(path) = path else {
+            return Ok(config);
+        };
+        if let Some(csv) = &config.stimulus.csv_path {
+            if csv.is_relative() {
+                let folder = path.parent().unwrap_or(Path::new("."));
+                config.stimulus.csv_path = Some(folder.join(csv));
+            }
+        }
+        Ok(config)
+    }
+
+    /// The config as TOML (resolved: every key present).
+    pub fn to_toml(&self) -> String {
+        toml::to_string(self).expect("config serializes")
+    }
+
+    /// Checks every value and returns the typed settings of every block.
+    ///
+    /// The top-level keys come first, then each section checks itself, in the order
+    /// `[stimulus]`, `[gyro_a]`, `[gyro_b]`, `[plant]`, `[sequencer]`, `[kf]`, `[estimator]`,
+    /// `[mean_filter]`; the estimator and the mean filter read the KF's input format.
+    ///
+    /// # Errors
+    /// [`Error::Config`] naming the first bad field.
+    pub fn validate(&self) -> Result<Settings> {
+        if self.samples == 0 || self.samples > MAX_SAMPLES {
+            return Err(Error::config(
+                "samples",
+                self.samples,
+                format!("1..={MAX_SAMPLES}"),
+            ));
+        }
+        let rounding: Rounding = self.rounding.parse().map_err(|_| {
+            Error::config(
+                "rounding",
+                format!("{:?}", self.rounding),
+                "one of floor, ceil, zero, nearest, round, convergent",
+            )
+        })?;
+        let overflow: Overflow = self.overflow.parse().map_err(|_| {
+            Error::config(
+                "overflow",
+                format!("{:?}", self.overflow),
+                "wrap or saturate",
+            )
+        })?;
+        let source = self.stimulus.validate()?;
+        let fs_hz = self.stimulus.fs_hz;
+        let plant = self.plant.validate(fs_hz, &self.gyro_a, &self.gyro_b)?;
+        let schedule = self.sequencer.validate()?;
+        let kf = self.kf.validate(fs_hz, rounding, overflow)?;
+        let estimator = self
+            .estimator
+            .validate(schedule, kf.input, rounding, overflow)?;
+        let mean_filter = self.mean_filter.validate(kf.input, rounding, overflow)?;
+        Ok(Settings {
+            source,
+            plant,
+            estimator,
+            kf,
+            mean_filter,
+        })
+    }
+}
+
+/// Asserts that each `(overlay, field, allowed)` parses but fails validation with an error that
+/// contains `field` (as `key = value`) and `allowed`. Each section's tests call it.
+#[cfg(test)]
+pub(crate) fn assert_refused(cases: &[(&str, &str, &str)]) {
+    for (text, field, allowed) in cases {
+        let err = Config::from_toml(text, "t")
+            .unwrap()
+            .validate()
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains(field) && err.contains(allowed),
+            "{text}: {err}"
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_embedded_default_is_valid_and_round_trips() {
+        let config = Config::embedded();
+        config.validate().unwrap();
+        assert_eq!(
+            Config::from_toml(&config.to_toml(), "round trip").unwrap(),
+            config
+        );
+        assert_eq!(config.kf.bandwidths_hz, vec![10.0, 20.0, 30.0]);
+    }
+
+    #[test]
+    fn a_partial_config_overlays_the_default() {
+        let config = Config::from_toml("seed = 9\nrounding = \"convergent\"\n", "t").unwrap();
+        assert_eq!(config.seed, 9);
+        assert_eq!(config.rounding, "convergent");
+        assert_eq!(config.kf.state_format, "s36.26");
+    }
+
+    #[test]
+    fn presets_overlay_the_default_and_are_valid() {
+        for (name, _) in PRESETS {
+            let config = Config::from_preset_and_file(Some(name), None).unwrap();
+            config
+                .validate()
+                .unwrap_or_else(|e| panic!("preset {name}: {e}"));
+        }
+        let gu = Config::from_preset_and_file(Some("gu2019"), None).unwrap();
+        assert_eq!(
+            (gu.stimulus.fs_hz, gu.sequencer.interval_length),
+            (50.0, 150)
+        );
+        let err = Config::from_preset_and_file(Some("nope"), None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("preset = \"nope\"") && err.contains("gu2019"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn unknown_keys_are_refused_with_name_and_line() {
+        let err =
+            Config::from_toml("seed = 1\n[kf]\nbandwith_hz = [1.0]\n", "my.toml").unwrap_err();
+        let text = err.to_string();
+        assert!(
+            text.contains("my.toml") && text.contains("bandwith_hz") && text.contains("line 3"),
+            "{text}"
+        );
+        let err = Config::from_toml("colour = 1\n", "t")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("colour"), "{err}");
+    }
+
+    #[test]
+    fn bad_top_level_values_name_field_value_and_what_is_allowed() {
+        assert_refused(&[
+            (
+                "rounding = \"half_up\"",
+                "rounding = \"half_up\"",
+                "convergent",
+            ),
+            ("overflow = \"clip\"", "overflow = \"clip\"", "saturate"),
+            ("samples = 0", "samples = 0", "1..="),
+        ]);
+    }
+}

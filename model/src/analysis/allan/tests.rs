@@ -1,0 +1,155 @@
+//! Tests of the Allan family: NIST SP 1065 reference values, the AVX2 kernel and the blocked
+//! pass against the plain ones, the τ grids, noise-type identification and interval coverage.
+
+use super::*;
+
+/// NIST SP 1065 §12.4 / Riley's 1000-point test set: n(i+1) = 16807 n(i) mod (2³¹ − 1),
+/// n(0) = 1234567890, y(i) = n(i) / (2³¹ − 1).
+fn nbs14_1000() -> Vec<f64> {
+    let mut n = vec![1_234_567_890u64];
+    for i in 0..999 {
+        n.push(16807 * n[i] % 2_147_483_647);
+    }
+    assert_eq!(&n[1..4], &[395_529_916, 1_209_410_747, 633_705_974]);
+    n.iter().map(|v| *v as f64 / 2_147_483_647.0).collect()
+}
+
+fn check(kind: Kind, data: &[f64], taus: &[usize], published: &[f64]) {
+    let x = phase(data);
+    for (m, want) in taus.iter().zip(published) {
+        let (got, _) = deviation(kind, &x, *m, 1.0).unwrap();
+        // The published values have 7 significant digits.
+        assert!(
+            (got / want - 1.0).abs() < 1e-6,
+            "{kind:?} m = {m}: {got:.9e} vs {want:e}"
+        );
+    }
+}
+
+#[test]
+fn reproduces_the_nist_1000_point_reference_values() {
+    // NIST SP 1065, p. 108 (Riley, Table III): τ = 1, 10, 100.
+    let y = nbs14_1000();
+    check(
+        Kind::NonOverlapping,
+        &y,
+        &[1, 10, 100],
+        &[2.922319e-01, 9.965736e-02, 3.897804e-02],
+    );
+    check(
+        Kind::Overlapping,
+        &y,
+        &[1, 10, 100],
+        &[2.922319e-01, 9.159953e-02, 3.241343e-02],
+    );
+    check(
+        Kind::Modified,
+        &y,
+        &[1, 10, 100],
+        &[2.922319e-01, 6.172376e-02, 2.170921e-02],
+    );
+    check(
+        Kind::Hadamard,
+        &y,
+        &[1, 10, 100],
+        &[2.943883e-01, 9.581083e-02, 3.237638e-02],
+    );
+}
+
+#[test]
+fn reproduces_the_nist_10_point_reference_values() {
+    // NBS14 frequency data (SP 1065 p. 107): τ = 1, 2.
+    let y = [
+        892.0, 809.0, 823.0, 798.0, 671.0, 644.0, 883.0, 903.0, 677.0,
+    ];
+    check(Kind::NonOverlapping, &y, &[1, 2], &[91.22945, 115.8082]);
+    check(Kind::Overlapping, &y, &[1, 2], &[91.22945, 85.95287]);
+    check(Kind::Modified, &y, &[1, 2], &[91.22945, 74.78849]);
+    check(Kind::Hadamard, &y, &[1, 2], &[70.80607, 85.61487]);
+}
+
+#[test]
+fn the_avx2_kernel_gives_the_same_bits() {
+    use crate::stimulus::{Gaussian, Stream};
+    let mut g = Gaussian::new(9, Stream::AngleRandomWalk(0));
+    let x = phase(&(0..10_007).map(|_| g.sample()).collect::<Vec<_>>());
+    for m in [1usize, 3, 64, 1000] {
+        let terms = x.len() - 2 * m;
+        let (a, b, c) = (&x[..terms], &x[m..m + terms], &x[2 * m..2 * m + terms]);
+        let portable = second_differences_kernel(a, b, c);
+        assert_eq!(
+            sum_second_differences(a, b, c).to_bits(),
+            portable.to_bits(),
+            "m {m}"
+        );
+    }
+}
+
+#[test]
+fn the_blocked_pass_agrees_with_one_deviation_at_a_time() {
+    use crate::stimulus::{Gaussian, Stream};
+    let mut g = Gaussian::new(10, Stream::AngleRandomWalk(0));
+    let y: Vec<f64> = (0..100_003).map(|_| 0.2 + g.sample()).collect();
+    let x = phase(&y);
+    let ms = factors(Kind::Overlapping, Grid::Octave, x.len());
+    for (m, blocked) in ms.iter().zip(deviations(Kind::Overlapping, &x, &ms, 50.0)) {
+        let (a, ta) = blocked.unwrap();
+        let (b, tb) = deviation(Kind::Overlapping, &x, *m, 50.0).unwrap();
+        assert_eq!(ta, tb);
+        // Blocks change the summation order only.
+        assert!((a / b - 1.0).abs() < 1e-12, "m {m}: {a} vs {b}");
+    }
+}
+
+#[test]
+fn grids() {
+    assert_eq!(
+        factors(Kind::Overlapping, Grid::Octave, 101),
+        vec![1, 2, 4, 8, 16, 32]
+    );
+    assert_eq!(
+        factors(Kind::Overlapping, Grid::Decade, 1001),
+        vec![1, 2, 5, 10, 20, 50, 100, 200]
+    );
+    assert_eq!(factors(Kind::Hadamard, Grid::All, 11).len(), 3);
+    assert!(deviation(Kind::Overlapping, &phase(&[1.0; 10]), 5, 1.0).is_none());
+}
+
+#[test]
+fn noise_types_are_identified() {
+    use crate::stimulus::{Gaussian, Stream};
+    let mut g = Gaussian::new(2, Stream::AngleRandomWalk(0));
+    let white: Vec<f64> = (0..100_000).map(|_| g.sample()).collect();
+    let mut walk = 0.0;
+    let random_walk: Vec<f64> = white
+        .iter()
+        .map(|w| {
+            walk += w;
+            walk
+        })
+        .collect();
+    let white_pm: Vec<f64> = white.windows(2).map(|w| w[1] - w[0]).collect();
+    for m in [1, 10, 100] {
+        assert_eq!(noise_type(&white, m), Some(0), "white FM at m = {m}");
+        assert_eq!(noise_type(&random_walk, m), Some(-2), "RW FM at m = {m}");
+    }
+    assert_eq!(noise_type(&white_pm, 1), Some(2));
+}
+
+#[test]
+fn confidence_intervals_cover_the_truth_about_68_percent_of_the_time() {
+    use crate::stimulus::{Gaussian, Stream};
+    // White FM of σ = 1 per sample: ADEV(m) = 1/√m exactly in expectation.
+    let mut covered = 0;
+    let trials = 200;
+    for seed in 0..trials {
+        let mut g = Gaussian::new(seed, Stream::RateRandomWalk(1));
+        let y: Vec<f64> = (0..2000).map(|_| g.sample()).collect();
+        let p = curve(Kind::Overlapping, &y, 1.0, Grid::Octave);
+        let point = p.iter().find(|p| p.m == 16).unwrap();
+        let truth = 1.0 / 4.0;
+        covered += usize::from(point.lo <= truth && truth <= point.hi);
+    }
+    let rate = covered as f64 / trials as f64;
+    assert!((0.58..=0.78).contains(&rate), "coverage {rate}");
+}
