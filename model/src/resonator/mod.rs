@@ -99,12 +99,15 @@
 
 pub mod closed_form;
 pub mod expm;
+mod noise;
 pub mod params;
 pub mod physics;
+pub mod settings;
 
 pub use closed_form::{ModeFigures, Reversal};
 pub use params::{Matrices, ParamError, ResonatorParams};
-pub use physics::{GaussMarkov, PhysicsSettings, Resonator, BOLTZMANN_J_PER_K};
+pub use physics::{Resonator, BOLTZMANN_J_PER_K};
+pub use settings::{GaussMarkov, PhysicsSettings};
 
 /// Which axis is driven: the mode of mode reversal.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
