@@ -57,7 +57,7 @@
 
 use super::nco::Reference;
 use super::{field_error, intermediate, mode_parameters, PlanError, Point, RtlParameter};
-use crate::fx::{Format, Overflow, Quantizer, Rounding};
+use crate::fx::{mode, Format, Overflow, Quantizer, Rounding};
 
 /// Largest low-pass shift `k`: −3 dB at `fs · 2^−24 / 2π`, 2 mHz at 200 kHz.
 pub const MAX_LOWPASS_SHIFT: u32 = 24;
@@ -240,6 +240,12 @@ pub struct OverflowCounts {
 }
 
 /// The bit-accurate demodulator.
+///
+/// Two paths compute the same bits: [`FixedDemodulator::step_reference`] follows the
+/// definition in `i128` with each point's own mode; [`FixedDemodulator::step`] is
+/// monomorphized per rounding mode and runs in `i64` when every point shares one mode and
+/// every exact intermediate fits 64 bits (the defaults do). A property test checks them
+/// against each other.
 #[derive(Clone, Debug)]
 pub struct FixedDemodulator {
     product: [Quantizer; 2],
@@ -248,6 +254,8 @@ pub struct FixedDemodulator {
     /// `state.frac − product.frac`: aligns a product to the state.
     align: u32,
     k: u32,
+    /// The shared rounding mode, when the 64-bit path applies.
+    fast: Option<Rounding>,
     y: [i64; 2],
 }
 
@@ -255,12 +263,17 @@ impl FixedDemodulator {
     /// The demodulator of `plan`, states at 0.
     pub fn new(plan: &Plan) -> Self {
         let pair = |p: &Point| [p.quantizer(), p.quantizer()];
+        let shared = plan.product.rounding == plan.state.rounding
+            && plan.state.rounding == plan.output.rounding;
+        // x·ref and y·2^k + (p − y) fit 64 bits.
+        let narrow = plan.product.from.width <= 64 && plan.state.from.width <= 64;
         FixedDemodulator {
             product: pair(&plan.product),
             state: pair(&plan.state),
             output: pair(&plan.output),
             align: (plan.state.to.frac - plan.product.to.frac) as u32,
             k: plan.lowpass_shift,
+            fast: (shared && narrow).then_some(plan.output.rounding),
             y: [0, 0],
         }
     }
@@ -273,6 +286,37 @@ impl FixedDemodulator {
     /// One sample: ADC code `x`, the NCO's references of the same sample; returns `I`, `Q`.
     #[inline]
     pub fn step(&mut self, x: i64, reference: Reference) -> Iq {
+        match self.fast {
+            Some(Rounding::Floor) => self.step_mode::<{ mode::FLOOR }>(x, reference),
+            Some(Rounding::Ceil) => self.step_mode::<{ mode::CEIL }>(x, reference),
+            Some(Rounding::Zero) => self.step_mode::<{ mode::ZERO }>(x, reference),
+            Some(Rounding::Nearest) => self.step_mode::<{ mode::NEAREST }>(x, reference),
+            Some(Rounding::Round) => self.step_mode::<{ mode::ROUND }>(x, reference),
+            Some(Rounding::Convergent) => self.step_mode::<{ mode::CONVERGENT }>(x, reference),
+            None => self.step_reference(x, reference),
+        }
+    }
+
+    #[inline(always)]
+    fn step_mode<const MODE: u8>(&mut self, x: i64, reference: Reference) -> Iq {
+        let references = [reference.sin, reference.cos];
+        let mut out = [0i64; 2];
+        for c in 0..2 {
+            let p = self.product[c].apply_mode_i64::<MODE>(x * references[c]);
+            let y = self.y[c];
+            let y = self.state[c].apply_mode_i64::<MODE>((y << self.k) + ((p << self.align) - y));
+            self.y[c] = y;
+            out[c] = self.output[c].apply_mode_i64::<MODE>(y);
+        }
+        Iq {
+            i: out[0],
+            q: out[1],
+        }
+    }
+
+    /// One sample computed literally from the definition in `i128`, each point with its own
+    /// mode: the reference the fast path is tested against, and the path for wide plans.
+    pub fn step_reference(&mut self, x: i64, reference: Reference) -> Iq {
         let x = i128::from(x);
         let references = [reference.sin, reference.cos];
         let mut out = [0i64; 2];

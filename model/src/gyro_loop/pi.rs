@@ -56,7 +56,7 @@ use super::{
     field_error, intermediate, mode_parameters, quantize_coefficients, Coefficient, PlanError,
     Point, RtlParameter,
 };
-use crate::fx::{from_f64, CoefficientFormat, Format, Overflow, Quantizer, Rounding};
+use crate::fx::{from_f64, mode, CoefficientFormat, Format, Overflow, Quantizer, Rounding};
 
 /// What a PI controller is asked to be.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -293,10 +293,15 @@ pub struct OverflowCounts {
 }
 
 /// The bit-accurate PI controller.
+///
+/// Two paths compute the same bits: [`FixedPi::step_reference`] follows the definition in
+/// `i128` with each point's own mode; [`FixedPi::step`] is monomorphized per rounding mode
+/// and runs in `i64` when both points share one mode and every exact intermediate fits 64
+/// bits (the defaults do). A property test checks them against each other.
 #[derive(Clone, Debug)]
 pub struct FixedPi {
-    kp: i128,
-    ki: i128,
+    kp: i64,
+    ki: i64,
     /// Left shifts aligning `v` and `ki·e` to the update's fraction.
     v_to_update: u32,
     ki_e_to_update: u32,
@@ -306,6 +311,8 @@ pub struct FixedPi {
     integrator: Quantizer,
     output: Quantizer,
     limits: [i64; 2],
+    /// The shared rounding mode, when the 64-bit path applies.
+    fast: Option<Rounding>,
     clamped: u64,
     v: i64,
 }
@@ -317,9 +324,12 @@ impl FixedPi {
         let sum = plan.output.from;
         let ki_e_frac = plan.ki.format.frac + plan.input.frac;
         let kp_e_frac = plan.kp.format.frac + plan.input.frac;
+        let shared = plan.integrator_point.rounding == plan.output.rounding;
+        // The products are no wider than the sums they enter.
+        let narrow = update.width <= 64 && sum.width <= 64;
         FixedPi {
-            kp: plan.kp.code,
-            ki: plan.ki.code,
+            kp: plan.kp.code as i64,
+            ki: plan.ki.code as i64,
             v_to_update: (update.frac - plan.integrator.frac) as u32,
             ki_e_to_update: (update.frac - ki_e_frac) as u32,
             kp_e_to_sum: (sum.frac - kp_e_frac) as u32,
@@ -327,6 +337,7 @@ impl FixedPi {
             integrator: plan.integrator_point.quantizer(),
             output: plan.output.quantizer(),
             limits: plan.limits.map(|c| c as i64),
+            fast: (shared && narrow).then_some(plan.output.rounding),
             clamped: 0,
             v: 0,
         }
@@ -350,15 +361,40 @@ impl FixedPi {
     /// One sample: error code `e`; returns the output code.
     #[inline]
     pub fn step(&mut self, e: i64) -> i64 {
+        match self.fast {
+            Some(Rounding::Floor) => self.step_mode::<{ mode::FLOOR }>(e),
+            Some(Rounding::Ceil) => self.step_mode::<{ mode::CEIL }>(e),
+            Some(Rounding::Zero) => self.step_mode::<{ mode::ZERO }>(e),
+            Some(Rounding::Nearest) => self.step_mode::<{ mode::NEAREST }>(e),
+            Some(Rounding::Round) => self.step_mode::<{ mode::ROUND }>(e),
+            Some(Rounding::Convergent) => self.step_mode::<{ mode::CONVERGENT }>(e),
+            None => self.step_reference(e),
+        }
+    }
+
+    #[inline(always)]
+    fn step_mode<const MODE: u8>(&mut self, e: i64) -> i64 {
+        let update = (self.v << self.v_to_update) + ((self.ki * e) << self.ki_e_to_update);
+        let rounded = self.integrator.apply_mode_i64::<MODE>(update);
+        let v = rounded.clamp(self.limits[0], self.limits[1]);
+        self.clamped += u64::from(v != rounded);
+        self.v = v;
+        let sum = ((self.kp * e) << self.kp_e_to_sum) + (v << self.v_to_sum);
+        self.output.apply_mode_i64::<MODE>(sum)
+    }
+
+    /// One sample computed literally from the definition in `i128`, each point with its own
+    /// mode: the reference the fast path is tested against, and the path for wide plans.
+    pub fn step_reference(&mut self, e: i64) -> i64 {
         let e = i128::from(e);
-        let update =
-            (i128::from(self.v) << self.v_to_update) + ((self.ki * e) << self.ki_e_to_update);
+        let update = (i128::from(self.v) << self.v_to_update)
+            + ((i128::from(self.ki) * e) << self.ki_e_to_update);
         let rounded = self.integrator.apply(update);
-        let [lo, hi] = self.limits;
-        let v = rounded.clamp(i128::from(lo), i128::from(hi));
+        let [lo, hi] = self.limits.map(i128::from);
+        let v = rounded.clamp(lo, hi);
         self.clamped += u64::from(v != rounded);
         self.v = v as i64;
-        let sum = ((self.kp * e) << self.kp_e_to_sum) + (v << self.v_to_sum);
+        let sum = ((i128::from(self.kp) * e) << self.kp_e_to_sum) + (v << self.v_to_sum);
         self.output.apply(sum) as i64
     }
 
