@@ -236,7 +236,7 @@ impl Plan {
                 "1 or 2",
             ));
         }
-        if spec.taps & 1 == 0 || !(1..=MAX_TAPS).contains(&spec.taps) {
+        if spec.taps.is_multiple_of(2) || !(1..=MAX_TAPS).contains(&spec.taps) {
             return Err(field_error(
                 B,
                 "taps",
