@@ -1098,3 +1098,34 @@ fn the_loop_rtl_lints_clean_for_several_parameter_sets() {
     let (ok, text) = run_tool("iverilog", &args, dir.path());
     assert!(ok && text.trim().is_empty(), "{text}");
 }
+
+#[test]
+fn yosys_synthesizes_the_loop_rtl_without_latches() {
+    let dir = tempfile::tempdir().unwrap();
+    let nco = nco::Plan::new(&nco::Spec::default()).unwrap();
+    std::fs::write(
+        dir.path().join("nco_sine.mem"),
+        rom_image(nco.output, nco.rom_codes()),
+    )
+    .unwrap();
+    let cic = cic::Plan::new(&cic::Spec::default()).unwrap();
+    std::fs::write(
+        dir.path().join("cic_taps.mem"),
+        rom_image(cic.taps[0].format, &cic.tap_codes()),
+    )
+    .unwrap();
+    for top in [
+        "gyrofx_nco",
+        "gyrofx_demodulator",
+        "gyrofx_pi",
+        "gyrofx_cic",
+    ] {
+        let script = format!(
+            "read_verilog {} {}; synth -top {top}; select -assert-none t:$dlatch t:$_DLATCH_*; check -assert",
+            hdl("gyrofx_quantize.v").display(),
+            hdl(&format!("{top}.v")).display()
+        );
+        let (ok, text) = run_tool("yosys", &["-q", "-p", &script], dir.path());
+        assert!(ok, "yosys {top}:\n{text}");
+    }
+}
