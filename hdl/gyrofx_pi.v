@@ -36,8 +36,8 @@ module gyrofx_pi #(
     parameter KI_W = 18,
     parameter KI_F = 34,
     // integrator: width and fraction bits
-    parameter INT_W = 40,
-    parameter INT_F = 38,
+    parameter INT_W = 59,
+    parameter INT_F = 57,
     // output: width and fraction bits
     parameter OUT_W = 32,
     parameter OUT_F = 32,
@@ -46,8 +46,8 @@ module gyrofx_pi #(
     parameter signed [KI_W-1:0] KI = 18'sd65536,
     // integrator limits, INT-format codes (INT_MIN <= INT_MAX; the defaults: 0.035
     // and 0.05 cycles per sample, 7 and 10 kHz at 200 kHz)
-    parameter signed [INT_W-1:0] INT_MIN = 40'sd9620726743,
-    parameter signed [INT_W-1:0] INT_MAX = 40'sd13743895347,
+    parameter signed [INT_W-1:0] INT_MIN = 59'sd5044031582654956,
+    parameter signed [INT_W-1:0] INT_MAX = 59'sd7205759403792794,
     // rounding: 0 floor, 1 ceil, 2 zero, 3 nearest, 4 round, 5 convergent
     parameter ROUNDING = 3,
     // overflow at the output: 0 wrap, 1 saturate

@@ -36,8 +36,8 @@ entity gyrofx_pi is
         KI_W : positive := 18;
         KI_F : integer := 34;
         -- integrator: width and fraction bits
-        INT_W : positive := 40;
-        INT_F : integer := 38;
+        INT_W : positive := 59;
+        INT_F : integer := 57;
         -- output: width and fraction bits
         OUT_W : positive := 32;
         OUT_F : integer := 32;
@@ -46,8 +46,8 @@ entity gyrofx_pi is
         KI : std_logic_vector := 18x"10000";
         -- integrator limits, INT-format codes (the defaults: 0.035 and 0.05 cycles per
         -- sample, 7 and 10 kHz at 200 kHz)
-        INT_MIN : std_logic_vector := 40x"23d70a3d7";
-        INT_MAX : std_logic_vector := 40x"333333333";
+        INT_MIN : std_logic_vector := 59x"11eb851eb851ec";
+        INT_MAX : std_logic_vector := 59x"1999999999999a";
         -- rounding: 0 floor, 1 ceil, 2 zero, 3 nearest, 4 round, 5 convergent
         ROUNDING : natural := 3;
         -- overflow at the output: 0 wrap, 1 saturate

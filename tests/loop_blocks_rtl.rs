@@ -1421,3 +1421,89 @@ fn yosys_synthesizes_the_loop_rtl_without_latches() {
         assert!(ok, "yosys {top}:\n{text}");
     }
 }
+
+/// The default parameter values of `file` (Verilog `parameter NAME = value` or VHDL
+/// `NAME : type := value`), as integers; strings are skipped.
+fn rtl_defaults(file: &str) -> Vec<(String, i128)> {
+    let text = std::fs::read_to_string(hdl(file)).unwrap();
+    let mut out = Vec::new();
+    for line in text.lines().map(str::trim) {
+        let (name, value) = if let Some(rest) = line.strip_prefix("parameter ") {
+            let Some((left, right)) = rest.split_once('=') else {
+                continue;
+            };
+            (left.split_whitespace().last().unwrap(), right)
+        } else if let Some((left, right)) = line.split_once(":=") {
+            let Some((name, _)) = left.split_once(':') else {
+                continue;
+            };
+            if name.trim().contains(' ') {
+                continue;
+            }
+            (name.trim(), right)
+        } else {
+            continue;
+        };
+        let value = value.trim().trim_end_matches([',', ';']).trim();
+        let parsed = if let Some((width, digits)) = value.split_once("'sd") {
+            let _: u32 = width.parse().unwrap();
+            digits.parse::<i128>().ok()
+        } else if let Some((width, digits)) = value.split_once("x\"") {
+            let width: u32 = width.parse().unwrap();
+            let bits = u128::from_str_radix(digits.trim_end_matches('"'), 16).unwrap();
+            Some(Format::signed(width, 0).unwrap().from_bits(bits))
+        } else {
+            value.parse::<i128>().ok()
+        };
+        if let Some(v) = parsed {
+            out.push((name.to_string(), v));
+        }
+    }
+    out
+}
+
+/// The RTL's default parameters (both languages) are the model's default plans, so the
+/// documented defaults describe one design.
+#[test]
+fn the_rtl_defaults_are_the_model_defaults() {
+    let plans: [(&str, Vec<RtlParameter>); 4] = [
+        (
+            "gyrofx_nco",
+            nco::Plan::new(&nco::Spec::default())
+                .unwrap()
+                .rtl_parameters(),
+        ),
+        (
+            "gyrofx_demodulator",
+            demodulator::Plan::new(&demodulator::Spec::default())
+                .unwrap()
+                .rtl_parameters(),
+        ),
+        (
+            "gyrofx_pi",
+            pi::Plan::new(&pi::Spec::default())
+                .unwrap()
+                .rtl_parameters(),
+        ),
+        (
+            "gyrofx_cic",
+            cic::Plan::new(&cic::Spec::default())
+                .unwrap()
+                .rtl_parameters(),
+        ),
+    ];
+    for (module, parameters) in plans {
+        for language in ["v", "vhd"] {
+            let file = format!("{module}.{language}");
+            let defaults = rtl_defaults(&file);
+            for (name, value) in &parameters {
+                let found = defaults.iter().find(|(n, _)| n == name);
+                assert_eq!(
+                    found.map(|f| f.1),
+                    Some(*value),
+                    "{file}: default of {name}"
+                );
+            }
+        }
+    }
+}

@@ -82,7 +82,8 @@ pub struct Spec {
 }
 
 impl Default for Spec {
-    /// `P` = 32, `A` = 10, `S` = 18: phase error ≤ 0.088°, spurs near −72 dBc.
+    /// `P` = 32, `A` = 10, `S` = 18: phase error ≤ 0.044° (half of a 12-bit phase bin),
+    /// truncation spurs near −72 dBc; within 101 output LSB of the exact sine.
     fn default() -> Self {
         Spec {
             phase_bits: 32,

@@ -85,8 +85,10 @@ pub struct Spec {
 
 impl Default for Spec {
     /// A PLL at 200 kHz: phase error `s24.23` (full scale) in, frequency word `s32.32`
-    /// (cycles per sample) out, `kp` = 2^−10, `ki` = 2^−18, an `s40.38` integrator limited to
-    /// 7–10 kHz (0.035–0.05 cycles per sample), 18-bit gains; nearest, saturate.
+    /// (cycles per sample) out, `kp` = 2^−10, `ki` = 2^−18 (18-bit gains), an `s59.57`
+    /// integrator limited to 7–10 kHz (0.035–0.05 cycles per sample); nearest, saturate. The
+    /// integrator keeps every bit of `ki·e` (57 fraction bits), so the fixed PLL stays within
+    /// half an output LSB of the float one however long it runs.
     fn default() -> Self {
         let f = |w, frac| Format::signed(w, frac).expect("valid");
         Spec {
@@ -95,7 +97,7 @@ impl Default for Spec {
             ki: 1.0 / 262_144.0,
             kp_format: CoefficientFormat::Auto { width: 18 },
             ki_format: CoefficientFormat::Auto { width: 18 },
-            integrator: f(40, 38),
+            integrator: f(59, 57),
             integrator_limits: [0.035, 0.05],
             output: f(32, 32),
             rounding: Rounding::Nearest,

@@ -185,7 +185,7 @@ fn plan_errors_name_the_coefficient_value_and_bits() {
         integrator_limits: [0.0, 4.0],
         ..Spec::default()
     };
-    assert!(Plan::new(&spec).unwrap_err().to_string().contains("s40.38"));
+    assert!(Plan::new(&spec).unwrap_err().to_string().contains("s59.57"));
     let spec = Spec {
         output: fmt("s64.63"),
         ..Spec::default()
