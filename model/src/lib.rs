@@ -11,6 +11,7 @@ pub mod chain;
 pub mod estimator;
 pub mod examples;
 pub mod fx;
+pub mod gyro_loop;
 pub mod kf;
 pub mod mean_filter;
 pub mod plant;
