@@ -25,7 +25,8 @@
 //!   pole (see [`super::gyro`]).
 //! - `rate_settling_ms`: from the switch until the rate output stays within 0.01 °/s of its
 //!   final value; predicted `τ_old ln(A/0.01 °/s)`: the formerly driven axis rings down with
-//!   its mode's `τ_old` from `A = q0 / SF` (°/s, about 2e4).
+//!   its mode's `τ_old` from `A = q0 / SF` (°/s, about 2e4), plus the CIC's and compensator's
+//!   group delay (`N (R − 1)/2` ADC samples and `(T − 1)/2` chain samples, 17.5 ms).
 //! - `residual_bias_dps`: `(S + S′)/2` at `Ω = 0`; predicted `(B − B′)/2`.
 
 use serde::Serialize;
@@ -227,7 +228,7 @@ pub fn characterize<L: LoopUnderTest>(
     let samples = |ms: f64| (ms / chain_ms).ceil() as usize;
     let omega = procedure.rate_dps;
     let n = procedure.average_samples;
-    let mut measure = |closed: &mut ClosedLoop<L>, mode: Mode| {
+    let measure = |closed: &mut ClosedLoop<L>, mode: Mode| {
         let at_zero = means(closed, 0.0, mode, n);
         for _ in 0..samples(procedure.rate_settle_ms) {
             closed.step_chain(omega, mode);
@@ -248,6 +249,10 @@ pub fn characterize<L: LoopUnderTest>(
     let normal_final = means(&mut closed, 0.0, Mode::Normal, n);
 
     let hold_ms = f64::from(plan.lock.hold_samples) / fs * 1e3;
+    // The CIC's N (R − 1)/2 ADC samples and the compensator's (T − 1)/2 chain samples.
+    let group_delay_ms = 1e3
+        * (f64::from(plan.cic.stages) * f64::from(plan.cic.decimation - 1) / 2.0 / fs
+            + (plan.cic.taps.len() - 1) as f64 / 2.0 / plan.chain_rate_hz());
     let agc_pole = 2.0 * std::f64::consts::PI * plan.settings.agc_bandwidth_hz;
     let report = |mode: Mode, (zero, rate): &(Means, Means), trace: &Trace, final_amp: f64| {
         let m = plan.mode(mode);
@@ -291,7 +296,8 @@ pub fn characterize<L: LoopUnderTest>(
                 measured: rate_settled,
                 predicted: 1e3
                     * other.ring_down_time_constant
-                    * libm::log(ring_start / RATE_SETTLED_DPS),
+                    * libm::log(ring_start / RATE_SETTLED_DPS)
+                    + group_delay_ms,
             },
         }
     };

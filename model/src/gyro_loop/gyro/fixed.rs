@@ -53,7 +53,6 @@ struct ModeConstants {
     setpoint: i64,
     pll_preset: i64,
     frequency_word: u64,
-    agc_preset: i64,
     dac_offset: u64,
     sense_offset: u64,
     rate_coefficient: i128,
@@ -67,7 +66,6 @@ impl ModeConstants {
             setpoint: m.setpoint_code,
             pll_preset: m.pll_preset,
             frequency_word: m.frequency_word,
-            agc_preset: m.agc_preset,
             dac_offset: m.dac_offset_word,
             sense_offset: m.sense_offset_word,
             rate_coefficient: m.rate_coefficient.code,
@@ -157,7 +155,7 @@ impl FixedGyroLoop {
         self.mode = mode;
         let m = self.modes[mode_index(mode)];
         self.pll.preset(m.pll_preset);
-        self.agc.preset(m.agc_preset);
+        self.agc.reset();
         self.freq = m.frequency_word;
         self.demod_drive.reset();
         self.demod_sense.reset();

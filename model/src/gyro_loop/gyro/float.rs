@@ -35,7 +35,6 @@ pub struct FloatStep {
 struct ModeValues {
     setpoint: f64,
     frequency: f64,
-    amplitude: f64,
     dac_offset: f64,
     sense_offset: f64,
     rate_coefficient: f64,
@@ -75,7 +74,6 @@ impl FloatGyroLoop {
         let modes = plan.modes.map(|m| ModeValues {
             setpoint: m.setpoint,
             frequency: m.frequency,
-            amplitude: m.nominal_amplitude,
             dac_offset: m.dac_offset,
             sense_offset: m.sense_offset,
             rate_coefficient: m.rate_coefficient.value,
@@ -111,7 +109,7 @@ impl FloatGyroLoop {
         self.mode = mode;
         let m = self.modes[mode_index(mode)];
         self.pll.preset(m.frequency);
-        self.agc.preset(m.amplitude);
+        self.agc.reset();
         self.freq = m.frequency;
         self.demod_drive.reset();
         self.demod_sense.reset();

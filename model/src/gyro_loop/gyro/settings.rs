@@ -99,7 +99,7 @@ impl Default for LoopSettings {
             lock_phase_deg: 0.1,
             lock_amplitude_tolerance: 1e-3,
             lock_hold_ms: 10.0,
-            lock_filter_shift: 12,
+            lock_filter_shift: 9,
             nco_phase_bits: 32,
             nco_address_bits: 10,
             nco_sine_width: 18,
