@@ -13,7 +13,9 @@
 //! given to the loop's `mode` input at the same sample.
 
 use super::gyro::{FixedGyroLoop, FloatGyroLoop, Plan};
-use crate::resonator::{Mode, ModeFigures, ParamError, PhysicsSettings, Resonator, ResonatorParams};
+use crate::resonator::{
+    Mode, ModeFigures, ParamError, PhysicsSettings, Resonator, ResonatorParams,
+};
 
 /// What one loop sample gives the harness.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -268,3 +270,6 @@ pub fn run<L: LoopUnderTest>(
         .map(|n| closed.step_chain(rate(n), mode(n)))
         .collect())
 }
+
+#[cfg(test)]
+mod tests;

@@ -202,9 +202,7 @@ impl FixedGyroLoop {
         let sense = self.demod_sense.step(adc[sensed], sense_reference);
 
         self.freq = (self.pll.step(q) as u64) & self.phase_mask;
-        let error = self
-            .agc_error
-            .apply(i128::from(m.setpoint) - i128::from(i)) as i64;
+        let error = self.agc_error.apply(i128::from(m.setpoint) - i128::from(i)) as i64;
         let amplitude = self.agc.step(error);
         let drive = self
             .dac
@@ -224,7 +222,8 @@ impl FixedGyroLoop {
         for (z, e) in self.lock_z.iter_mut().zip([q, error]) {
             *z = *z - (*z >> s) + e;
         }
-        let inside = self.lock_z[0].abs() < m.lock_limits[0] && self.lock_z[1].abs() < m.lock_limits[1];
+        let inside =
+            self.lock_z[0].abs() < m.lock_limits[0] && self.lock_z[1].abs() < m.lock_limits[1];
         self.lock_count = if inside {
             self.lock_count.saturating_add(1).min(self.lock_hold)
         } else {
@@ -236,8 +235,7 @@ impl FixedGyroLoop {
         let chain = match (yi, yq) {
             (Some(yi), Some(yq)) => Some(ChainSample {
                 rate: self.output[0].apply(m.rate_coefficient * i128::from(yi)) as i64,
-                quadrature: self.output[1].apply(m.quadrature_coefficient * i128::from(yq))
-                    as i64,
+                quadrature: self.output[1].apply(m.quadrature_coefficient * i128::from(yq)) as i64,
                 locked: self.locked(),
             }),
             _ => None,

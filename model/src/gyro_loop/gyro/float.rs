@@ -171,7 +171,8 @@ impl FloatGyroLoop {
         for (y, e) in self.lock_y.iter_mut().zip([q, error]) {
             *y += (e - *y) * self.lock_decay;
         }
-        let inside = self.lock_y[0].abs() < m.lock_limits[0] && self.lock_y[1].abs() < m.lock_limits[1];
+        let inside =
+            self.lock_y[0].abs() < m.lock_limits[0] && self.lock_y[1].abs() < m.lock_limits[1];
         self.lock_count = if inside {
             self.lock_count.saturating_add(1).min(self.lock_hold)
         } else {

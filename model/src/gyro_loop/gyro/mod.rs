@@ -25,7 +25,10 @@
 //!   force by 90°, so it is then in phase with NCO_D's `sin` and `Q_D` is the phase error. The
 //!   DAC value computed at sample `k` is output at `k + L` (`L` =
 //!   `adc_to_dac_latency_samples`) and held for a sample, whose fundamental is centred half a
-//!   sample later: NCO_T leads by `δ_T = (L + ½) f_nom / fs` cycles. The sense reference is
+//!   sample later: NCO_T leads by `δ_T = (L + ½) f_nom / fs` cycles, corrected for the phase
+//!   the AGC's proportional path adds with the drive demodulator's 2f ripple (derived in
+//!   [`Plan::new`]'s helper `dac_offset`; 51 mHz of detuning at the defaults uncorrected).
+//!   The sense reference is
 //!   the drive displacement's phase shifted to the Coriolis component:
 //!   `δ_S = −¼ − ψ/2π` cycles (`ψ = arg Z` of the mode, [`crate::resonator::ModeFigures`]);
 //!   both pick-offs are sampled at the same instant and both demodulators run on the same
@@ -58,10 +61,14 @@
 //! # At a mode switch
 //!
 //! When `mode` changes (applied before that sample): the PLL integrator is preset to the new
-//! mode's nominal frequency word, the AGC integrator to its `u_nom`, both demodulators' states,
-//! the lock filters and the lock counter are cleared, and the DAC delay line is cleared (it
-//! held values for the other axis). The NCO accumulators and the CICs keep running (the
-//! output keeps its cadence; the sequencer blanks the transient).
+//! mode's nominal frequency word and the NCOs' frequency register loaded with it; the AGC
+//! integrator, both demodulators' states, the lock filters, the lock counter and the DAC
+//! delay line (it held values for the other axis) are cleared. The AGC starts from 0 on
+//! purpose: with the pole–zero cancellation above, a zero initial state is exactly what makes
+//! the amplitude rise as the first-order `q0 (1 − e^{−2π f_agc t})` without overshoot
+//! (presetting `u_nom` excites the `−1/τ` mode as well and overshoots by tens of per cent).
+//! The NCO accumulators and the CICs keep running (the output keeps its cadence; the
+//! sequencer blanks the transient). The loop starts as if switched into normal mode.
 //!
 //! # Lock detector
 //!

@@ -10,7 +10,7 @@ use crate::fx::{from_f64, CoefficientFormat, Format, Overflow, Rounding};
 use crate::gyro_loop::{
     cic, demodulator, field_error, nco, pi, quantize_coefficients, Coefficient, PlanError, Point,
 };
-use crate::resonator::{ModeFigures, Mode, PhysicsSettings, ResonatorParams};
+use crate::resonator::{Mode, ModeFigures, PhysicsSettings, ResonatorParams};
 
 /// Largest `adc_to_dac_latency_samples`.
 pub const MAX_LATENCY: u32 = 8;
@@ -282,9 +282,9 @@ impl Plan {
             let hold_gain = libm::sin(x) / x;
             let tau = f.ring_down_time_constant;
             let setpoint = per_fs(driven) * params.drive_amplitude_m * a_nco;
-            let plant_gain = per_fs(driven) * a_nco * a_nco * front.dac_newton_per_lsb * hold_gain
-                * tau
-                / (2.0 * params.mass_kg * f.drive_angular_frequency);
+            let plant_gain =
+                per_fs(driven) * a_nco * a_nco * front.dac_newton_per_lsb * hold_gain * tau
+                    / (2.0 * params.mass_kg * f.drive_angular_frequency);
             let sense = per_fs(sensed) * a_nco * f.scale_factor_m_per_dps() * cic_gain;
             (f_nom, tau, setpoint, plant_gain, sense, sensed)
         });
@@ -370,8 +370,11 @@ impl Plan {
             "loop",
             "scale_coefficients",
             &coefficient_values,
-            CoefficientFormat::Auto {
-                width: s.scale_coefficient_width,
+            match &s.scale_coefficient_format {
+                Some(text) => CoefficientFormat::Fixed(format("scale_coefficient_format", text)?),
+                None => CoefficientFormat::Auto {
+                    width: s.scale_coefficient_width,
+                },
             },
         )?;
         let output_format = format("output_format", &s.output_format)?;
@@ -401,7 +404,12 @@ impl Plan {
         }
         let hold = libm::round(hold_ms * 1e-3 * fs);
         if hold > f64::from(u32::MAX) {
-            return Err(field_error("loop", "lock_hold_ms", hold_ms, "below 2^32 samples"));
+            return Err(field_error(
+                "loop",
+                "lock_hold_ms",
+                hold_ms,
+                "below 2^32 samples",
+            ));
         }
         let lock = LockPlan {
             shift,
@@ -456,8 +464,16 @@ impl Plan {
                 rate_coefficient: coefficients[i],
                 quadrature_coefficient: coefficients[2 + i],
                 lock_limits: [
-                    code(lock_q, Format::intermediate(true, 64, demod_output.frac).expect("64"), "lock_phase_deg")?,
-                    code(lock_a, Format::intermediate(true, 64, demod_output.frac).expect("64"), "lock_amplitude_tolerance")?,
+                    code(
+                        lock_q,
+                        Format::intermediate(true, 64, demod_output.frac).expect("64"),
+                        "lock_phase_deg",
+                    )?,
+                    code(
+                        lock_a,
+                        Format::intermediate(true, 64, demod_output.frac).expect("64"),
+                        "lock_amplitude_tolerance",
+                    )?,
                 ],
             });
         }

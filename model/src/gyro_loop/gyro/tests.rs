@@ -1,33 +1,85 @@
-//! The loop closed around paper 004's resonator.
+//! The plan: settings as the config writes them, and refusals that name the key.
 
 use super::*;
-use crate::gyro_loop::closed::{FixedHarness, FloatHarness};
-use crate::gyro_loop::figures::{characterize, Procedure};
+use crate::gyro_loop::PlanError;
 
 #[test]
-fn print_characterization() {
-    let spec = Spec::paper_004();
-    let plan = Plan::new(&spec).unwrap();
-    println!("{:#?}", plan.design);
-    println!("{:#?}", plan.modes[0]);
-    let c = characterize::<FixedHarness>(&plan, &spec.resonator, &spec.front_end, &Procedure::default()).unwrap();
-    println!("{}", serde_json::to_string_pretty(&c).unwrap());
-    let c = characterize::<FloatHarness>(&plan, &spec.resonator, &spec.front_end, &Procedure::default()).unwrap();
-    println!("{}", serde_json::to_string_pretty(&c).unwrap());
+fn settings_keys_round_trip_and_unknown_keys_are_refused() {
+    let settings = LoopSettings::default();
+    let text = serde_json::to_string(&settings).unwrap();
+    assert!(!text.contains("scale_coefficient_format"), "{text}");
+    let back: LoopSettings = serde_json::from_str(&text).unwrap();
+    assert_eq!(back, settings);
+    let unknown = text.replace("pll_bandwidth_hz", "pll_bandwith_hz");
+    assert!(serde_json::from_str::<LoopSettings>(&unknown).is_err());
 }
 
 #[test]
-fn print_switch_trace() {
-    use crate::gyro_loop::closed::{FixedClosedLoop, LoopUnderTest};
-    use crate::resonator::Mode;
+fn design_follows_the_physics() {
     let spec = Spec::paper_004();
     let plan = Plan::new(&spec).unwrap();
-    let mut c = FixedClosedLoop::new(&plan, &spec.resonator, &spec.front_end.noiseless(), 0).unwrap();
-    for _ in 0..80 { c.step_chain(0.0, Mode::Normal); }
-    c.set(0.0, Mode::Reverse);
-    for k in 0..60 {
-        let w = c.advance(1000);
-        let f = c.gyro.frequency_hz();
-        println!("{:5.1} ms amp {:.6e} f {:.4} locked {} rate {:?} agc {}", (k+1) as f64*5.0, w.drive_amplitude_m, f, w.locked, w.chain.map(|c| c.rate_dps), c.gyro.gyro.agc_integrator());
-    }
+    let n = plan.mode(crate::resonator::Mode::Normal);
+    // a_set = g q0 / FS · A_nco = 1e5 · 2e-6 / 1 V, times A_nco ≈ 1.
+    assert!((n.setpoint - 0.2).abs() < 1e-5, "{}", n.setpoint);
+    // u_nom: the force k q0 / Q = 15.56 µN (SPEC's example: ~15 600 LSB of 1 nN), a little
+    // more for the DAC hold's sinc.
+    let force = n.nominal_amplitude * spec.front_end.dac_newton_per_lsb;
+    let k = spec.resonator.principal_stiffness()[0];
+    let want = k * 2e-6 / spec.resonator.q_drive;
+    assert!((force / want - 1.0).abs() < 5e-3, "{force} vs {want}");
+    // PLL crossover f = fs kp a_set (20 Hz), zero at 1/τ.
+    let [kp, ki] = plan.design.pll_gains;
+    assert!((200e3 * kp * n.setpoint - 20.0).abs() < 1e-9);
+    assert!((kp / (ki * 200e3) - n.figures.ring_down_time_constant).abs() < 1e-12);
+    // The two references differ by ψ − ψ′ = 135.7° (SPEC): the sense offsets differ by as much.
+    let r = plan.mode(crate::resonator::Mode::Reverse);
+    let difference = (r.sense_offset - n.sense_offset) * 360.0;
+    assert!((difference - 135.7).abs() < 0.05, "{difference}");
+    // Normal and reverse 1/SF have opposite signs; quadrature coefficients are both negative.
+    assert!(n.rate_coefficient.code > 0 && r.rate_coefficient.code < 0);
+    assert!(n.quadrature_coefficient.code < 0 && r.quadrature_coefficient.code < 0);
+}
+
+#[test]
+fn refusals_name_the_key() {
+    let refuse = |edit: &dyn Fn(&mut Spec)| {
+        let mut spec = Spec::paper_004();
+        edit(&mut spec);
+        Plan::new(&spec).unwrap_err()
+    };
+    let err = refuse(&|s| s.settings.adc_rate_hz = 100e3);
+    assert!(
+        err.to_string().starts_with("loop.adc_rate_hz = 100000"),
+        "{err}"
+    );
+    let err = refuse(&|s| s.settings.adc_format = "s20.19".into());
+    assert!(err.to_string().contains("s24.23"), "{err}");
+    let err = refuse(&|s| s.settings.rounding = "up".into());
+    assert!(err.to_string().starts_with("loop.rounding"), "{err}");
+    let err = refuse(&|s| s.settings.lock_filter_shift = 40);
+    assert!(
+        err.to_string().starts_with("loop.lock_filter_shift = 40"),
+        "{err}"
+    );
+    let err = refuse(&|s| s.settings.output_format = "q8".into());
+    assert!(
+        err.to_string().starts_with("loop.output_format = \"q8\""),
+        "{err}"
+    );
+    // 1/SF is about 1e5 °/s per FS unit: an explicit s16.8 cannot hold it.
+    let err = refuse(&|s| s.settings.scale_coefficient_format = Some("s16.8".into()));
+    assert!(
+        matches!(
+            err,
+            PlanError::CoefficientOverflow {
+                name: "scale_coefficients",
+                ..
+            }
+        ),
+        "{err}"
+    );
+    let err = refuse(&|s| s.settings.adc_to_dac_latency_samples = 9);
+    assert!(err.to_string().contains("0..=8"), "{err}");
+    let err = refuse(&|s| s.resonator.q_drive = 0.1);
+    assert!(err.to_string().starts_with("resonator.q_drive"), "{err}");
 }
