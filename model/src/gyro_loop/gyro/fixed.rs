@@ -1,7 +1,8 @@
 //! The bit-accurate loop: ADC codes of both axes in, DAC codes of both axes out, the rate and
 //! quadrature every `R`-th sample.
 
-use super::plan::{ModePlan, Plan};
+use super::design::ModePlan;
+use super::plan::Plan;
 use super::{axes, mode_index};
 use crate::fx::Quantizer;
 use crate::gyro_loop::cic::FixedCic;

@@ -100,14 +100,16 @@
 //! it, as a PI's registered output does). The fixed model, the float twin and the RTL share
 //! `L`. The rate and quadrature appear with the CIC's output, every `R`-th sample.
 
+mod design;
 mod fixed;
 mod float;
 mod plan;
 mod settings;
 
+pub use design::{Design, LockPlan, ModePlan};
 pub use fixed::{ChainSample, FixedGyroLoop, FixedStep, LoopOverflows};
 pub use float::{FloatChainSample, FloatGyroLoop, FloatStep};
-pub use plan::{Design, LockPlan, ModePlan, Plan, Spec};
+pub use plan::{Plan, Spec};
 pub use settings::LoopSettings;
 
 use crate::resonator::Mode;
