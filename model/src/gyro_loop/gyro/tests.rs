@@ -83,3 +83,77 @@ fn refusals_name_the_key() {
     let err = refuse(&|s| s.resonator.q_drive = 0.1);
     assert!(err.to_string().starts_with("resonator.q_drive"), "{err}");
 }
+
+/// The declared ADC-to-DAC latency: the loop starts as if just switched (AGC integrator and
+/// delay line cleared), so its first DAC code is `(kp + ki) · a_set` times the reference (the
+/// PI's output uses the integrator after this sample's update), and it
+/// appears exactly `L` samples after the ADC sample it was computed from, in the fixed model
+/// and the float twin alike.
+#[test]
+fn the_dac_follows_the_adc_by_the_declared_latency() {
+    for latency in 0..=3u32 {
+        let mut spec = Spec::paper_004();
+        spec.settings.adc_to_dac_latency_samples = latency;
+        let plan = Plan::new(&spec).unwrap();
+        let mut fixed = FixedGyroLoop::new(&plan);
+        let mut float = FloatGyroLoop::new(&plan);
+        for k in 0..=latency {
+            let x = fixed.step([0, 0], crate::resonator::Mode::Normal).dac;
+            let y = float.step([0.0, 0.0], crate::resonator::Mode::Normal).dac;
+            assert_eq!(x[1], 0, "the sense DAC stays at 0");
+            assert_eq!(y[1], 0.0);
+            if k < latency {
+                assert_eq!((x[0], y[0]), (0, 0.0), "L = {latency}, sample {k}");
+            } else {
+                // (kp + ki) · a_set ≈ 10 500 LSB times cos(2π δ_T).
+                let n = plan.mode(crate::resonator::Mode::Normal);
+                let want = (plan.agc.kp.quantized() + plan.agc.ki.quantized())
+                    * n.setpoint
+                    * libm::cos(2.0 * std::f64::consts::PI * n.dac_offset);
+                // The NCO's phase is within half a ROM bin, π/2^(A+2) rad, of the exact one;
+                // plus the DAC's rounding.
+                let u = want.abs() / libm::cos(2.0 * std::f64::consts::PI * n.dac_offset).abs();
+                let tolerance = u * std::f64::consts::PI / 4096.0 + 1.0;
+                assert!(
+                    (x[0] as f64 - want).abs() < tolerance,
+                    "L = {latency}: {} vs {want}",
+                    x[0]
+                );
+                assert!(
+                    (y[0] - want).abs() < 1.0,
+                    "L = {latency}: {} vs {want}",
+                    y[0]
+                );
+            }
+        }
+    }
+}
+
+/// `reset` returns to the state of `new`: the same ADC codes give the same DAC codes and
+/// outputs, across a mode switch.
+#[test]
+fn reset_replays() {
+    let plan = Plan::new(&Spec::paper_004()).unwrap();
+    let mut gyro = FixedGyroLoop::new(&plan);
+    let codes: Vec<[i64; 2]> = (0..3000i64)
+        .map(|k| [(k * 7919) % 200_003 - 100_000, (k * 104_729) % 3001 - 1500])
+        .collect();
+    let mode = |k: usize| {
+        if k < 1500 {
+            crate::resonator::Mode::Normal
+        } else {
+            crate::resonator::Mode::Reverse
+        }
+    };
+    let run = |gyro: &mut FixedGyroLoop| -> Vec<FixedStep> {
+        codes
+            .iter()
+            .enumerate()
+            .map(|(k, c)| gyro.step(*c, mode(k)))
+            .collect()
+    };
+    let first = run(&mut gyro);
+    assert!(first.iter().filter(|s| s.chain.is_some()).count() == 3);
+    gyro.reset();
+    assert_eq!(run(&mut gyro), first);
+}
