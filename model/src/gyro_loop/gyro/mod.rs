@@ -50,6 +50,8 @@
 //!   `ω = kp G / τ`: `kp = 2π f_agc τ / G`, `ki = kp / (τ fs)`; the nominal amplitude is
 //!   `u_nom = a_set / G`. The closed loop has the poles `−2π f_agc` and `−1/τ`: the amplitude
 //!   settles to 1e-3 in about `ln(1000) / min(2π f_agc, 1/τ)` (73 ms at 15 Hz).
+//! - **Limits.** The PLL integrator stays within `pll_pull_range_hz` of the two modes'
+//!   nominal frequencies, the AGC integrator within `[0, DAC full scale]` (anti-windup).
 //! - Both are designed from normal mode (`a_set`, `τ`); in reverse mode `τ′` (7.62 ms) leaves
 //!   a slow pole–zero doublet and the bandwidths scale with `a_set′/a_set` (1 with equal
 //!   pick-off gains).
