@@ -434,7 +434,7 @@ impl Quantizer {
     }
 
     /// Quantizes one value (see [`requantize`]) and counts an overflow.
-    #[inline]
+    #[inline(always)]
     pub fn apply(&mut self, code: i128) -> i128 {
         match self.rounding {
             Rounding::Floor => self.apply_mode::<{ mode::FLOOR }>(code),

@@ -1,6 +1,8 @@
 //! The open-loop blocks of the per-gyro digital drive/sense loop (SPEC §1.6), run at the ADC
 //! rate `fs` (100–200 kHz) around a ~8 kHz resonator: [`nco`], [`demodulator`], [`pi`] and
-//! [`cic`].
+//! [`cic`]; [`gyro`] wires them into one gyro's closed loop, [`closed`] closes it around the
+//! simulated resonator and [`figures`] measures what it achieves against SPEC §1.6's closed
+//! forms.
 //!
 //! Each block follows the KF's shape: a `Spec` (formats, widths, settings, the rounding and
 //! overflow modes of the config) resolved once into a pure-data `Plan` (the format of every
@@ -37,7 +39,10 @@ use std::fmt;
 use crate::fx::{from_f64, CoefficientFormat, Format, FxError, Overflow, Quantizer, Rounding};
 
 pub mod cic;
+pub mod closed;
 pub mod demodulator;
+pub mod figures;
+pub mod gyro;
 pub mod nco;
 pub mod pi;
 

@@ -1,0 +1,315 @@
+//! What one gyro's closed loop achieves, beside SPEC §1.6's closed forms: [`characterize`]
+//! runs the loop around the noiseless, drift-free resonator in both modes and measures the
+//! drive frequency and amplitude, scale factor, bias, quadrature and settling after a switch.
+//!
+//! # Procedure
+//!
+//! From rest in normal mode: `startup_ms` to lock, then each figure is the mean of
+//! `average_samples` chain samples at `Ω = 0` and, after `rate_settle_ms`, at `Ω = rate_dps`.
+//! Then a switch to reverse mode at `Ω = 0`, traced in windows of `window_samples` ADC
+//! samples for `switch_ms`, reverse mode's figures the same way, and a switch back to
+//! normal mode, traced likewise (normal mode's settling).
+//!
+//! - `scale_factor`: `(S(Ω) − S(0)) / Ω`, output °/s per input °/s (predicted 1: the loop
+//!   divides by the closed-form SF).
+//! - `bias_dps`: `S(0)` in the chain's convention: `+B` normal, `−B′` reverse.
+//! - `quadrature_dps`: the quadrature channel at `Ω = 0`; predicted `Q(0)/SF` of the closed
+//!   form.
+//! - `drive_frequency_hz`: the mean NCO frequency; predicted the coupled resonance, where the
+//!   driven axis's effective impedance `Z_aa − Z_as Z_sa / Z_ss` is purely imaginary (the
+//!   displacement lags the force by 90°).
+//! - `drive_amplitude_m`: `sqrt(q_a² + (q_a′/w)²)` of the resonator's state; predicted `q0`.
+//! - `settling_ms`: from the switch into the mode until the lock flag is up (it includes the
+//!   flag's `lock_hold_ms`) and the amplitude within 0.1 % of its final value, for good.
+//!   Predicted: `ln(1000) / min(2π f_agc, 1/τ) + lock_hold_ms`, the AGC's slower closed-loop
+//!   pole (see [`super::gyro`]).
+//! - `rate_settling_ms`: from the switch until the rate output stays within 0.01 °/s of its
+//!   final value; predicted `τ_old ln(A/0.01 °/s)`: the formerly driven axis rings down with
+//!   its mode's `τ_old` from `A = q0 / SF` (°/s, about 2e4), plus the CIC's and compensator's
+//!   group delay (`N (R − 1)/2` ADC samples and `(T − 1)/2` chain samples, 17.5 ms).
+//! - `residual_bias_dps`: `(S + S′)/2` at `Ω = 0`; predicted `(B − B′)/2`.
+
+use serde::Serialize;
+
+use super::closed::{ClosedLoop, LoopUnderTest};
+use super::gyro::{mode_index, Plan};
+use crate::resonator::{Mode, ModeFigures, ParamError, PhysicsSettings, ResonatorParams};
+
+/// A measured figure beside its closed-form prediction.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Figure {
+    /// What the closed loop gave.
+    pub measured: f64,
+    /// What SPEC §1.6's closed forms (and the loop's design) predict.
+    pub predicted: f64,
+}
+
+/// One mode's figures.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ModeCharacterization {
+    /// `normal` or `reverse`.
+    pub mode: &'static str,
+    /// Locked NCO frequency, Hz.
+    pub drive_frequency_hz: Figure,
+    /// Drive amplitude, m.
+    pub drive_amplitude_m: Figure,
+    /// Output °/s per input °/s.
+    pub scale_factor: Figure,
+    /// Zero-rate output in the chain's convention, °/s.
+    pub bias_dps: Figure,
+    /// Quadrature channel at zero rate, °/s.
+    pub quadrature_dps: Figure,
+    /// From a switch into this mode to lock and amplitude within 0.1 %, ms.
+    pub settling_ms: Figure,
+    /// From a switch into this mode until the rate is within 0.01 °/s of its final value, ms.
+    pub rate_settling_ms: Figure,
+}
+
+/// Both modes and what reversal leaves.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Characterization {
+    /// Normal mode.
+    pub normal: ModeCharacterization,
+    /// Reverse mode.
+    pub reverse: ModeCharacterization,
+    /// `(S + S′)/2` at zero rate, °/s.
+    pub residual_bias_dps: Figure,
+}
+
+/// How [`characterize`] runs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Procedure {
+    /// The second input rate, °/s.
+    pub rate_dps: f64,
+    /// From rest to the first measurement, ms.
+    pub startup_ms: f64,
+    /// After a rate change, ms.
+    pub rate_settle_ms: f64,
+    /// Chain samples per mean.
+    pub average_samples: usize,
+    /// Traced after each switch, ms.
+    pub switch_ms: f64,
+    /// ADC samples per trace window.
+    pub window_samples: u32,
+}
+
+impl Default for Procedure {
+    /// 100 °/s, 400 ms start-up, 100 ms after a rate step, means over 40 chain samples,
+    /// 300 ms traced after a switch in windows of 100 ADC samples.
+    fn default() -> Self {
+        Procedure {
+            rate_dps: 100.0,
+            startup_ms: 400.0,
+            rate_settle_ms: 100.0,
+            average_samples: 40,
+            switch_ms: 300.0,
+            window_samples: 100,
+        }
+    }
+}
+
+/// Rate 0.01 °/s: the output settling criterion.
+const RATE_SETTLED_DPS: f64 = 0.01;
+/// Amplitude within 0.1 %.
+const AMPLITUDE_SETTLED: f64 = 1e-3;
+
+/// The coupled drive resonance of `mode` at `Ω = 0`, Hz: where `Re(Z_aa − Z_as²/Z_ss) = 0`
+/// with `Z_ij = k_ij − m w² δ_ij + i w d_ij` (bisection within ±5 % of `sqrt(k_aa/m)`).
+pub fn coupled_resonance_hz(params: &ResonatorParams, mode: Mode) -> f64 {
+    let mats = params.matrices();
+    let m = params.mass_kg;
+    let [a, s] = super::gyro::axes(mode);
+    let real_part = |w: f64| {
+        let (zaa_re, zaa_im) = (mats.k[a][a] - m * w * w, w * mats.d[a][a]);
+        let (zss_re, zss_im) = (mats.k[s][s] - m * w * w, w * mats.d[s][s]);
+        let (c_re, c_im) = (mats.k[0][1], w * mats.d[0][1]);
+        // Z_as² / Z_ss.
+        let (n_re, n_im) = (c_re * c_re - c_im * c_im, 2.0 * c_re * c_im);
+        let den = zss_re * zss_re + zss_im * zss_im;
+        let q_re = (n_re * zss_re + n_im * zss_im) / den;
+        let _ = zaa_im;
+        zaa_re - q_re
+    };
+    let w0 = (mats.k[a][a] / m).sqrt();
+    let (mut lo, mut hi) = (0.95 * w0, 1.05 * w0);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if real_part(mid) > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi) / (2.0 * std::f64::consts::PI)
+}
+
+struct Means {
+    rate: f64,
+    quadrature: f64,
+    frequency: f64,
+    amplitude: f64,
+}
+
+fn means<L: LoopUnderTest>(closed: &mut ClosedLoop<L>, rate: f64, mode: Mode, n: usize) -> Means {
+    let mut sums = [0.0; 4];
+    for _ in 0..n {
+        let r = closed.step_chain(rate, mode);
+        sums[0] += r.output.rate_dps;
+        sums[1] += r.output.quadrature_dps;
+        sums[2] += r.drive_frequency_hz;
+        sums[3] += r.drive_amplitude_m;
+    }
+    let k = n as f64;
+    Means {
+        rate: sums[0] / k,
+        quadrature: sums[1] / k,
+        frequency: sums[2] / k,
+        amplitude: sums[3] / k,
+    }
+}
+
+/// A switch traced: `(t_ms, amplitude_m, locked, rate_dps if a chain sample came)` per window.
+type Trace = Vec<(f64, f64, bool, Option<f64>)>;
+
+fn trace_switch<L: LoopUnderTest>(
+    closed: &mut ClosedLoop<L>,
+    mode: Mode,
+    procedure: &Procedure,
+    fs: f64,
+) -> Trace {
+    closed.set(0.0, mode);
+    let windows = (procedure.switch_ms * 1e-3 * fs / f64::from(procedure.window_samples)).ceil();
+    (1..=windows as u32)
+        .map(|k| {
+            let w = closed.advance(procedure.window_samples);
+            let t = f64::from(k * procedure.window_samples) / fs * 1e3;
+            (
+                t,
+                w.drive_amplitude_m,
+                w.locked,
+                w.chain.map(|c| c.rate_dps),
+            )
+        })
+        .collect()
+}
+
+/// The settling times of a trace given the final amplitude and rate: (lock and amplitude, rate).
+fn settling(trace: &Trace, amplitude: f64, rate: f64) -> (f64, f64) {
+    let mut settled = 0.0;
+    let mut rate_settled = 0.0;
+    for (t, a, locked, r) in trace {
+        if !locked || ((a - amplitude) / amplitude).abs() > AMPLITUDE_SETTLED {
+            settled = *t;
+        }
+        if let Some(r) = r {
+            if (r - rate).abs() > RATE_SETTLED_DPS {
+                rate_settled = *t;
+            }
+        }
+    }
+    (settled, rate_settled)
+}
+
+/// Runs `L` (the fixed loop or its twin) of `plan` around `params` with `physics`' front end
+/// (noise and drift off) as [`Procedure`] says; see the [module doc](self).
+///
+/// # Errors
+/// [`ParamError`] for invalid physics.
+pub fn characterize<L: LoopUnderTest>(
+    plan: &Plan,
+    params: &ResonatorParams,
+    physics: &PhysicsSettings,
+    procedure: &Procedure,
+) -> Result<Characterization, ParamError> {
+    let physics = physics.noiseless();
+    let fs = plan.adc_rate_hz;
+    let chain_ms = 1e3 / plan.chain_rate_hz();
+    let mut closed = ClosedLoop::<L>::new(plan, params, &physics, 0)?;
+    let samples = |ms: f64| (ms / chain_ms).ceil() as usize;
+    let omega = procedure.rate_dps;
+    let n = procedure.average_samples;
+    let measure = |closed: &mut ClosedLoop<L>, mode: Mode| {
+        let at_zero = means(closed, 0.0, mode, n);
+        for _ in 0..samples(procedure.rate_settle_ms) {
+            closed.step_chain(omega, mode);
+        }
+        let at_rate = means(closed, omega, mode, n);
+        for _ in 0..samples(procedure.rate_settle_ms) {
+            closed.step_chain(0.0, mode);
+        }
+        (at_zero, at_rate)
+    };
+    for _ in 0..samples(procedure.startup_ms) {
+        closed.step_chain(0.0, Mode::Normal);
+    }
+    let normal = measure(&mut closed, Mode::Normal);
+    let to_reverse = trace_switch(&mut closed, Mode::Reverse, procedure, fs);
+    let reverse = measure(&mut closed, Mode::Reverse);
+    let to_normal = trace_switch(&mut closed, Mode::Normal, procedure, fs);
+    let normal_final = means(&mut closed, 0.0, Mode::Normal, n);
+
+    let hold_ms = f64::from(plan.lock.hold_samples) / fs * 1e3;
+    // The CIC's N (R − 1)/2 ADC samples and the compensator's (T − 1)/2 chain samples.
+    let group_delay_ms = 1e3
+        * (f64::from(plan.cic.stages) * f64::from(plan.cic.decimation - 1) / 2.0 / fs
+            + (plan.cic.taps.len() - 1) as f64 / 2.0 / plan.chain_rate_hz());
+    let agc_pole = 2.0 * std::f64::consts::PI * plan.settings.agc_bandwidth_hz;
+    let report = |mode: Mode, (zero, rate): &(Means, Means), trace: &Trace, final_amp: f64| {
+        let m = plan.mode(mode);
+        let f = m.figures;
+        let other = plan.modes[1 - mode_index(mode)].figures;
+        let (settled, rate_settled) = settling(trace, final_amp, zero.rate);
+        let sigma = f.sigma();
+        let ring_start = f.drive_amplitude / f.scale_factor_m_per_dps();
+        ModeCharacterization {
+            mode: match mode {
+                Mode::Normal => "normal",
+                Mode::Reverse => "reverse",
+            },
+            drive_frequency_hz: Figure {
+                measured: zero.frequency,
+                predicted: coupled_resonance_hz(params, mode),
+            },
+            drive_amplitude_m: Figure {
+                measured: zero.amplitude,
+                predicted: params.drive_amplitude_m,
+            },
+            scale_factor: Figure {
+                measured: (rate.rate - zero.rate) / omega,
+                predicted: 1.0,
+            },
+            bias_dps: Figure {
+                measured: zero.rate,
+                predicted: sigma * f.bias_dps(),
+            },
+            quadrature_dps: Figure {
+                measured: zero.quadrature,
+                predicted: (f.quadrature(0.0) / f.scale_factor).to_degrees(),
+            },
+            settling_ms: Figure {
+                measured: settled,
+                predicted: 1e3 * libm::log(1.0 / AMPLITUDE_SETTLED)
+                    / agc_pole.min(1.0 / f.ring_down_time_constant)
+                    + hold_ms,
+            },
+            rate_settling_ms: Figure {
+                measured: rate_settled,
+                predicted: 1e3
+                    * other.ring_down_time_constant
+                    * libm::log(ring_start / RATE_SETTLED_DPS)
+                    + group_delay_ms,
+            },
+        }
+    };
+    let normal_report = report(Mode::Normal, &normal, &to_normal, normal_final.amplitude);
+    let reverse_report = report(Mode::Reverse, &reverse, &to_reverse, reverse.0.amplitude);
+    let figures = [Mode::Normal, Mode::Reverse].map(|m| ModeFigures::new(params, m));
+    Ok(Characterization {
+        normal: normal_report,
+        reverse: reverse_report,
+        residual_bias_dps: Figure {
+            measured: (normal.0.rate + reverse.0.rate) / 2.0,
+            predicted: (figures[0].bias_dps() - figures[1].bias_dps()) / 2.0,
+        },
+    })
+}

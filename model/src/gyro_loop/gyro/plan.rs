@@ -1,0 +1,429 @@
+//! [`Spec`] → [`Plan`]: the blocks' plans, the per-mode presets, offsets and `1/SF`
+//! coefficients, and the PI gains, all designed from the nominal physics (equations in the
+//! [module doc](super)).
+
+use std::f64::consts::PI;
+
+use super::design::{dac_offset, Design, LockPlan, ModePlan};
+use super::settings::{format, LoopSettings};
+use super::{axes, mode_index};
+use crate::fx::{from_f64, CoefficientFormat, Format, Overflow, Rounding};
+use crate::gyro_loop::{
+    cic, demodulator, field_error, nco, pi, quantize_coefficients, PlanError, Point,
+};
+use crate::resonator::{Mode, ModeFigures, PhysicsSettings, ResonatorParams};
+
+/// Largest `adc_to_dac_latency_samples`.
+pub const MAX_LATENCY: u32 = 8;
+
+/// What one gyro's loop is asked to be: its settings and the nominal physics it is designed
+/// from (the resonator and its front end: pick-off gains, ADC, DAC).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Spec {
+    /// The `[loop]` settings.
+    pub settings: LoopSettings,
+    /// The nominal resonator.
+    pub resonator: ResonatorParams,
+    /// The nominal front end (its noise and drift settings do not matter here).
+    pub front_end: PhysicsSettings,
+}
+
+impl Spec {
+    /// Paper 004 with [`LoopSettings::default`] and [`PhysicsSettings::example`].
+    pub fn paper_004() -> Self {
+        Spec {
+            settings: LoopSettings::default(),
+            resonator: ResonatorParams::paper_004(),
+            front_end: PhysicsSettings::example(),
+        }
+    }
+}
+
+/// The resolved loop.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Plan {
+    /// The settings it was resolved from.
+    pub settings: LoopSettings,
+    /// `fs`, Hz.
+    pub adc_rate_hz: f64,
+    /// `L`.
+    pub latency: u32,
+    /// ADC codes.
+    pub adc: Format,
+    /// The three NCOs.
+    pub nco: nco::Plan,
+    /// Both demodulators.
+    pub demodulator: demodulator::Plan,
+    /// PLL: `Q_D` in, frequency word `s P.P` out.
+    pub pll: pi::Plan,
+    /// AGC: `e_A` in, `u` out.
+    pub agc: pi::Plan,
+    /// `a_set − I_D` → demodulator output format.
+    pub agc_error: Point,
+    /// `u · cos` → DAC format.
+    pub dac: Point,
+    /// Both CICs (`I_S`, `Q_S`).
+    pub cic: cic::Plan,
+    /// `c · y_CIC` → output format.
+    pub output: Point,
+    /// Lock detector.
+    pub lock: LockPlan,
+    /// Normal, reverse.
+    pub modes: [ModePlan; 2],
+    /// The unquantized design values.
+    pub design: Design,
+    /// DAC force per LSB, N (the twin's DAC).
+    pub dac_newton_per_lsb: f64,
+    /// ADC full scale, V (the twin's ADC).
+    pub adc_full_scale_v: f64,
+}
+
+fn positive(field: &'static str, value: f64) -> Result<f64, PlanError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(field_error("loop", field, value, "a finite value above 0"))
+    }
+}
+
+fn word(nco: &nco::Plan, cycles: f64) -> Result<u64, PlanError> {
+    nco.offset_word(cycles * 360.0)
+}
+
+impl Plan {
+    /// Validates `spec`, designs the gains, presets, offsets and coefficients, and resolves
+    /// every block.
+    ///
+    /// # Errors
+    /// [`PlanError::Field`] for a setting out of range, a format that does not parse, a
+    /// front end that does not match (`adc_rate_hz`, `adc_format`) or invalid physics;
+    /// [`PlanError::CoefficientOverflow`] for a gain, preset or `1/SF` that does not fit.
+    pub fn new(spec: &Spec) -> Result<Plan, PlanError> {
+        let s = &spec.settings;
+        let (params, front) = (&spec.resonator, &spec.front_end);
+        params
+            .validate()
+            .and_then(|_| front.validate(params))
+            .map_err(|e| match e {
+                crate::resonator::ParamError::Range {
+                    field,
+                    value,
+                    allowed,
+                } => field_error("resonator", field, value, allowed),
+            })?;
+        let rounding = s.rounding_mode()?;
+        let overflow = s.overflow_mode()?;
+        let fs = positive("adc_rate_hz", s.adc_rate_hz)?;
+        if fs != front.sample_rate_hz {
+            return Err(field_error(
+                "loop",
+                "adc_rate_hz",
+                fs,
+                format!("the resonator's sample rate, {} Hz", front.sample_rate_hz),
+            ));
+        }
+        let adc = format("adc_format", &s.adc_format)?;
+        let w = front.adc_width;
+        if !adc.signed || adc.width != w || adc.frac != w as i32 - 1 {
+            return Err(field_error(
+                "loop",
+                "adc_format",
+                adc,
+                format!("s{w}.{} (the resonator's ADC in full-scale units)", w - 1),
+            ));
+        }
+        if s.adc_to_dac_latency_samples > MAX_LATENCY {
+            return Err(field_error(
+                "loop",
+                "adc_to_dac_latency_samples",
+                s.adc_to_dac_latency_samples,
+                format!("0..={MAX_LATENCY}"),
+            ));
+        }
+        let pll_bandwidth = positive("pll_bandwidth_hz", s.pll_bandwidth_hz)?;
+        let agc_bandwidth = positive("agc_bandwidth_hz", s.agc_bandwidth_hz)?;
+        let pull = positive("pll_pull_range_hz", s.pll_pull_range_hz)?;
+        let lock_phase = positive("lock_phase_deg", s.lock_phase_deg)?;
+        let lock_tolerance = positive("lock_amplitude_tolerance", s.lock_amplitude_tolerance)?;
+        let hold_ms = positive("lock_hold_ms", s.lock_hold_ms)?;
+
+        let nco = nco::Plan::new(&nco::Spec {
+            phase_bits: s.nco_phase_bits,
+            address_bits: s.nco_address_bits,
+            sine_width: s.nco_sine_width,
+        })?;
+        let demod_output = format("demod_output_format", &s.demod_output_format)?;
+        let demodulator = demodulator::Plan::new(&demodulator::Spec {
+            input: adc,
+            reference: nco.output,
+            product: format("demod_product_format", &s.demod_product_format)?,
+            state: format("demod_state_format", &s.demod_state_format)?,
+            output: demod_output,
+            lowpass_shift: s.demod_lowpass_shift,
+            rounding,
+            overflow,
+        })?;
+        let cic = cic::Plan::new(&cic::Spec {
+            input: demod_output,
+            stages: s.cic_stages,
+            decimation: s.decimation,
+            differential_delay: 1,
+            shift: None,
+            cic_output: format("cic_internal_format", &s.cic_internal_format)?,
+            taps: s.cic_taps,
+            passband: s.cic_passband,
+            coefficients: CoefficientFormat::Auto {
+                width: s.cic_tap_width,
+            },
+            output: format("cic_output_format", &s.cic_output_format)?,
+            rounding,
+            overflow,
+        })?;
+        let cic_gain = cic.flatness().dc_gain;
+
+        // Per-mode physics.
+        let a_nco = nco.amplitude();
+        let gains = front.pickoff_gain_v_per_m;
+        let per_fs = |axis: usize| gains[axis] / front.adc_full_scale_v;
+        let latency = s.adc_to_dac_latency_samples;
+        let figures = [Mode::Normal, Mode::Reverse].map(|m| ModeFigures::new(params, m));
+        let physics = figures.map(|f| {
+            let [driven, sensed] = axes(f.mode);
+            let f_nom = f.drive_frequency_hz();
+            let x = PI * f_nom / fs;
+            let hold_gain = libm::sin(x) / x;
+            let tau = f.ring_down_time_constant;
+            let setpoint = per_fs(driven) * params.drive_amplitude_m * a_nco;
+            let plant_gain =
+                per_fs(driven) * a_nco * a_nco * front.dac_newton_per_lsb * hold_gain * tau
+                    / (2.0 * params.mass_kg * f.drive_angular_frequency);
+            let sense = per_fs(sensed) * a_nco * f.scale_factor_m_per_dps() * cic_gain;
+            (f_nom, tau, setpoint, plant_gain, sense, sensed)
+        });
+        let (_, tau, setpoint, plant_gain, _, _) = physics[0];
+
+        // PLL.
+        let kp = pll_bandwidth / (fs * setpoint);
+        let ki = kp / (tau * fs);
+        let frequencies = physics.map(|p| p.0);
+        let lowest = frequencies[0].min(frequencies[1]) - pull;
+        let highest = frequencies[0].max(frequencies[1]) + pull;
+        if lowest <= 0.0 || highest >= fs / 2.0 {
+            return Err(field_error(
+                "loop",
+                "pll_pull_range_hz",
+                pull,
+                format!("a range within (0, fs/2) around {lowest} .. {highest} Hz"),
+            ));
+        }
+        let p = nco.phase.width;
+        let pll_limits = [lowest / fs, highest / fs];
+        let pll = pi::Plan::new(&pi::Spec {
+            input: demod_output,
+            kp,
+            ki,
+            kp_format: CoefficientFormat::Auto {
+                width: s.pll_gain_width,
+            },
+            ki_format: CoefficientFormat::Auto {
+                width: s.pll_gain_width,
+            },
+            integrator: format("pll_integrator_format", &s.pll_integrator_format)?,
+            integrator_limits: pll_limits,
+            output: Format::signed(p, p as i32).expect("the NCO checked P"),
+            rounding,
+            overflow,
+        })?;
+
+        // AGC.
+        let dac = format("dac_format", &s.dac_format)?;
+        let agc_kp = 2.0 * PI * agc_bandwidth * tau / plant_gain;
+        let agc_ki = agc_kp / (tau * fs);
+        let agc_limits = [0.0, dac.max_value()];
+        let agc = pi::Plan::new(&pi::Spec {
+            input: demod_output,
+            kp: agc_kp,
+            ki: agc_ki,
+            kp_format: CoefficientFormat::Auto {
+                width: s.agc_gain_width,
+            },
+            ki_format: CoefficientFormat::Auto {
+                width: s.agc_gain_width,
+            },
+            integrator: format("agc_integrator_format", &s.agc_integrator_format)?,
+            integrator_limits: agc_limits,
+            output: format("agc_output_format", &s.agc_output_format)?,
+            rounding,
+            overflow,
+        })?;
+        let error_exact = Format::sum(demod_output, demod_output, true)
+            .map_err(crate::gyro_loop::intermediate("loop", "a_set - I"))?;
+        let agc_error = Point::new(
+            "loop",
+            "demod_output_format",
+            error_exact,
+            demod_output,
+            rounding,
+            overflow,
+        )?;
+        let drive_exact = Format::product(agc.output.to, nco.output)
+            .map_err(crate::gyro_loop::intermediate("loop", "u * cos"))?;
+        let dac_point = Point::new("loop", "dac_format", drive_exact, dac, rounding, overflow)?;
+
+        // 1/SF, one format for the four coefficients.
+        let sigma = [1.0, -1.0];
+        let coefficient_values = [
+            sigma[0] / physics[0].4,
+            sigma[1] / physics[1].4,
+            -1.0 / physics[0].4,
+            -1.0 / physics[1].4,
+        ];
+        let coefficients = quantize_coefficients(
+            "loop",
+            "scale_coefficients",
+            &coefficient_values,
+            match &s.scale_coefficient_format {
+                Some(text) => CoefficientFormat::Fixed(format("scale_coefficient_format", text)?),
+                None => CoefficientFormat::Auto {
+                    width: s.scale_coefficient_width,
+                },
+            },
+        )?;
+        let output_format = format("output_format", &s.output_format)?;
+        let output_exact = Format::product(cic.output.to, coefficients[0].format)
+            .map_err(crate::gyro_loop::intermediate("loop", "c * y"))?;
+        let output = Point::new(
+            "loop",
+            "output_format",
+            output_exact,
+            output_format,
+            rounding,
+            overflow,
+        )?;
+
+        // Lock detector.
+        let shift = s.lock_filter_shift;
+        if shift == 0 || demod_output.width + shift + 1 > 64 {
+            return Err(field_error(
+                "loop",
+                "lock_filter_shift",
+                shift,
+                format!(
+                    "1..={} (the filter state has demod_output width + s + 1 bits, at most 64)",
+                    63 - demod_output.width
+                ),
+            ));
+        }
+        let hold = libm::round(hold_ms * 1e-3 * fs);
+        if hold > f64::from(u32::MAX) {
+            return Err(field_error(
+                "loop",
+                "lock_hold_ms",
+                hold_ms,
+                "below 2^32 samples",
+            ));
+        }
+        let lock = LockPlan {
+            shift,
+            hold_samples: hold as u32,
+        };
+
+        let code = |value: f64, to: Format, field: &'static str| -> Result<i64, PlanError> {
+            let q = from_f64(value, to, Rounding::Convergent, Overflow::Saturate)
+                .map_err(|_| field_error("loop", field, value, "a finite number"))?;
+            if q.overflowed {
+                return Err(field_error(
+                    "loop",
+                    field,
+                    value,
+                    format!("a value that fits {to}"),
+                ));
+            }
+            Ok(q.code as i64)
+        };
+        let scale = crate::fx::pow2(shift as i32);
+        let mut modes = Vec::with_capacity(2);
+        for (i, f) in figures.iter().enumerate() {
+            let (f_nom, _, setpoint, plant_gain, sense, _) = physics[i];
+            let nominal_amplitude = setpoint / plant_gain;
+            let dac_offset = dac_offset(
+                (f64::from(latency) + 0.5) * f_nom / fs,
+                f_nom / fs,
+                s.demod_lowpass_shift,
+                agc.kp.quantized() * setpoint / (2.0 * nominal_amplitude),
+            );
+            let sense_offset = -0.25 - f.sense_phase / (2.0 * PI);
+            let lock_q = setpoint * libm::sin(lock_phase.to_radians()) * scale;
+            let lock_a = lock_tolerance * setpoint * scale;
+            modes.push(ModePlan {
+                mode: f.mode,
+                figures: *f,
+                setpoint,
+                setpoint_code: code(setpoint, demod_output, "setpoint")?,
+                nominal_frequency_hz: f_nom,
+                frequency: f_nom / fs,
+                pll_preset: pll
+                    .integrator_code(f_nom / fs)
+                    .map_err(|_| field_error("loop", "nominal_frequency", f_nom, "finite"))?,
+                frequency_word: nco.frequency_word(f_nom, fs)?,
+                plant_gain,
+                nominal_amplitude,
+                dac_offset,
+                dac_offset_word: word(&nco, dac_offset)?,
+                sense_offset,
+                sense_offset_word: word(&nco, sense_offset)?,
+                sense_gain_per_dps: sense,
+                rate_coefficient: coefficients[i],
+                quadrature_coefficient: coefficients[2 + i],
+                lock_limits: [
+                    code(
+                        lock_q,
+                        Format::intermediate(true, 64, demod_output.frac).expect("64"),
+                        "lock_phase_deg",
+                    )?,
+                    code(
+                        lock_a,
+                        Format::intermediate(true, 64, demod_output.frac).expect("64"),
+                        "lock_amplitude_tolerance",
+                    )?,
+                ],
+            });
+        }
+        let modes: [ModePlan; 2] = [modes[0], modes[1]];
+        debug_assert_eq!(mode_index(modes[1].mode), 1);
+        Ok(Plan {
+            settings: s.clone(),
+            adc_rate_hz: fs,
+            latency,
+            adc,
+            nco,
+            demodulator,
+            pll,
+            agc,
+            agc_error,
+            dac: dac_point,
+            cic,
+            output,
+            lock,
+            modes,
+            design: Design {
+                pll_gains: [kp, ki],
+                agc_gains: [agc_kp, agc_ki],
+                pll_limits,
+                agc_limits,
+            },
+            dac_newton_per_lsb: front.dac_newton_per_lsb,
+            adc_full_scale_v: front.adc_full_scale_v,
+        })
+    }
+
+    /// The plan of `mode`.
+    pub fn mode(&self, mode: Mode) -> &ModePlan {
+        &self.modes[mode_index(mode)]
+    }
+
+    /// The chain's rate `fs / R`, Hz.
+    pub fn chain_rate_hz(&self) -> f64 {
+        self.adc_rate_hz / f64::from(self.cic.decimation)
+    }
+}
