@@ -7,7 +7,9 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use commands::{allan, ar, davar, design, filter, generate, init, reproduce, synth, verify};
+use commands::{
+    allan, ar, davar, design, filter, generate, gyro_loop, init, reproduce, synth, verify,
+};
 
 #[derive(Parser)]
 #[command(
@@ -30,6 +32,7 @@ enum Command {
     Design(design::Args),
     Generate(generate::Args),
     Synth(synth::Args),
+    Loop(gyro_loop::Args),
     Verify(verify::Args),
     Filter(filter::Args),
     Reproduce(reproduce::Args),
@@ -45,6 +48,7 @@ fn main() -> ExitCode {
         Command::Design(args) => design::run(args),
         Command::Generate(args) => generate::run(args),
         Command::Synth(args) => synth::run(args),
+        Command::Loop(args) => gyro_loop::run(args),
         Command::Verify(args) => verify::run(args),
         Command::Filter(args) => filter::run(args),
         Command::Reproduce(args) => reproduce::run(args),

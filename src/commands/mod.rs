@@ -6,6 +6,7 @@ pub mod davar;
 pub mod design;
 pub mod filter;
 pub mod generate;
+pub mod gyro_loop;
 pub mod init;
 mod options;
 pub mod reproduce;

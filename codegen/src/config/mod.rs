@@ -12,11 +12,13 @@ use gyrofx_model::estimator::Spec as EstimatorSpec;
 use gyrofx_model::fx::{Overflow, Rounding};
 use gyrofx_model::mean_filter::Spec as MeanFilterSpec;
 use gyrofx_model::plant::{GyroErrors, Plant};
+use gyrofx_model::resonator::ResonatorParams;
 
 use crate::error::{Error, Result};
 
 pub(crate) mod check;
 mod gyro;
+mod resonator;
 mod stimulus;
 
 pub use crate::blocks::estimator::config::EstimatorConfig;
@@ -24,6 +26,7 @@ pub use crate::blocks::kf::config::{KfConfig, KfSettings};
 pub use crate::blocks::mean_filter::config::MeanFilterConfig;
 pub use crate::blocks::sequencer::config::SequencerConfig;
 pub use gyro::PlantConfig;
+pub use resonator::GyroLoop;
 pub use stimulus::{Source, StimulusConfig};
 
 /// Largest `samples`: the vector set and its files are built in memory.
@@ -61,6 +64,17 @@ pub struct Config {
     /// The mean filter with gross-error rejection (paper 003; a block of its own, beside the
     /// chain).
     pub mean_filter: MeanFilterConfig,
+    /// Gyro A's structure at resonator level (SPEC §1.6).
+    pub resonator_a: ResonatorParams,
+    /// Gyro B's structure.
+    pub resonator_b: ResonatorParams,
+    /// The resonators' front end (`PhysicsSettings` without its sample rate, which is
+    /// `[loop]`'s).
+    pub front_end: toml::Table,
+    /// One gyro's digital loop (`LoopSettings` without rounding and overflow, which are the
+    /// config's).
+    #[serde(rename = "loop")]
+    pub gyro_loop: toml::Table,
 }
 
 /// Everything the config says, validated and typed.

@@ -91,11 +91,16 @@ pub struct Procedure {
     pub switch_ms: f64,
     /// ADC samples per trace window.
     pub window_samples: u32,
+    /// Thermomechanical and electronic noise and drift as the front end says (off: the
+    /// deterministic figures the closed forms predict).
+    pub noise: bool,
+    /// Seed of the resonator's random streams (with `noise`).
+    pub seed: u64,
 }
 
 impl Default for Procedure {
     /// 100 °/s, 400 ms start-up, 100 ms after a rate step, means over 40 chain samples,
-    /// 300 ms traced after a switch in windows of 100 ADC samples.
+    /// 300 ms traced after a switch in windows of 100 ADC samples; noise and drift off.
     fn default() -> Self {
         Procedure {
             rate_dps: 100.0,
@@ -104,6 +109,8 @@ impl Default for Procedure {
             average_samples: 40,
             switch_ms: 300.0,
             window_samples: 100,
+            noise: false,
+            seed: 0,
         }
     }
 }
@@ -211,7 +218,7 @@ fn settling(trace: &Trace, amplitude: f64, rate: f64) -> (f64, f64) {
 }
 
 /// Runs `L` (the fixed loop or its twin) of `plan` around `params` with `physics`' front end
-/// (noise and drift off) as [`Procedure`] says; see the [module doc](self).
+/// (noise and drift off unless `procedure.noise`) as [`Procedure`] says; see the [module doc](self).
 ///
 /// # Errors
 /// [`ParamError`] for invalid physics.
@@ -221,10 +228,14 @@ pub fn characterize<L: LoopUnderTest>(
     physics: &PhysicsSettings,
     procedure: &Procedure,
 ) -> Result<Characterization, ParamError> {
-    let physics = physics.noiseless();
+    let physics = if procedure.noise {
+        *physics
+    } else {
+        physics.noiseless()
+    };
     let fs = plan.adc_rate_hz;
     let chain_ms = 1e3 / plan.chain_rate_hz();
-    let mut closed = ClosedLoop::<L>::new(plan, params, &physics, 0)?;
+    let mut closed = ClosedLoop::<L>::new(plan, params, &physics, procedure.seed)?;
     let samples = |ms: f64| (ms / chain_ms).ceil() as usize;
     let omega = procedure.rate_dps;
     let n = procedure.average_samples;

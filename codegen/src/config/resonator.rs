@@ -1,0 +1,124 @@
+//! `[resonator_a]`, `[resonator_b]` (each gyro's structure, SPEC §1.6), `[front_end]` (pick-off,
+//! ADC, DAC, thermal and electronic noise, drift: shared by both gyros) and `[loop]` (one gyro's
+//! digital drive and sense loop, the same for both): what `gyrofx loop` runs.
+//!
+//! `[front_end]`'s sample rate is `[loop]`'s `adc_rate_hz`, and `[loop]`'s rounding and
+//! overflow are the config's `rounding` and `overflow`, so neither can disagree.
+
+use gyrofx_model::gyro_loop::gyro::{LoopSettings, Plan, Spec};
+use gyrofx_model::resonator::{PhysicsSettings, ResonatorParams};
+
+use super::Config;
+use crate::error::{Error, Result};
+
+/// One gyro's resolved loop: its plan, its structure and its front end.
+#[derive(Clone, Debug)]
+pub struct GyroLoop {
+    /// `a` or `b`.
+    pub name: &'static str,
+    /// The loop's plan, designed from the nominal structure.
+    pub plan: Plan,
+    /// The structure.
+    pub params: ResonatorParams,
+    /// The front end (noise and drift on; callers switch them off where they want).
+    pub front_end: PhysicsSettings,
+}
+
+/// Deserializes `table` (a config section after overlaying) as `T`, naming the section in the
+/// error.
+fn section<T: serde::de::DeserializeOwned>(name: &str, table: toml::Table) -> Result<T> {
+    T::deserialize(toml::Value::Table(table))
+        .map_err(|e| Error::config(name, "(section)", e.to_string().trim().replace('\n', " ")))
+}
+
+impl Config {
+    /// Both gyros' loops, validated and designed.
+    ///
+    /// # Errors
+    /// [`Error::Config`] naming the first bad field of `[resonator_a]`, `[resonator_b]`,
+    /// `[front_end]` or `[loop]`, or a loop the design refuses.
+    pub fn gyro_loops(&self) -> Result<[GyroLoop; 2]> {
+        let mut table = self.gyro_loop.clone();
+        table.insert("rounding".into(), self.rounding.clone().into());
+        table.insert("overflow".into(), self.overflow.clone().into());
+        let settings: LoopSettings = section("loop", table)?;
+        let mut front_end = self.front_end.clone();
+        front_end.insert("sample_rate_hz".into(), settings.adc_rate_hz.into());
+        let front_end: PhysicsSettings = section("front_end", front_end)?;
+        let resolve = |name: &'static str, params: &ResonatorParams| -> Result<GyroLoop> {
+            let key = format!("resonator_{name}");
+            params
+                .validate()
+                .map_err(|e| prefixed(&key, e.to_string()))?;
+            front_end
+                .validate(params)
+                .map_err(|e| prefixed("front_end", e.to_string()))?;
+            let plan = Plan::new(&Spec {
+                settings: settings.clone(),
+                resonator: *params,
+                front_end,
+            })
+            .map_err(|e| prefixed("loop", e.to_string()))?;
+            Ok(GyroLoop {
+                name,
+                plan,
+                params: *params,
+                front_end,
+            })
+        };
+        Ok([
+            resolve("a", &self.resonator_a)?,
+            resolve("b", &self.resonator_b)?,
+        ])
+    }
+}
+
+/// The model's "`field = value is not allowed: …`" under the section's name.
+fn prefixed(section: &str, message: String) -> Error {
+    match message.split_once(" = ") {
+        Some((field, rest)) => match rest.split_once(" is not allowed: ") {
+            Some((value, allowed)) => {
+                Error::config(format!("{section}.{field}"), value, allowed.to_string())
+            }
+            None => Error::config(section, message, "see the annotated default (gyrofx init)"),
+        },
+        None => Error::config(section, message, "see the annotated default (gyrofx init)"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The embedded default's loops are paper 004's gyro with the default loop, and a bad
+    /// structure or loop setting is refused naming its section and key.
+    #[test]
+    fn the_default_loops_are_paper_004s_and_bad_fields_are_named() {
+        let [a, b] = Config::embedded().gyro_loops().unwrap();
+        assert_eq!(a.params, ResonatorParams::paper_004());
+        assert_eq!(b.params, ResonatorParams::paper_004());
+        assert_eq!(a.front_end.sample_rate_hz, a.plan.adc_rate_hz);
+        for (text, field) in [
+            (
+                "[resonator_b]\nq_drive = -3.0\n",
+                "resonator_b.q_drive = -3",
+            ),
+            ("[resonator_a]\nmass_kg = 0.0\n", "resonator_a.mass_kg = 0"),
+            ("[loop]\nnco_phase_bits = 70\n", "phase_bits = 70"),
+            ("[loop]\ndemod_output_format = \"x12\"\n", "loop"),
+        ] {
+            let err = Config::from_toml(text, "test.toml")
+                .and_then(|c| c.gyro_loops().map(|_| ()))
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains(field), "{text}: {err}");
+        }
+        // Rounding and overflow are the config's: [loop] has no keys of its own for them.
+        assert!(Config::from_toml("[loop]\nrounding = \"floor\"\n", "test.toml").is_err());
+        let floor = Config::from_toml("rounding = \"floor\"\n", "test.toml").unwrap();
+        assert_eq!(
+            floor.gyro_loops().unwrap()[0].plan.settings.rounding,
+            "floor"
+        );
+    }
+}

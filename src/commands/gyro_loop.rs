@@ -1,0 +1,146 @@
+//! `gyrofx loop`: both resonator-level gyros closed by their fixed-point loops, in both modes at
+//! a constant input rate, each figure beside SPEC §1.6's closed-form prediction.
+
+use std::process::ExitCode;
+
+use anyhow::{bail, Result};
+use serde::Serialize;
+
+use gyrofx_model::gyro_loop::closed::FixedHarness;
+use gyrofx_model::gyro_loop::figures::{
+    characterize, Characterization, Figure, ModeCharacterization, Procedure,
+};
+
+use super::options::ConfigSource;
+
+/// Run both gyros' closed loops (resonator physics, NCO, PLL, AGC, sense demodulation, CIC,
+/// 1/SF) in normal and reverse mode at a constant rate and print, per gyro and mode, the
+/// locked drive frequency, drive amplitude, scale factor, bias (the chain's sign convention),
+/// quadrature and settling after a switch beside SPEC 1.6's closed forms, and the residual
+/// bias after reversal. Noise and drift are off unless --noise is given.
+#[derive(clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    source: ConfigSource,
+    /// Seconds of output averaged for each figure (the chain rate times this many samples per
+    /// mean).
+    #[arg(long, default_value_t = 0.2)]
+    seconds: f64,
+    /// The input rate for the scale factor, °/s (the bias is measured at 0).
+    #[arg(long, default_value_t = 100.0)]
+    rate_dps: f64,
+    /// Thermomechanical and electronic noise and drift as [front_end] says.
+    #[arg(long)]
+    noise: bool,
+    /// Print JSON instead of the table.
+    #[arg(long)]
+    json: bool,
+}
+
+/// One gyro's figures.
+#[derive(Serialize)]
+struct GyroFigures {
+    gyro: &'static str,
+    #[serde(flatten)]
+    figures: Characterization,
+}
+
+/// Characterizes both gyros and prints the figures.
+pub fn run(args: Args) -> Result<ExitCode> {
+    if !(args.seconds.is_finite() && args.seconds > 0.0 && args.seconds <= 100.0) {
+        bail!(
+            "--seconds {} is not allowed: a number of seconds in (0, 100]",
+            args.seconds
+        );
+    }
+    if !(args.rate_dps.is_finite() && args.rate_dps != 0.0 && args.rate_dps.abs() <= 1e4) {
+        bail!(
+            "--rate-dps {} is not allowed: a non-zero rate within ±10000 °/s",
+            args.rate_dps
+        );
+    }
+    let config = args.source.load()?;
+    let loops = config.gyro_loops()?;
+    let figures: Vec<GyroFigures> = std::thread::scope(|scope| {
+        let handles: Vec<_> = loops
+            .iter()
+            .enumerate()
+            .map(|(index, gyro)| {
+                let procedure = Procedure {
+                    rate_dps: args.rate_dps,
+                    average_samples: ((args.seconds * gyro.plan.chain_rate_hz()).round() as usize)
+                        .max(1),
+                    noise: args.noise,
+                    seed: config.seed.wrapping_mul(2).wrapping_add(index as u64),
+                    ..Procedure::default()
+                };
+                scope.spawn(move || {
+                    characterize::<FixedHarness>(
+                        &gyro.plan,
+                        &gyro.params,
+                        &gyro.front_end,
+                        &procedure,
+                    )
+                    .map(|figures| GyroFigures {
+                        gyro: gyro.name,
+                        figures,
+                    })
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("the loop simulation does not panic"))
+            .collect::<std::result::Result<_, _>>()
+    })?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&figures)?);
+    } else {
+        print_table(&figures);
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn print_table(figures: &[GyroFigures]) {
+    println!(
+        "{:<5} {:<8} {:<19} {:>16} {:>16} {:>12} {:>10}",
+        "gyro", "mode", "figure", "measured", "predicted", "difference", "relative"
+    );
+    for gyro in figures {
+        let modes: [&ModeCharacterization; 2] = [&gyro.figures.normal, &gyro.figures.reverse];
+        for mode in modes {
+            let rows: [(&str, &Figure, f64); 7] = [
+                ("drive_frequency_hz", &mode.drive_frequency_hz, 1.0),
+                ("drive_amplitude_um", &mode.drive_amplitude_m, 1e6),
+                ("scale_factor", &mode.scale_factor, 1.0),
+                ("bias_dps", &mode.bias_dps, 1.0),
+                ("quadrature_dps", &mode.quadrature_dps, 1.0),
+                ("settling_ms", &mode.settling_ms, 1.0),
+                ("rate_settling_ms", &mode.rate_settling_ms, 1.0),
+            ];
+            for (name, figure, unit) in rows {
+                print_row(gyro.gyro, mode.mode, name, figure, unit);
+            }
+        }
+        print_row(
+            gyro.gyro,
+            "both",
+            "residual_bias_dps",
+            &gyro.figures.residual_bias_dps,
+            1.0,
+        );
+    }
+}
+
+fn print_row(gyro: &str, mode: &str, name: &str, figure: &Figure, unit: f64) {
+    let (measured, predicted) = (figure.measured * unit, figure.predicted * unit);
+    let difference = measured - predicted;
+    let relative = if predicted != 0.0 {
+        format!("{:+.3} %", 100.0 * difference / predicted.abs())
+    } else {
+        "-".to_string()
+    };
+    println!(
+        "{gyro:<5} {mode:<8} {name:<19} {measured:>16.6} {predicted:>16.6} {difference:>+12.3e} {relative:>10}"
+    );
+}
