@@ -71,8 +71,8 @@
 use std::f64::consts::PI;
 
 use super::{
-    field_error, intermediate, mode_parameters, quantize_coefficients, Coefficient, PlanError,
-    Point, RtlParameter,
+    field_error, intermediate, mode_parameters, quantize_coefficients, require_signed, Coefficient,
+    PlanError, Point, RtlParameter,
 };
 use crate::fx::{CoefficientFormat, Format, Overflow, Quantizer, Rounding};
 
@@ -203,15 +203,14 @@ impl Plan {
     /// bits; [`PlanError::CoefficientOverflow`] for taps that do not fit a fixed tap format.
     pub fn new(spec: &Spec) -> Result<Plan, PlanError> {
         const B: &str = "cic";
-        for (field, format) in [
-            ("input_format", spec.input),
-            ("cic_output_format", spec.cic_output),
-            ("output_format", spec.output),
-        ] {
-            if !format.signed {
-                return Err(field_error(B, field, format, "a signed format"));
-            }
-        }
+        require_signed(
+            B,
+            &[
+                ("input_format", spec.input),
+                ("cic_output_format", spec.cic_output),
+                ("output_format", spec.output),
+            ],
+        )?;
         if !(1..=MAX_STAGES).contains(&spec.stages) {
             return Err(field_error(
                 B,

@@ -56,7 +56,9 @@
 //! Latency: 1 clock.
 
 use super::nco::Reference;
-use super::{field_error, intermediate, mode_parameters, PlanError, Point, RtlParameter};
+use super::{
+    field_error, intermediate, mode_parameters, require_signed, PlanError, Point, RtlParameter,
+};
 use crate::fx::{mode, Format, Overflow, Quantizer, Rounding};
 
 /// Largest low-pass shift `k`: −3 dB at `fs · 2^−24 / 2π`, 2 mHz at 200 kHz.
@@ -129,17 +131,16 @@ impl Plan {
     /// [`PlanError::Intermediate`] beyond 128 bits.
     pub fn new(spec: &Spec) -> Result<Plan, PlanError> {
         const B: &str = "demodulator";
-        for (field, format) in [
-            ("input_format", spec.input),
-            ("reference_format", spec.reference),
-            ("product_format", spec.product),
-            ("state_format", spec.state),
-            ("output_format", spec.output),
-        ] {
-            if !format.signed {
-                return Err(field_error(B, field, format, "a signed format"));
-            }
-        }
+        require_signed(
+            B,
+            &[
+                ("input_format", spec.input),
+                ("reference_format", spec.reference),
+                ("product_format", spec.product),
+                ("state_format", spec.state),
+                ("output_format", spec.output),
+            ],
+        )?;
         if !(1..=MAX_LOWPASS_SHIFT).contains(&spec.lowpass_shift) {
             return Err(field_error(
                 B,

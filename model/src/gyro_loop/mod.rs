@@ -106,6 +106,19 @@ pub enum PlanError {
     },
 }
 
+/// Refuses the first unsigned format of `formats` (field name, format) of `block`: every
+/// signal of the loop is signed.
+pub(crate) fn require_signed(
+    block: &'static str,
+    formats: &[(&'static str, Format)],
+) -> Result<(), PlanError> {
+    match formats.iter().find(|(_, format)| !format.signed) {
+        Some((field, format)) => Err(field_error(block, field, format, "a signed format")),
+        None => Ok(()),
+    }
+}
+
+/// A [`PlanError::Field`].
 pub(crate) fn field_error(
     block: &'static str,
     field: &'static str,

@@ -53,8 +53,8 @@
 //! Latency: 1 clock. `kp`, `ki` and the limits are parameters (codes).
 
 use super::{
-    field_error, intermediate, mode_parameters, quantize_coefficients, Coefficient, PlanError,
-    Point, RtlParameter,
+    field_error, intermediate, mode_parameters, quantize_coefficients, require_signed, Coefficient,
+    PlanError, Point, RtlParameter,
 };
 use crate::fx::{from_f64, mode, CoefficientFormat, Format, Overflow, Quantizer, Rounding};
 
@@ -136,15 +136,14 @@ impl Plan {
     /// `kp·e + v`; [`PlanError::Intermediate`] beyond 128 bits.
     pub fn new(spec: &Spec) -> Result<Plan, PlanError> {
         const B: &str = "pi";
-        for (field, format) in [
-            ("input_format", spec.input),
-            ("integrator_format", spec.integrator),
-            ("output_format", spec.output),
-        ] {
-            if !format.signed {
-                return Err(field_error(B, field, format, "a signed format"));
-            }
-        }
+        require_signed(
+            B,
+            &[
+                ("input_format", spec.input),
+                ("integrator_format", spec.integrator),
+                ("output_format", spec.output),
+            ],
+        )?;
         let kp = quantize_coefficients(B, "kp", &[spec.kp], spec.kp_format)?[0];
         let ki = quantize_coefficients(B, "ki", &[spec.ki], spec.ki_format)?[0];
         let [low, high] = spec.integrator_limits;
