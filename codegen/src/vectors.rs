@@ -11,7 +11,10 @@
 use gyrofx_model::analysis::allan::{self, Kind};
 use gyrofx_model::chain::{FixedChain, FloatChain};
 use gyrofx_model::estimator::OverflowCounts as EstimatorOverflows;
+use gyrofx_model::fx::Format;
+use gyrofx_model::gyro_loop::closed::FixedClosedLoop;
 use gyrofx_model::kf::OverflowCounts;
+use gyrofx_model::resonator::Mode;
 use gyrofx_model::sequencer::Sequencer;
 use gyrofx_model::stimulus::adc;
 use serde::Serialize;
@@ -19,7 +22,8 @@ use serde::Serialize;
 use crate::block::Block;
 use crate::blocks::kf::TieCases;
 use crate::blocks::{ChainSample, RomImages, REGISTRY};
-use crate::error::Result;
+use crate::config::GyroLoop;
+use crate::error::{Error, Result};
 use crate::job::Job;
 pub use crate::stats::ErrorStats;
 
@@ -178,9 +182,26 @@ pub fn run(job: &Job, roms: &RomImages) -> Result<Run> {
     }
     let plant = &job.settings.plant;
     let seed = job.config.seed;
-    let record = plant.simulate(&rate, &modes, seed);
-    let (ya, sat_a) = adc(&record.y[0], est.input);
-    let (yb, sat_b) = adc(&record.y[1], est.input);
+    let ([ya, yb], [sat_a, sat_b]) = match &job.settings.resonator {
+        None => {
+            let record = plant.simulate(&rate, &modes, seed);
+            let (ya, sat_a) = adc(&record.y[0], est.input);
+            let (yb, sat_b) = adc(&record.y[1], est.input);
+            ([ya, yb], [sat_a, sat_b])
+        }
+        Some(loops) => {
+            let [a, b] = resonator_record(loops, &rate, &modes, seed, est.input)?;
+            ([a.codes, b.codes], [a.saturations, b.saturations])
+        }
+    };
+    // The same gyros without reversal, °/s, for the report.
+    let raw_record = || -> Result<[Vec<f64>; 2]> {
+        Ok(match &job.settings.resonator {
+            None => plant.simulate(&rate, &vec![[1i8, 1i8]; n], seed).y,
+            Some(loops) => resonator_record(loops, &rate, &vec![[1i8, 1i8]; n], seed, est.input)?
+                .map(|gyro| gyro.dps),
+        })
+    };
 
     let mut builders: Vec<_> = REGISTRY
         .iter()
@@ -190,7 +211,7 @@ pub fn run(job: &Job, roms: &RomImages) -> Result<Run> {
     // Report: the same gyros run without reversal (same noise streams), simulated on the other
     // core while the chain runs.
     std::thread::scope(|scope| -> Result<Run> {
-        let raw_record = scope.spawn(|| plant.simulate(&rate, &vec![[1i8, 1i8]; n], seed));
+        let raw_record = scope.spawn(raw_record);
         let mut fixed = FixedChain::new(plan);
         let mut float = FloatChain::quantized(plan);
         let mut ideal = FloatChain::ideal(plan);
@@ -252,7 +273,7 @@ pub fn run(job: &Job, roms: &RomImages) -> Result<Run> {
 
         let raw = raw_record
             .join()
-            .expect("the plant simulation does not panic");
+            .expect("the plant simulation does not panic")?;
         let fs = job.config.stimulus.fs_hz;
         // Only calibrated samples: from the first estimate to the reset.
         let start = first_estimate.unwrap_or(n).min(n);
@@ -261,8 +282,8 @@ pub fn run(job: &Job, roms: &RomImages) -> Result<Run> {
             fs,
             &rate[start..end],
             [
-                &raw.y[0][start..end],
-                &raw.y[1][start..end],
+                &raw[0][start..end],
+                &raw[1][start..end],
                 &combined_series[start..end],
                 &filtered_series[start..end],
             ],
@@ -285,6 +306,69 @@ pub fn run(job: &Job, roms: &RomImages) -> Result<Run> {
             report,
             samples: n,
         })
+    })
+}
+
+/// One resonator-level gyro's output at the chain rate.
+struct GyroRecord {
+    /// Codes in the chain's input format.
+    codes: Vec<i64>,
+    /// The same, °/s.
+    dps: Vec<f64>,
+    /// Pick-off ADC saturations.
+    saturations: u64,
+}
+
+/// Start-up before the record: the loops lock from rest (about 80 ms for paper 004's gyro).
+const RESONATOR_STARTUP_S: f64 = 0.5;
+
+/// Both resonator-level gyros closed by their fixed-point loops, each in the modes `modes`
+/// asks for (`+1` normal, `−1` reverse), at the true rate `rate` (°/s) per chain sample, after
+/// [`RESONATOR_STARTUP_S`] at the first sample's rate in normal mode. Gyro `g` takes the seed
+/// `2·seed + g`. The loops' outputs are already codes of `input` (checked by the config).
+fn resonator_record(
+    loops: &[GyroLoop; 2],
+    rate: &[f64],
+    modes: &[[i8; 2]],
+    seed: u64,
+    input: Format,
+) -> Result<[GyroRecord; 2]> {
+    let run = |g: usize| -> Result<GyroRecord> {
+        let gyro = &loops[g];
+        let mut closed = FixedClosedLoop::new(
+            &gyro.plan,
+            &gyro.params,
+            &gyro.front_end,
+            seed.wrapping_mul(2).wrapping_add(g as u64),
+        )
+        .map_err(|e| Error::config(format!("resonator_{}", gyro.name), e, "see gyrofx init"))?;
+        let startup = (RESONATOR_STARTUP_S * gyro.plan.chain_rate_hz()).ceil() as usize;
+        for _ in 0..startup {
+            closed.step_chain(rate.first().copied().unwrap_or(0.0), Mode::Normal);
+        }
+        let scale = libm::ldexp(1.0, input.frac);
+        let mut record = GyroRecord {
+            codes: Vec::with_capacity(rate.len()),
+            dps: Vec::with_capacity(rate.len()),
+            saturations: 0,
+        };
+        for (omega, mode) in rate.iter().zip(modes) {
+            let mode = if mode[g] > 0 {
+                Mode::Normal
+            } else {
+                Mode::Reverse
+            };
+            let output = closed.step_chain(*omega, mode).output.rate_dps;
+            record.codes.push((output * scale).round() as i64);
+            record.dps.push(output);
+        }
+        record.saturations = closed.resonator.adc_saturations();
+        Ok(record)
+    };
+    std::thread::scope(|scope| {
+        let b = scope.spawn(|| run(1));
+        let a = run(0)?;
+        Ok([a, b.join().expect("the loop simulation does not panic")?])
     })
 }
 

@@ -11,6 +11,9 @@ use crate::error::{Error, Result};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PlantConfig {
+    /// What produces each gyro's samples: `rate` (the rate-level model of `[gyro_a]`,
+    /// `[gyro_b]`) or `resonator` (`[resonator_a]`, `[resonator_b]` closed by `[loop]`).
+    pub model: String,
     /// Shortest bias-instability correlation time, s.
     pub bi_tau_min_s: f64,
     /// Longest, s.

@@ -84,6 +84,8 @@ pub struct Settings {
     pub source: Source,
     /// The plant.
     pub plant: Plant,
+    /// Whether the resonator-level gyros feed the chain instead of the rate-level plant.
+    pub resonator: Option<[GyroLoop; 2]>,
     /// The estimator (with the sequencer's schedule).
     pub estimator: EstimatorSpec,
     /// The KF.
@@ -306,15 +308,30 @@ impl Config {
         let source = self.stimulus.validate()?;
         let fs_hz = self.stimulus.fs_hz;
         let plant = self.plant.validate(fs_hz, &self.gyro_a, &self.gyro_b)?;
+        let resonator = match self.plant.model.as_str() {
+            "rate" => None,
+            "resonator" => Some(self.gyro_loops()?),
+            other => {
+                return Err(Error::config(
+                    "plant.model",
+                    format!("{other:?}"),
+                    "\"rate\" or \"resonator\"",
+                ))
+            }
+        };
         let schedule = self.sequencer.validate()?;
         let kf = self.kf.validate(fs_hz, rounding, overflow)?;
         let estimator = self
             .estimator
             .validate(schedule, kf.input, rounding, overflow)?;
         let mean_filter = self.mean_filter.validate(kf.input, rounding, overflow)?;
+        if let Some(loops) = &resonator {
+            resonator::check_chain(loops, fs_hz, kf.input, &estimator.schedule)?;
+        }
         Ok(Settings {
             source,
             plant,
+            resonator,
             estimator,
             kf,
             mean_filter,

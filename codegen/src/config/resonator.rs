@@ -5,14 +5,18 @@
 //! `[front_end]`'s sample rate is `[loop]`'s `adc_rate_hz`, and `[loop]`'s rounding and
 //! overflow are the config's `rounding` and `overflow`, so neither can disagree.
 
+use gyrofx_model::fx::Format;
+use gyrofx_model::gyro_loop::closed::FixedHarness;
+use gyrofx_model::gyro_loop::figures::{characterize, Procedure};
 use gyrofx_model::gyro_loop::gyro::{LoopSettings, Plan, Spec};
 use gyrofx_model::resonator::{PhysicsSettings, ResonatorParams};
+use gyrofx_model::sequencer::Schedule;
 
 use super::Config;
 use crate::error::{Error, Result};
 
 /// One gyro's resolved loop: its plan, its structure and its front end.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct GyroLoop {
     /// `a` or `b`.
     pub name: &'static str,
@@ -71,6 +75,73 @@ impl Config {
             resolve("b", &self.resonator_b)?,
         ])
     }
+}
+
+/// Checks that the loops can feed the chain: their output rate is `fs_hz` (Hz) and their
+/// output format the chain's `input`, and the sequencer's blanking covers each loop's measured
+/// settling after a switch (rate within 0.01 °/s, noise off), in both modes.
+///
+/// # Errors
+/// [`Error::Config`] naming the field that disagrees.
+pub(super) fn check_chain(
+    loops: &[GyroLoop; 2],
+    fs_hz: f64,
+    input: Format,
+    schedule: &Schedule,
+) -> Result<()> {
+    for gyro in loops {
+        let rate = gyro.plan.chain_rate_hz();
+        if (rate - fs_hz).abs() > 1e-9 * fs_hz {
+            return Err(Error::config(
+                "stimulus.fs_hz",
+                fs_hz,
+                format!(
+                    "the resonator loop's output rate loop.adc_rate_hz / loop.decimation = {rate} Hz"
+                ),
+            ));
+        }
+        let output: Format = gyro.plan.settings.output_format.parse().map_err(|_| {
+            Error::config(
+                "loop.output_format",
+                &gyro.plan.settings.output_format,
+                "a format such as s24.14",
+            )
+        })?;
+        if output != input {
+            return Err(Error::config(
+                "loop.output_format",
+                output,
+                format!("the chain's input format kf.input_format = {input}"),
+            ));
+        }
+    }
+    let blank_ms = schedule.blank as f64 * 1e3 / fs_hz;
+    for gyro in loops {
+        let figures = characterize::<FixedHarness>(
+            &gyro.plan,
+            &gyro.params,
+            &gyro.front_end,
+            &Procedure::default(),
+        )
+        .map_err(|e| prefixed(&format!("resonator_{}", gyro.name), e.to_string()))?;
+        let settling = figures
+            .normal
+            .rate_settling_ms
+            .measured
+            .max(figures.reverse.rate_settling_ms.measured);
+        if blank_ms < settling {
+            return Err(Error::config(
+                "sequencer.blank",
+                schedule.blank,
+                format!(
+                    "at least {} samples: the blanking ({blank_ms} ms at {fs_hz} Hz) must cover gyro {}'s settling after a switch, {settling} ms",
+                    (settling * fs_hz / 1e3).ceil(),
+                    gyro.name
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The model's "`field = value is not allowed: …`" under the section's name.
