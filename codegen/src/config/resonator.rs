@@ -149,7 +149,14 @@ fn prefixed(section: &str, message: String) -> Error {
     match message.split_once(" = ") {
         Some((field, rest)) => match rest.split_once(" is not allowed: ") {
             Some((value, allowed)) => {
-                Error::config(format!("{section}.{field}"), value, allowed.to_string())
+                // The loop's plan names its own keys already (`loop.nco_phase_bits`); the
+                // resonator's sample rate is `[loop]`'s `adc_rate_hz`.
+                let field = match field {
+                    "sample_rate_hz" => "loop.adc_rate_hz".to_string(),
+                    f if f.starts_with(&format!("{section}.")) => f.to_string(),
+                    f => format!("{section}.{f}"),
+                };
+                Error::config(field, value, allowed.to_string())
             }
             None => Error::config(section, message, "see the annotated default (gyrofx init)"),
         },
@@ -175,14 +182,29 @@ mod tests {
                 "resonator_b.q_drive = -3",
             ),
             ("[resonator_a]\nmass_kg = 0.0\n", "resonator_a.mass_kg = 0"),
-            ("[loop]\nnco_phase_bits = 70\n", "phase_bits = 70"),
-            ("[loop]\ndemod_output_format = \"x12\"\n", "loop"),
+            ("[loop]\nnco_phase_bits = 70\n", "loop.nco_phase_bits = 70"),
+            ("[loop]\ndemod_output_format = \"x12\"\n", "loop.demod_output_format"),
+            ("[loop]\nadc_format = \"s20.19\"\n", "loop.adc_format = s20.19"),
+            ("[loop]\nadc_rate_hz = -1.0\n", "loop.adc_rate_hz = -1"),
+            ("[loop]\ndemod_state_format = \"s10.2\"\n", "loop.demod_state_format"),
+            ("[loop]\ndecimation = 0\n", "loop.decimation = 0"),
+            ("[loop]\ncic_tap_width = 1\n", "loop.cic_tap_width = 1"),
+            ("[loop]\npll_gain_width = 1\n", "loop.pll_gain_width = 1"),
+            (
+                "[loop]\npll_integrator_format = \"s8.2\"\n",
+                "loop.pll_integrator_format = s8.2",
+            ),
+            (
+                "[loop]\nagc_output_format = \"s4.0\"\n",
+                "loop.agc_output_format = s4.0 is not allowed: a format whose largest value is at least",
+            ),
         ] {
             let err = Config::from_toml(text, "test.toml")
                 .and_then(|c| c.gyro_loops().map(|_| ()))
                 .unwrap_err()
                 .to_string();
             assert!(err.contains(field), "{text}: {err}");
+            assert!(!err.contains("loop.loop"), "{text}: {err}");
         }
         // Rounding and overflow are the config's: [loop] has no keys of its own for them.
         assert!(Config::from_toml("[loop]\nrounding = \"floor\"\n", "test.toml").is_err());

@@ -118,5 +118,15 @@ pub enum Mode {
     Reverse,
 }
 
+impl Mode {
+    /// `normal` or `reverse`, as reports and the config name it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Normal => "normal",
+            Mode::Reverse => "reverse",
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests;

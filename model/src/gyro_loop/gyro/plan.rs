@@ -78,6 +78,110 @@ pub struct Plan {
     pub adc_full_scale_v: f64,
 }
 
+/// Largest share of the AGC output's or the DAC's full scale the nominal drive may take.
+const AMPLITUDE_HEADROOM: f64 = 0.8;
+
+/// The `[loop]` key behind each field a block's plan names, per block: a refused sub-plan is
+/// reported as the config key the user wrote (`loop.nco_phase_bits`, not the block's own
+/// `nco.phase_bits`).
+type Keys = &'static [(&'static str, &'static str)];
+const NCO_KEYS: Keys = &[
+    ("phase_bits", "nco_phase_bits"),
+    ("address_bits", "nco_address_bits"),
+    ("sine_width", "nco_sine_width"),
+];
+const DEMODULATOR_KEYS: Keys = &[
+    ("input_format", "adc_format"),
+    ("reference_format", "nco_sine_width"),
+    ("product_format", "demod_product_format"),
+    ("state_format", "demod_state_format"),
+    ("output_format", "demod_output_format"),
+    ("lowpass_shift", "demod_lowpass_shift"),
+];
+const CIC_KEYS: Keys = &[
+    ("input_format", "demod_output_format"),
+    ("stages", "cic_stages"),
+    ("decimation", "decimation"),
+    ("taps", "cic_taps"),
+    ("coefficient taps", "cic_tap_width"),
+    ("passband", "cic_passband"),
+    ("cic_output_format", "cic_internal_format"),
+    ("output_format", "cic_output_format"),
+];
+const PLL_KEYS: Keys = &[
+    ("input_format", "demod_output_format"),
+    ("coefficient kp", "pll_gain_width"),
+    ("coefficient ki", "pll_gain_width"),
+    ("integrator_format", "pll_integrator_format"),
+    ("integrator_limits", "pll_pull_range_hz"),
+    ("preset", "pll_integrator_format"),
+    ("output_format", "nco_phase_bits"),
+];
+const AGC_KEYS: Keys = &[
+    ("input_format", "demod_output_format"),
+    ("coefficient kp", "agc_gain_width"),
+    ("coefficient ki", "agc_gain_width"),
+    ("integrator_format", "agc_integrator_format"),
+    ("integrator_limits", "dac_format"),
+    ("output_format", "agc_output_format"),
+];
+
+/// Renames a block's refusal to the `[loop]` key of `keys` (a coefficient's entry is
+/// `"coefficient NAME"`): a field error keeps its value and what is allowed; a coefficient that
+/// does not fit or rounds to zero names the width key that sizes it.
+fn config_key(keys: Keys) -> impl Fn(PlanError) -> PlanError {
+    move |error| {
+        let key = |name: &str| keys.iter().find(|(field, _)| *field == name).map(|k| k.1);
+        match &error {
+            PlanError::Field {
+                field,
+                value,
+                allowed,
+                ..
+            } => match key(field) {
+                Some(key) => field_error("loop", key, value, allowed.clone()),
+                None => error,
+            },
+            PlanError::CoefficientOverflow {
+                name,
+                value,
+                format,
+                bits_needed,
+                ..
+            } => match key(&format!("coefficient {name}")) {
+                Some(key) => field_error(
+                    "loop",
+                    key,
+                    format.width,
+                    format!(
+                        "a width that holds the designed {} {name} = {value:e}: it needs {bits_needed} bits in {format}",
+                        key.split('_').next().unwrap_or("loop")
+                    ),
+                ),
+                None => error,
+            },
+            PlanError::CoefficientZero {
+                name,
+                value,
+                format,
+                ..
+            } => match key(&format!("coefficient {name}")) {
+                Some(key) => field_error(
+                    "loop",
+                    key,
+                    format.width,
+                    format!(
+                        "a width at which the designed {} {name} = {value:e} does not round to zero (it does in {format})",
+                        key.split('_').next().unwrap_or("loop")
+                    ),
+                ),
+                None => error,
+            },
+            PlanError::Intermediate { .. } => error,
+        }
+    }
+}
+
 fn positive(field: &'static str, value: f64) -> Result<f64, PlanError> {
     if value.is_finite() && value > 0.0 {
         Ok(value)
@@ -151,7 +255,8 @@ impl Plan {
             phase_bits: s.nco_phase_bits,
             address_bits: s.nco_address_bits,
             sine_width: s.nco_sine_width,
-        })?;
+        })
+        .map_err(config_key(NCO_KEYS))?;
         let demod_output = format("demod_output_format", &s.demod_output_format)?;
         let demodulator = demodulator::Plan::new(&demodulator::Spec {
             input: adc,
@@ -162,7 +267,8 @@ impl Plan {
             lowpass_shift: s.demod_lowpass_shift,
             rounding,
             overflow,
-        })?;
+        })
+        .map_err(config_key(DEMODULATOR_KEYS))?;
         let cic = cic::Plan::new(&cic::Spec {
             input: demod_output,
             stages: s.cic_stages,
@@ -178,7 +284,8 @@ impl Plan {
             output: format("cic_output_format", &s.cic_output_format)?,
             rounding,
             overflow,
-        })?;
+        })
+        .map_err(config_key(CIC_KEYS))?;
         let cic_gain = cic.flatness().dc_gain;
 
         // Per-mode physics.
@@ -233,7 +340,19 @@ impl Plan {
             output: Format::signed(p, p as i32).expect("the NCO checked P"),
             rounding,
             overflow,
-        })?;
+        })
+        .map_err(config_key(PLL_KEYS))?;
+        if pll.integrator.frac < p as i32 {
+            return Err(field_error(
+                "loop",
+                "pll_integrator_format",
+                pll.integrator,
+                format!(
+                    "at least nco_phase_bits = {p} fraction bits (the integrator must resolve the \
+                     NCO's frequency step, 2^-{p} cycles per sample)"
+                ),
+            ));
+        }
 
         // AGC.
         let dac = format("dac_format", &s.dac_format)?;
@@ -255,7 +374,8 @@ impl Plan {
             output: format("agc_output_format", &s.agc_output_format)?,
             rounding,
             overflow,
-        })?;
+        })
+        .map_err(config_key(AGC_KEYS))?;
         let error_exact = Format::sum(demod_output, demod_output, true)
             .map_err(crate::gyro_loop::intermediate("loop", "a_set - I"))?;
         let agc_error = Point::new(
@@ -346,6 +466,27 @@ impl Plan {
         for (i, f) in figures.iter().enumerate() {
             let (f_nom, _, setpoint, plant_gain, sense, _) = physics[i];
             let nominal_amplitude = setpoint / plant_gain;
+            // The AGC must reach the amplitude that holds q0 with room for its transients.
+            let (limit_key, limit) = if agc.output.to.max_value() < dac.max_value() {
+                ("agc_output_format", agc.output.to)
+            } else {
+                ("dac_format", dac)
+            };
+            if nominal_amplitude > AMPLITUDE_HEADROOM * limit.max_value() {
+                return Err(field_error(
+                    "loop",
+                    limit_key,
+                    limit,
+                    format!(
+                        "a format whose largest value is at least {:.0} LSB: the {} mode's \
+                         nominal drive u_nom = {nominal_amplitude:.1} DAC LSB (drive q0 = {:e} m \
+                         through front_end.dac_newton_per_lsb) over {AMPLITUDE_HEADROOM}",
+                        libm::ceil(nominal_amplitude / AMPLITUDE_HEADROOM),
+                        f.mode.name(),
+                        params.drive_amplitude_m
+                    ),
+                ));
+            }
             let dac_offset = dac_offset(
                 (f64::from(latency) + 0.5) * f_nom / fs,
                 f_nom / fs,
