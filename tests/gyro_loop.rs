@@ -72,7 +72,7 @@ fn the_config_sets_each_gyros_structure_and_bad_values_are_refused() {
     assert!(err.contains("--seconds 0 is not allowed"), "{err}");
 }
 
-/// `[plant] model = "resonator"`: the two resonator-level gyros feed the chain. Mode reversal
+/// `[plant] model = "resonator"` (the embedded default): the two resonator-level gyros feed the chain. Mode reversal
 /// removes their physical bias (about 20 °/s each, from the structure's damping coupling and
 /// quadrature leak) down to the residual the closed forms leave, and the chain's RTL is still
 /// bit-exact on their samples. A blanking shorter than the loops' settling, or a chain rate
@@ -80,25 +80,22 @@ fn the_config_sets_each_gyros_structure_and_bad_values_are_refused() {
 #[test]
 fn the_resonator_plant_feeds_the_chain_and_reversal_removes_its_bias() {
     let dir = tempfile::tempdir().unwrap();
-    let short = write_config(dir.path(), "short.toml", "[plant]\nmodel = \"resonator\"\n");
+    let short = write_config(dir.path(), "short.toml", "[sequencer]\nblank = 10\n");
     let err = fails(&["generate", "--config", &short, "--out", "unused"]);
     assert!(
         err.contains("sequencer.blank = 10") && err.contains("at least 25 samples"),
         "{err}"
     );
-    let rate = write_config(
-        dir.path(),
-        "rate.toml",
-        "[plant]\nmodel = \"resonator\"\n[stimulus]\nfs_hz = 100.0\n",
-    );
+    let rate = write_config(dir.path(), "rate.toml", "[stimulus]\nfs_hz = 100.0\n");
     let err = fails(&["generate", "--config", &rate, "--out", "unused"]);
     assert!(err.contains("stimulus.fs_hz = 100"), "{err}");
     assert!(!dir.path().join("unused").exists());
 
+    // The embedded default is this plant.
     let config = write_config(
         dir.path(),
         "resonator.toml",
-        "[plant]\nmodel = \"resonator\"\n[sequencer]\nblank = 30\n",
+        "[plant]\nmodel = \"resonator\"\n",
     );
     let out = dir.path().join("package");
     let out_text = out.to_str().unwrap();

@@ -87,6 +87,9 @@ seed = {seed}
 rounding = \"{rounding}\"
 overflow = \"{overflow}\"
 
+[plant]
+model = \"rate\"
+
 [stimulus]
 fs_hz = {fs:?}
 scenario = \"{scenario}\"
