@@ -39,6 +39,12 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    // Ctrl-C or SIGTERM while a package is being written: remove its staging folder, then end
+    // as a shell expects of an interrupted program (128 + SIGINT).
+    let _ = ctrlc::set_handler(|| {
+        gyrofx_codegen::output_folder::remove_registered();
+        std::process::exit(130);
+    });
     let cli = Cli::parse();
     let outcome = match cli.command {
         Command::Allan(args) => allan::run(args),

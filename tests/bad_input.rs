@@ -246,7 +246,8 @@ fn an_unwritable_output_folder() {
         std::fs::read_to_string(user.join("notes.txt")).unwrap(),
         "keep me"
     );
-    // A previous gyrofx output is replaced whole.
+    // A previous gyrofx output is replaced whole; one holding a file gyrofx did not write only
+    // with --force (tests/output_folder.rs covers the rest).
     let previous = dir.path().join("previous");
     ok(&[
         "generate",
@@ -255,13 +256,29 @@ fn an_unwritable_output_folder() {
         "--samples",
         "100",
     ]);
+    ok(&[
+        "generate",
+        "--out",
+        previous.to_str().unwrap(),
+        "--samples",
+        "110",
+    ]);
     std::fs::write(previous.join("stale.txt"), "old").unwrap();
+    let log = fails(&[
+        "generate",
+        "--out",
+        previous.to_str().unwrap(),
+        "--samples",
+        "120",
+    ]);
+    assert!(log.contains("stale.txt"), "{log}");
     ok(&[
         "generate",
         "--out",
         previous.to_str().unwrap(),
         "--samples",
         "120",
+        "--force",
     ]);
     assert!(!previous.join("stale.txt").exists());
     let names: Vec<_> = std::fs::read_dir(dir.path())

@@ -10,6 +10,7 @@ use crate::blocks::{RomImages, REGISTRY};
 use crate::error::Result;
 use crate::hdl;
 use crate::job::Job;
+use crate::output_folder::{self, Kind, Replace};
 use crate::package::{sha256_hex, Package, MANIFEST};
 use crate::rom::{self, RomFormat, ROM_FOLDER};
 use crate::testbench::{verilog, vhdl};
@@ -144,7 +145,7 @@ pub fn build_package(
     let roms = RomImages::new(job, provenance);
     let run = vectors::run(job, &roms)?;
     progress("files");
-    let mut package = Package::new();
+    let mut package = Package::new(Kind::Generate, writers::build_outputs(&run.blocks));
     package.add("README.md", writers::package_readme(&run, provenance));
     package.add("Makefile", writers::makefile(&run.blocks, provenance));
     package.add("report.md", writers::report_md(&run, provenance));
@@ -208,7 +209,8 @@ pub fn build_package(
     Ok((package, Summary { run, files }))
 }
 
-/// Builds the package for `job` and writes it to `out` atomically.
+/// Builds the package for `job` and writes it to `out` atomically, if `out` may be replaced
+/// ([`output_folder::check`], checked before the work starts).
 ///
 /// # Errors
 /// Stimulus errors, and [`crate::Error::Output`] / [`crate::Error::Io`] when `out` cannot be
@@ -216,11 +218,13 @@ pub fn build_package(
 pub fn generate(
     job: &Job,
     out: &Path,
+    replace: Replace,
     provenance: &Provenance,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Summary> {
+    output_folder::check(out, Kind::Generate, replace)?;
     let (package, summary) = build_package(job, provenance, progress)?;
     progress("writing");
-    package.write_atomically(out)?;
+    package.write_atomically(out, replace)?;
     Ok(summary)
 }

@@ -17,6 +17,7 @@ pub mod hdl;
 pub mod input;
 pub mod job;
 pub mod junit;
+pub mod output_folder;
 pub mod package;
 pub mod plot;
 pub mod report;

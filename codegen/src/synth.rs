@@ -16,6 +16,7 @@ use crate::blocks::{self, RomImages};
 use crate::error::{Error, Result};
 use crate::hdl;
 use crate::job::Job;
+use crate::output_folder::{self, Kind, Replace};
 use crate::package::Package;
 use crate::writers::Provenance;
 
@@ -218,11 +219,18 @@ fn report(top: &Block, resources: &Resources, provenance: &Provenance) -> String
 }
 
 /// Synthesizes the chain for `job` and writes the scripts, logs, stat files, report and
-/// manifest to `out` atomically; nothing is written when a check fails.
+/// manifest to `out` atomically, if `out` may be replaced ([`output_folder::check`], checked
+/// first); nothing is written when a check fails.
 ///
 /// # Errors
 /// A failed check or a missing yosys ([`Error::Synthesis`]), or an I/O error.
-pub fn synthesize(job: &Job, out: &Path, provenance: &Provenance) -> Result<Resources> {
+pub fn synthesize(
+    job: &Job,
+    out: &Path,
+    replace: Replace,
+    provenance: &Provenance,
+) -> Result<Resources> {
+    output_folder::check(out, Kind::Synth, replace)?;
     let roms = RomImages::new(job, provenance);
     let top = blocks::find(TOP_BLOCK).block(job, &roms);
 
@@ -241,7 +249,7 @@ pub fn synthesize(job: &Job, out: &Path, provenance: &Provenance) -> Result<Reso
     }
     let resources = measure(work.path())?;
 
-    let mut package = Package::new();
+    let mut package = Package::new(Kind::Synth, Vec::new());
     package.add("report.md", report(&top, &resources, provenance));
     for (name, text) in &inputs {
         package.add(name.as_str(), text.as_str());
@@ -270,6 +278,6 @@ pub fn synthesize(job: &Job, out: &Path, provenance: &Provenance) -> Result<Reso
     let mut text = serde_json::to_string_pretty(&manifest).expect("manifest serializes");
     text.push('\n');
     package.add(crate::package::MANIFEST, text);
-    package.write_atomically(out)?;
+    package.write_atomically(out, replace)?;
     Ok(resources)
 }

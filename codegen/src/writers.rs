@@ -271,7 +271,7 @@ verilator-{name}:
 
 ghdl-{name}:
 \t@echo \"== {name}\"
-\tcd {name} && mkdir -p ghdl_work && $(GHDL) -a --std=08 -Werror --workdir=ghdl_work $(VHDL) {tb}.vhd
+\tcd {name} && rm -rf ghdl_work && mkdir ghdl_work && $(GHDL) -a --std=08 -Werror --workdir=ghdl_work $(VHDL) {tb}.vhd
 \tcd {name} && $(GHDL) --elab-run --std=08 --workdir=ghdl_work {tb} $(TB_GENERICS) $(if $(filter 1,$(WAVES)),--vcd={tb}.vcd) $(GHDL_RUN_FLAGS)
 ",
             name = b.name,
@@ -279,19 +279,29 @@ ghdl-{name}:
     }
     let _ = write!(
         out,
-        "
-clean:
-\trm -rf {}
-",
-        names
-            .iter()
-            .map(|n| format!(
-                "{n}/*.vvp {n}/obj_verilator {n}/verilator_build.log {n}/ghdl_work {n}/*.vcd"
-            ))
-            .collect::<Vec<_>>()
-            .join(" ")
+        "\nclean:\n\trm -rf {}\n",
+        build_outputs(blocks).join(" ")
     );
     out
+}
+
+/// What the package's Makefile writes into it (the simulators' work files, `make clean`
+/// removes them), as the marker lists them ([`crate::output_folder::Marker`]): a
+/// regenerated package may replace a folder holding these.
+pub fn build_outputs(blocks: &[Block]) -> Vec<String> {
+    blocks
+        .iter()
+        .flat_map(|b| {
+            let n = b.name;
+            [
+                format!("{n}/*.vvp"),
+                format!("{n}/obj_verilator/"),
+                format!("{n}/verilator_build.log"),
+                format!("{n}/ghdl_work/"),
+                format!("{n}/*.vcd"),
+            ]
+        })
+        .collect()
 }
 
 /// The package's README.

@@ -29,12 +29,12 @@ pub struct Args {
 /// errors, the overflow counts and the noise report.
 pub fn run(args: Args) -> Result<ExitCode> {
     let Args {
-        out: OutputFolder { out },
+        out: folder,
         source,
         samples,
         seed,
     } = args;
-    let out = out.as_path();
+    let out = folder.out.as_path();
     let mut config = source.load()?;
     if let Some(n) = samples {
         config.samples = n;
@@ -46,7 +46,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
     let bar = indicatif::ProgressBar::new_spinner();
     let long = job.config.samples >= 1_000_000;
     let provenance = source.provenance(&job, Output::Package);
-    let summary = generate(&job, out, &provenance, &mut |phase| {
+    let summary = generate(&job, out, folder.replace(), &provenance, &mut |phase| {
         if long {
             bar.set_message(format!("generate: {phase}"));
             bar.tick();

@@ -12,6 +12,7 @@ use gyrofx_codegen::config::Config;
 use gyrofx_codegen::generate::{provenance, Output};
 use gyrofx_codegen::input::{read_column, read_column_with_gaps};
 use gyrofx_codegen::job::Job;
+use gyrofx_codegen::output_folder::Replace;
 use gyrofx_codegen::writers::Provenance;
 
 // One column of a CSV record (ar, davar, filter). A command whose help words these flags
@@ -62,9 +63,29 @@ impl SampleRate {
 // The folder a command writes its output into atomically (generate, synth).
 #[derive(clap::Args)]
 pub struct OutputFolder {
-    /// Output folder (replaced only if empty or a previous gyrofx output).
+    /// Output folder (replaced only if empty, or a package of this command that holds only the
+    /// files gyrofx wrote, unchanged).
     #[arg(long)]
     pub out: PathBuf,
+    /// Replace --out even if it holds other files or another kind of package.
+    #[arg(long)]
+    pub force: bool,
+}
+
+impl OutputFolder {
+    /// How `--out` may be replaced.
+    pub fn replace(&self) -> Replace {
+        replace(self.force)
+    }
+}
+
+/// [`Replace::Force`] when `--force` was given.
+pub fn replace(force: bool) -> Replace {
+    if force {
+        Replace::Force
+    } else {
+        Replace::IfOwned
+    }
 }
 
 // Where the chain's config comes from (generate, synth): the embedded default, overlaid by a

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Result};
 
-use gyrofx_codegen::reproduce;
+use gyrofx_codegen::{output_folder, reproduce};
 
 /// Run a paper's pipeline on simulated data and print its tables beside gyrofx's, with
 /// the differences explained (markdown): 000, 002, 003, 004.
@@ -21,9 +21,13 @@ pub struct Args {
     /// Seed of the simulation.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Also write report.md, allan.png (and davar.png for 002) into this folder.
+    /// Also write report.md, allan.png (and davar.png for 002) into this folder (replaced
+    /// only if empty or a previous reproduction holding only its own files, unchanged).
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Replace --out even if it holds other files or another kind of package.
+    #[arg(long, requires = "out")]
+    force: bool,
 }
 
 /// Prints the report; with `--out`, also writes it and its plots.
@@ -33,8 +37,14 @@ pub fn run(args: Args) -> Result<ExitCode> {
         samples,
         seed,
         out,
+        force,
     } = args;
     let paper = paper.as_str();
+    let replace = super::options::replace(force);
+    if let Some(folder) = &out {
+        // Before the simulation: a folder that cannot be written fails now, not minutes later.
+        output_folder::check(folder, output_folder::Kind::Reproduce, replace)?;
+    }
     let (report, curves, davar) = match paper {
         "000" => {
             let p = reproduce::paper_000(samples.unwrap_or(reproduce::SAMPLES_000), seed)?;
@@ -57,7 +67,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
     print!("{report}");
     if let Some(folder) = &out {
         let davar = davar.as_ref().map(|(d, c)| (d, c));
-        let files = reproduce::write(folder, paper, seed, &report, &curves, davar)?;
+        let files = reproduce::write(folder, replace, paper, seed, &report, &curves, davar)?;
         eprintln!("wrote {} in {}", files.join(", "), folder.display());
     }
     Ok(ExitCode::SUCCESS)

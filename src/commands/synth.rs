@@ -25,14 +25,14 @@ pub struct Args {
 /// Synthesizes the chain and prints the resources of both targets.
 pub fn run(args: Args) -> Result<ExitCode> {
     let Args {
-        out: OutputFolder { out },
+        out: folder,
         source,
     } = args;
-    let out = out.as_path();
+    let out = folder.out.as_path();
     let config = source.load()?;
     let job = Job::new(config)?;
     let provenance = source.provenance(&job, Output::Synthesis);
-    let resources = synthesize(&job, out, &provenance)?;
+    let resources = synthesize(&job, out, folder.replace(), &provenance)?;
     let (g, x) = (&resources.generic, &resources.xilinx);
     println!(
         "synthesis check passed: {}; report in {}",

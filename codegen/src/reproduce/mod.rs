@@ -106,6 +106,7 @@ pub(crate) fn terms(rate: &[f64], rate_hz: f64) -> [f64; 5] {
 /// A plot error (no font), or the package's output errors.
 pub fn write(
     out: &std::path::Path,
+    replace: crate::output_folder::Replace,
     paper: &str,
     seed: u64,
     report: &str,
@@ -116,7 +117,9 @@ pub fn write(
     )>,
 ) -> Result<Vec<String>> {
     let scratch = tempfile::tempdir().map_err(|e| Error::io(std::env::temp_dir(), e))?;
-    let mut package = crate::package::Package::new();
+    crate::output_folder::check(out, crate::output_folder::Kind::Reproduce, replace)?;
+    let mut package =
+        crate::package::Package::new(crate::output_folder::Kind::Reproduce, Vec::new());
     package.add("report.md", report);
     let series: Vec<crate::plot::AllanSeries> = curves
         .iter()
@@ -147,12 +150,12 @@ pub fn write(
     let manifest = serde_json::json!({
         "generator": format!("gyrofx {}", env!("CARGO_PKG_VERSION")),
         "command": format!("gyrofx reproduce --paper {paper} --seed {seed}"),
-        "files": files,
+        "files": package.entries(),
     });
     package.add(
         "manifest.json",
         serde_json::to_string_pretty(&manifest).expect("manifest serializes") + "\n",
     );
-    package.write_atomically(out)?;
+    package.write_atomically(out, replace)?;
     Ok(files)
 }
