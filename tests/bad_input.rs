@@ -43,6 +43,36 @@ fn unknown_config_key() {
     refused("sampels = 10\n", &["unknown key sampels", "line 1"]);
 }
 
+/// A value of the wrong type names the user's file, its line and the key (not the line of the
+/// config merged over the default), in the chain's sections and in the loop's.
+#[test]
+fn a_value_of_the_wrong_type_names_the_users_line() {
+    for (toml, needles) in [
+        (
+            "seed = 2\nsamples = \"many\"\n",
+            &["bad.toml: line 2: samples: invalid type: string \"many\""][..],
+        ),
+        (
+            "# mine\n\n[kf]\ntolerance = \"x\"\n",
+            &["line 4: kf.tolerance: invalid type"],
+        ),
+        (
+            "[kf]\nbandwidths_hz = [1.0, \"x\"]\n",
+            &["line 2: kf.bandwidths_hz[1]"],
+        ),
+        (
+            "\n[loop]\ndecimation = -3\n",
+            &["line 3: loop.decimation: invalid value: integer `-3`"],
+        ),
+        (
+            "[front_end]\ndamping_split_drift = { std = \"a\", correlation_time_s = 1.0 }\n",
+            &["line 2: front_end.damping_split_drift.std: invalid type"],
+        ),
+    ] {
+        refused(toml, needles);
+    }
+}
+
 #[test]
 fn widths_out_of_range_and_bad_format_strings() {
     refused(
@@ -212,6 +242,43 @@ fn a_missing_or_nan_csv_cell_names_its_line() {
     }
 }
 
+/// A CSV stimulus shorter than the run is refused, naming both counts, rather than silently
+/// running a record too short to analyse; `--samples` within it runs.
+#[test]
+fn a_csv_stimulus_shorter_than_the_run_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let rows: String = (0..300).map(|k| format!("{k},1.5\n")).collect();
+    std::fs::write(dir.path().join("rate.csv"), format!("t,rate_dps\n{rows}")).unwrap();
+    let config = write_config(
+        dir.path(),
+        "csv.toml",
+        "[plant]\nmodel = \"rate\"\n[stimulus]\nsource = \"csv\"\ncsv_path = \"rate.csv\"\n",
+    );
+    let out = dir.path().join("out");
+    let log = fails(&[
+        "generate",
+        "--out",
+        out.to_str().unwrap(),
+        "--config",
+        &config,
+    ]);
+    assert!(
+        log.contains("rate.csv: column rate_dps has 300 values but samples = 10000")
+            && log.contains("samples <= 300"),
+        "{log}"
+    );
+    assert!(!out.exists());
+    ok(&[
+        "generate",
+        "--out",
+        out.to_str().unwrap(),
+        "--config",
+        &config,
+        "--samples",
+        "300",
+    ]);
+}
+
 #[test]
 fn an_unwritable_output_folder() {
     let dir = tempfile::tempdir().unwrap();
@@ -307,4 +374,54 @@ fn verify_refuses_a_folder_that_is_not_a_package_and_unknown_simulators() {
         "modelsim",
     ]);
     assert!(log.contains("\"modelsim\" is not supported"), "{log}");
+}
+
+/// Usage errors (a bad argument value) exit with 2, as clap's own do; failures of the work
+/// exit with 1; every error is one line, its cause not repeated.
+#[test]
+fn usage_errors_exit_2_failures_exit_1_and_each_error_is_said_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let out = out.to_str().unwrap();
+    let missing = dir.path().join("missing.toml");
+    for (args, code, needle) in [
+        (
+            vec![
+                "generate",
+                "--out",
+                out,
+                "--config",
+                missing.to_str().unwrap(),
+            ],
+            1,
+            "No such file or directory",
+        ),
+        (
+            vec!["generate", "--out", out, "--samples", "1.5"],
+            2,
+            "'1.5' is not a count",
+        ),
+        (vec!["reproduce", "--paper", "9"], 2, "--paper \"9\""),
+        (
+            vec!["allan", "--input", out, "--rate", "-1"],
+            2,
+            "--rate -1 is not allowed",
+        ),
+    ] {
+        let output = gyrofx(&args);
+        let log = text(&output);
+        assert_eq!(output.status.code(), Some(code), "{args:?}: {log}");
+        assert_eq!(log.matches(needle).count(), 1, "{args:?}: {log}");
+        assert!(log.starts_with("error: "), "{log}");
+    }
+    // A count may be written in exponent form.
+    ok(&[
+        "generate",
+        "--out",
+        out,
+        "--config",
+        &write_config(dir.path(), "rate.toml", "[plant]\nmodel = \"rate\"\n"),
+        "--samples",
+        "2e2",
+    ]);
 }

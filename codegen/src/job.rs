@@ -110,11 +110,12 @@ impl Job {
         &self.chain.kf
     }
 
-    /// The true rate Ω for `samples` samples, °/s: the scenario, or the CSV (cut to
-    /// `samples`; a shorter file sets the count).
+    /// The true rate Ω for `samples` samples, °/s: the scenario, or the CSV's first `samples`
+    /// values.
     ///
     /// # Errors
-    /// [`Error::Input`] / [`Error::Io`] for a bad CSV file.
+    /// [`Error::Input`] / [`Error::Io`] for a bad CSV file, or one with fewer than `samples`
+    /// values (silently running a shorter record would leave the report nothing to analyse).
     pub fn true_rate(&self, samples: usize) -> Result<Vec<f64>> {
         Ok(match &self.settings.source {
             Source::Synthetic(scenario) => {
@@ -125,6 +126,17 @@ impl Job {
             }
             Source::Csv { path, column } => {
                 let mut values = read_column(path, column)?;
+                if values.len() < samples {
+                    return Err(crate::error::Error::Input {
+                        path: path.clone(),
+                        message: format!(
+                            "column {column} has {} values but samples = {samples}: give \
+                             samples <= {} (in the config or with --samples), or a longer record",
+                            values.len(),
+                            values.len()
+                        ),
+                    });
+                }
                 values.truncate(samples);
                 values
             }

@@ -4,7 +4,9 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::{bail, Result};
+use anyhow::Result;
+
+use super::usage;
 
 use gyrofx_model::analysis::davar::{coefficients, davar, disturbances, Pid, Window};
 
@@ -64,18 +66,18 @@ pub fn run(args: Args) -> Result<ExitCode> {
     let rate = rate.hz()?;
     let (values, skipped) = csv.read_with_gaps()?;
     if window < 4 || window > values.len() {
-        bail!(
+        usage!(
             "--window {window} is not allowed: it must be 4..={} samples (the record's length)",
             values.len()
         );
     }
     let min = min_window.unwrap_or((window / 10).max(4));
     if adaptive && !(4..=window).contains(&min) {
-        bail!("--min-window {min} is not allowed: it must be 4..={window}");
+        usage!("--min-window {min} is not allowed: it must be 4..={window}");
     }
     let step = step.unwrap_or((window / 20).max(1));
     if step == 0 {
-        bail!("--step 0 is not allowed: windows move by at least 1 sample");
+        usage!("--step 0 is not allowed: windows move by at least 1 sample");
     }
     let mode = if adaptive {
         Window::Adaptive(Pid {

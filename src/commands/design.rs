@@ -3,7 +3,9 @@
 
 use std::process::ExitCode;
 
-use anyhow::{bail, Result};
+use anyhow::Result;
+
+use super::usage;
 
 use gyrofx_codegen::report;
 use gyrofx_model::fx::{Overflow, Rounding};
@@ -76,7 +78,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
             method,
             convergence,
         )?,
-        (None, None) => bail!("give --qw (°/s)²/s or --bandwidth HZ"),
+        (None, None) => usage!("give --qw (°/s)²/s or --bandwidth HZ"),
     };
     let label = match bandwidth {
         Some(bw) => format!("{bw} Hz"),

@@ -18,7 +18,7 @@ pub struct Args {
     #[command(flatten)]
     source: ConfigSource,
     /// Samples of the chain run (overrides the config).
-    #[arg(long)]
+    #[arg(long, value_parser = super::options::count)]
     samples: Option<usize>,
     /// Seed (overrides the config).
     #[arg(long)]

@@ -6,7 +6,9 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Result};
+use anyhow::Result;
+
+use super::usage;
 
 use gyrofx_codegen::config::Config;
 use gyrofx_codegen::generate::{provenance, Output};
@@ -52,7 +54,7 @@ impl SampleRate {
     pub fn hz(&self) -> Result<f64> {
         let rate = self.rate;
         if !(rate.is_finite() && rate > 0.0) {
-            bail!(
+            usage!(
                 "--rate {rate} is not allowed: the sample rate must be a finite number of Hz > 0"
             );
         }
@@ -113,5 +115,21 @@ impl ConfigSource {
     /// command that regenerates it.
     pub fn provenance(&self, job: &Job, output: Output) -> Provenance {
         provenance(job, output, self.preset.as_deref(), self.config.as_deref())
+    }
+}
+
+/// A count of samples from the command line: a whole number, also written as `1e6` or
+/// `2.5e5` when that is exactly a whole number (clap's value parser).
+pub fn count(text: &str) -> std::result::Result<usize, String> {
+    let refuse =
+        || format!("'{text}' is not a count: a whole number >= 0 such as 1000000, 1e6 or 2.5e5");
+    if let Ok(n) = text.parse::<usize>() {
+        return Ok(n);
+    }
+    let value: f64 = text.parse().map_err(|_| refuse())?;
+    if value.is_finite() && value >= 0.0 && value.fract() == 0.0 && value < 2f64.powi(53) {
+        Ok(value as usize)
+    } else {
+        Err(refuse())
     }
 }

@@ -4,7 +4,9 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::{bail, Result};
+use anyhow::Result;
+
+use super::usage;
 
 use gyrofx_codegen::{output_folder, reproduce};
 
@@ -16,7 +18,7 @@ pub struct Args {
     #[arg(long)]
     paper: String,
     /// Samples to simulate (default: the paper's record length).
-    #[arg(long)]
+    #[arg(long, value_parser = super::options::count)]
     samples: Option<usize>,
     /// Seed of the simulation.
     #[arg(long, default_value_t = 1)]
@@ -62,7 +64,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
             let p = reproduce::paper_004(samples.unwrap_or(reproduce::SAMPLES_004), seed)?;
             (p.markdown(), p.curves, None)
         }
-        other => bail!("--paper {other:?} is not one of the papers: use 000, 002, 003 or 004"),
+        other => usage!("--paper {other:?} is not one of the papers: use 000, 002, 003 or 004"),
     };
     print!("{report}");
     if let Some(folder) = &out {

@@ -180,6 +180,51 @@ fn check_known_keys(
     Ok(())
 }
 
+/// The 1-based line of `text` that sets the dotted key `path` (`kf.tolerance`; a key inside an
+/// inline table or array is found at the line of its outer key), tracking `[section]` headers
+/// and dotted keys.
+fn line_of(text: &str, path: &str) -> Option<usize> {
+    let mut section = String::new();
+    for (index, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if let Some(header) = line.strip_prefix('[') {
+            section = header
+                .trim_start_matches('[')
+                .split(']')
+                .next()
+                .unwrap_or("")
+                .split('.')
+                .map(|part| part.trim().trim_matches('"'))
+                .collect::<Vec<_>>()
+                .join(".");
+            continue;
+        }
+        let Some((key, _)) = line.split_once('=') else {
+            continue;
+        };
+        let key = key
+            .split('.')
+            .map(|part| part.trim().trim_matches('"'))
+            .collect::<Vec<_>>()
+            .join(".");
+        if key.is_empty() || key.starts_with('#') {
+            continue;
+        }
+        let full = if section.is_empty() {
+            key
+        } else {
+            format!("{section}.{key}")
+        };
+        if path == full
+            || path.starts_with(&format!("{full}."))
+            || path.starts_with(&format!("{full}["))
+        {
+            return Some(index + 1);
+        }
+    }
+    None
+}
+
 /// Merges `overlay` into `base`, table by table.
 fn merge(base: &mut toml::Table, overlay: toml::Table) {
     for (key, value) in overlay {
@@ -224,11 +269,27 @@ impl Config {
             merge(&mut merged, user);
         }
         let merged_text = toml::to_string(&merged).expect("a table serializes");
-        let origin = overlays.last().map(|o| o.1).unwrap_or("embedded default");
-        toml::from_str(&merged_text).map_err(|e| Error::ConfigSyntax {
-            origin: origin.to_string(),
-            message: e.to_string().trim_end().to_string(),
-        })
+        // The merged text's line means nothing to the user: a type error names the key and the
+        // line of the last overlay that sets it.
+        let located = |key: String, message: &str| {
+            let (origin, line) = overlays
+                .iter()
+                .rev()
+                .find_map(|(text, origin)| line_of(text, &key).map(|line| (*origin, line)))
+                .map(|(origin, line)| (origin.to_string(), format!("line {line}: ")))
+                .unwrap_or_else(|| ("embedded default".to_string(), String::new()));
+            Error::ConfigSyntax {
+                origin,
+                message: format!("{line}{key}: {}", message.trim_end()),
+            }
+        };
+        let config: Config =
+            serde_path_to_error::deserialize(toml::Deserializer::new(&merged_text))
+                .map_err(|e| located(e.path().to_string(), e.inner().message()))?;
+        if let Some((key, message)) = config.section_type_error() {
+            return Err(located(key, &message));
+        }
+        Ok(config)
     }
 
     /// Reads a config file over the embedded default; a relative `csv_path` is resolved against

@@ -31,11 +31,44 @@ pub struct GyroLoop {
 /// Deserializes `table` (a config section after overlaying) as `T`, naming the section in the
 /// error.
 fn section<T: serde::de::DeserializeOwned>(name: &str, table: toml::Table) -> Result<T> {
-    T::deserialize(toml::Value::Table(table))
-        .map_err(|e| Error::config(name, "(section)", e.to_string().trim().replace('\n', " ")))
+    typed(name, table).map_err(|(key, message)| Error::ConfigSyntax {
+        origin: "config".into(),
+        message: format!("{key}: {message}"),
+    })
+}
+
+/// `table` as the section `name`'s type, or the dotted key that does not fit and why.
+fn typed<T: serde::de::DeserializeOwned>(
+    name: &str,
+    table: toml::Table,
+) -> std::result::Result<T, (String, String)> {
+    serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {
+        let key = e.path().to_string();
+        let key = if key == "." || key.is_empty() {
+            name.to_string()
+        } else {
+            format!("{name}.{key}")
+        };
+        (key, e.inner().message().trim().replace('\n', " "))
+    })
 }
 
 impl Config {
+    /// The first key of `[loop]` or `[front_end]` (sections kept as tables until a loop is
+    /// built) whose value has the wrong type, and why: checked when the config is read, so
+    /// that the error can name the user's line.
+    pub(super) fn section_type_error(&self) -> Option<(String, String)> {
+        let mut table = self.gyro_loop.clone();
+        table.insert("rounding".into(), self.rounding.clone().into());
+        table.insert("overflow".into(), self.overflow.clone().into());
+        if let Err(e) = typed::<LoopSettings>("loop", table) {
+            return Some(e);
+        }
+        let mut front_end = self.front_end.clone();
+        front_end.insert("sample_rate_hz".into(), 1.0.into());
+        typed::<PhysicsSettings>("front_end", front_end).err()
+    }
+
     /// Both gyros' loops, validated and designed.
     ///
     /// # Errors
