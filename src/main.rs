@@ -45,6 +45,7 @@ fn main() -> ExitCode {
         gyrofx_codegen::output_folder::remove_registered();
         std::process::exit(130);
     });
+    quiet_on_closed_stdout();
     let cli = Cli::parse();
     let outcome = match cli.command {
         Command::Allan(args) => allan::run(args),
@@ -78,4 +79,29 @@ fn main() -> ExitCode {
             }
         }
     }
+}
+
+/// A reader that closes stdout early (`gyrofx init | head -1`) ends the program quietly with
+/// exit 0, as ripgrep does, instead of the panic `println!` raises on the broken pipe. Every
+/// command prints with `println!`, so this is caught where that panic starts: the hook
+/// recognises std's message for a failed stdout write with the pipe's OS error (EPIPE) and
+/// leaves every other panic to the default hook.
+fn quiet_on_closed_stdout() {
+    let broken_pipe = std::io::Error::from_raw_os_error(32).to_string();
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let payload = info.payload();
+        let message = payload
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| payload.downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if cfg!(unix)
+            && message.starts_with("failed printing to stdout")
+            && message.ends_with(&broken_pipe)
+        {
+            std::process::exit(0);
+        }
+        default(info);
+    }));
 }

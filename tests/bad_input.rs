@@ -425,3 +425,26 @@ fn usage_errors_exit_2_failures_exit_1_and_each_error_is_said_once() {
         "2e2",
     ]);
 }
+
+/// A reader that closes stdout early (`gyrofx init | head -1`) ends gyrofx quietly with exit
+/// 0, no panic message.
+#[test]
+fn a_closed_stdout_ends_quietly() {
+    for args in [&["init"][..], &["init", "--preset", "gu2019"]] {
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_gyrofx"))
+            .args(args)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        // Closed before the program has started writing.
+        drop(child.stdout.take());
+        let output = child.wait_with_output().unwrap();
+        assert_eq!(output.status.code(), Some(0), "{args:?}");
+        assert!(
+            output.stderr.is_empty(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+    }
+}
