@@ -448,3 +448,72 @@ fn a_closed_stdout_ends_quietly() {
         );
     }
 }
+
+/// `filter`: an --output that is the --input is refused untouched; an --output whose folder
+/// does not exist fails before the work; a record at a rate other than the default plant's
+/// is filtered; the CSV and a plot follow the umask (not a temporary file's 0600).
+#[test]
+fn filter_guards_its_input_and_writes_files_by_the_umask() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.csv");
+    let rows: String = (0..50)
+        .map(|k| format!("{k},{}\n", k as f64 * 0.1))
+        .collect();
+    std::fs::write(&input, format!("t,rate_dps\n{rows}")).unwrap();
+    let before = std::fs::read(&input).unwrap();
+    let input_text = input.to_str().unwrap();
+    let output = gyrofx(&[
+        "filter", "--input", input_text, "--fs", "100", "--output", input_text,
+    ]);
+    assert_eq!(output.status.code(), Some(2), "{}", text(&output));
+    assert!(text(&output).contains("is the --input file"));
+    assert_eq!(std::fs::read(&input).unwrap(), before);
+
+    let log = fails(&[
+        "filter",
+        "--input",
+        input_text,
+        "--fs",
+        "100",
+        "--output",
+        dir.path().join("no/such/folder/out.csv").to_str().unwrap(),
+    ]);
+    assert!(
+        log.contains("cannot create a file in") && !log.contains(".gyrofx-filter-"),
+        "{log}"
+    );
+
+    let filtered = dir.path().join("out.csv");
+    ok(&[
+        "filter",
+        "--input",
+        input_text,
+        "--fs",
+        "100",
+        "--output",
+        filtered.to_str().unwrap(),
+    ]);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        // The test process's umask is what the file must follow: read it back from a file
+        // created the ordinary way.
+        let probe = dir.path().join("probe");
+        std::fs::write(&probe, "").unwrap();
+        let expected = std::fs::metadata(&probe).unwrap().permissions().mode() & 0o777;
+        let mode = std::fs::metadata(&filtered).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode, expected, "filtered CSV mode {mode:o}");
+        let plot = dir.path().join("allan.png");
+        ok(&[
+            "allan",
+            "--input",
+            input_text,
+            "--rate",
+            "100",
+            "--plot",
+            plot.to_str().unwrap(),
+        ]);
+        let mode = std::fs::metadata(&plot).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode, expected, "plot mode {mode:o}");
+    }
+}

@@ -387,6 +387,27 @@ pub fn clean_stale(parent: &Path) {
     }
 }
 
+/// A temporary file in `folder` (`<prefix>…<suffix>`) for a single output file that is
+/// renamed into place when complete. Created with mode 0666 less the umask, as any file a
+/// program writes, not the 0600 of a private temporary file: the renamed output keeps it.
+///
+/// # Errors
+/// The error of creating it.
+pub fn staged_file(
+    folder: &Path,
+    prefix: &str,
+    suffix: &str,
+) -> std::io::Result<tempfile::NamedTempFile> {
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(prefix).suffix(suffix);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    builder.tempfile_in(folder)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -8,10 +8,12 @@ use anyhow::{Context, Result};
 
 use gyrofx_codegen::config::Config;
 use gyrofx_codegen::job::{design_bandwidths, plan_for};
+use gyrofx_codegen::output_folder;
 use gyrofx_model::fx::{from_f64, Overflow, Rounding};
 use gyrofx_model::kf::{FixedKf, FloatKf};
 
 use super::options::CsvColumn;
+use super::usage;
 
 /// Run recorded rate data (°/s) through the bit-accurate KF and its float model.
 #[derive(clap::Args)]
@@ -43,12 +45,39 @@ pub fn run(args: Args) -> Result<ExitCode> {
         output,
     } = args;
     let output = output.as_path();
+    if let (Ok(input), Ok(existing)) = (csv.input.canonicalize(), output.canonicalize()) {
+        if input == existing {
+            usage!(
+                "--output {} is the --input file: the filtered CSV would replace the record; choose another file",
+                output.display()
+            );
+        }
+    }
+    // The output's folder is checked before the work: the file is staged there first.
+    let folder = match output.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let mut staged =
+        output_folder::staged_file(folder, ".gyrofx-filter-", ".csv").map_err(|e| {
+            // The OS's reason, without the temporary file's name that tempfile adds.
+            let reason = e.to_string();
+            let reason = reason.split(" at path ").next().unwrap_or_default();
+            anyhow::anyhow!(
+                "--output {}: cannot create a file in {}: {reason}",
+                output.display(),
+                folder.display()
+            )
+        })?;
     // filter takes no --preset: its config is the embedded default, or the file over it.
     let mut config = match config {
         Some(path) => Config::from_file(&path)?,
         None => Config::embedded(),
     };
     config.stimulus.fs_hz = fs;
+    // The recorded data replace the gyros: the resonator plant's rate (fixed by its loop)
+    // need not match the record's.
+    config.plant.model = "rate".into();
     if let Some(bw) = bandwidth {
         config.kf.bandwidths_hz = vec![bw];
     }
@@ -78,17 +107,6 @@ pub fn run(args: Args) -> Result<ExitCode> {
             plan.output.to_f64(i128::from(rate))
         ));
     }
-    let folder = match output.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let mut staged = tempfile::NamedTempFile::new_in(folder).with_context(|| {
-        format!(
-            "output {}: cannot create a file in {}",
-            output.display(),
-            folder.display()
-        )
-    })?;
     std::io::Write::write_all(&mut staged, text.as_bytes())
         .with_context(|| format!("output {}", output.display()))?;
     staged
