@@ -517,3 +517,51 @@ fn filter_guards_its_input_and_writes_files_by_the_umask() {
         assert_eq!(mode, expected, "plot mode {mode:o}");
     }
 }
+
+/// A quantizer that saturates on the run's data is a warning naming the signals; `--strict`
+/// makes it an error that writes nothing.
+#[test]
+fn overflow_is_a_warning_and_strict_makes_it_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = write_config(
+        dir.path(),
+        "fast.toml",
+        "[plant]\nmodel = \"rate\"\n[stimulus]\nscenario = \"constant\"\nrate_dps = 600.0\n",
+    );
+    let out = dir.path().join("out");
+    let out = out.to_str().unwrap();
+    let output = gyrofx(&[
+        "generate",
+        "--out",
+        out,
+        "--config",
+        &config,
+        "--samples",
+        "400",
+    ]);
+    let log = text(&output);
+    assert!(output.status.success(), "{log}");
+    assert!(
+        log.contains("warning: quantizers overflowed or saturated on the chain run's data: ADC A 400, ADC B 400"),
+        "{log}"
+    );
+    let strict = dir.path().join("strict");
+    let output = gyrofx(&[
+        "generate",
+        "--out",
+        strict.to_str().unwrap(),
+        "--config",
+        &config,
+        "--samples",
+        "400",
+        "--strict",
+    ]);
+    assert_eq!(output.status.code(), Some(1), "{}", text(&output));
+    assert!(text(&output).contains("--strict: quantizers overflowed"));
+    assert!(!strict.exists());
+    // The default's run saturates nothing (a resonator loop's switching transient saturates
+    // only blanked samples, which are not counted).
+    let clean = gyrofx(&["generate", "--out", out, "--samples", "400", "--strict"]);
+    assert!(clean.status.success(), "{}", text(&clean));
+    assert!(!text(&clean).contains("warning"), "{}", text(&clean));
+}

@@ -4,7 +4,7 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 
 use gyrofx_codegen::config::Config;
-use gyrofx_codegen::generate::{generate, provenance, Output};
+use gyrofx_codegen::generate::{generate, provenance, Options, Output};
 use gyrofx_codegen::job::Job;
 use gyrofx_codegen::output_folder::Replace;
 
@@ -19,7 +19,19 @@ fn generate_million(c: &mut Criterion) {
     let mut group = c.benchmark_group("generate");
     group.sample_size(10);
     group.bench_function("default_1M_samples_all_files", |b| {
-        b.iter(|| generate(&job, &out, Replace::IfOwned, &provenance, &mut |_| {}).unwrap())
+        b.iter(|| {
+            generate(
+                &job,
+                &out,
+                Options {
+                    replace: Replace::IfOwned,
+                    strict: false,
+                },
+                &provenance,
+                &mut |_| {},
+            )
+            .unwrap()
+        })
     });
     group.finish();
 }

@@ -52,6 +52,11 @@ pub enum Error {
         /// What is wrong, with line and column where known.
         message: String,
     },
+    /// `--strict`: a quantizer overflowed or saturated on the run's data.
+    #[error(
+        "--strict: quantizers overflowed or saturated in the chain run ({0}); nothing was written"
+    )]
+    Overflow(String),
     /// Reading or writing a file failed.
     #[error("{path}: {source}")]
     Io {

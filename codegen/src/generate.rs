@@ -209,8 +209,28 @@ pub fn build_package(
     Ok((package, Summary { run, files }))
 }
 
+/// How [`generate`] treats its output folder and overflows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Options {
+    /// Whether an existing folder may be replaced.
+    pub replace: Replace,
+    /// Refuse to write when a quantizer overflowed on the run's data
+    /// ([`crate::vectors::Overflows::in_chain_run`]).
+    pub strict: bool,
+}
+
+/// `name count, name count, …` of [`crate::vectors::Overflows::in_chain_run`].
+pub fn overflow_list(overflowed: &[(String, u64)]) -> String {
+    overflowed
+        .iter()
+        .map(|(name, n)| format!("{name} {n}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 /// Builds the package for `job` and writes it to `out` atomically, if `out` may be replaced
-/// ([`output_folder::check`], checked before the work starts).
+/// ([`output_folder::check`], checked before the work starts); with `options.strict`, only if
+/// no quantizer overflowed on the run's data.
 ///
 /// # Errors
 /// Stimulus errors, and [`crate::Error::Output`] / [`crate::Error::Io`] when `out` cannot be
@@ -218,13 +238,18 @@ pub fn build_package(
 pub fn generate(
     job: &Job,
     out: &Path,
-    replace: Replace,
+    options: Options,
     provenance: &Provenance,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Summary> {
-    output_folder::check(out, Kind::Generate, replace)?;
+    output_folder::check(out, Kind::Generate, options.replace)?;
     let (package, summary) = build_package(job, provenance, progress)?;
+    let overflowed = summary.run.overflows.in_chain_run();
+    if options.strict && !overflowed.is_empty() {
+        return Err(crate::error::Error::Overflow(overflow_list(&overflowed)));
+    }
     progress("writing");
+    let replace = options.replace;
     package.write_atomically(out, replace)?;
     Ok(summary)
 }

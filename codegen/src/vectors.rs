@@ -42,6 +42,34 @@ pub struct Overflows {
     pub mean_filter: u64,
 }
 
+impl Overflows {
+    /// The quantization points that overflowed or saturated on the chain run's data, with
+    /// their counts, by signal name. The directed test segments (the KF's full-scale segment,
+    /// the mean filter's blocks) saturate on purpose and are not among them.
+    pub fn in_chain_run(&self) -> Vec<(String, u64)> {
+        let e = &self.estimator;
+        let k = &self.kf_chain;
+        [
+            ("ADC A", self.adc[0]),
+            ("ADC B", self.adc[1]),
+            ("interval mean A", e.mean[0]),
+            ("interval mean B", e.mean[1]),
+            ("bias A", e.bias[0]),
+            ("bias B", e.bias[1]),
+            ("calibrated A", e.calibrated[0]),
+            ("calibrated B", e.calibrated[1]),
+            ("combined", e.combined),
+            ("KF x1", k.x1),
+            ("KF x2", k.x2),
+            ("KF rate_hat", k.rate_hat),
+        ]
+        .into_iter()
+        .filter(|(_, n)| *n > 0)
+        .map(|(name, n)| (name.to_string(), n))
+        .collect()
+    }
+}
+
 /// Estimator overflow counts (serializable mirror).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct EstimatorCounts {
@@ -49,7 +77,7 @@ pub struct EstimatorCounts {
     pub mean: [u64; 2],
     /// Bias estimates of A and B.
     pub bias: [u64; 2],
-    /// Calibrated outputs of A and B.
+    /// Calibrated outputs of A and B (valid samples).
     pub calibrated: [u64; 2],
     /// Combined output.
     pub combined: u64,

@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::Result;
 
-use gyrofx_codegen::generate::{generate, Output};
+use gyrofx_codegen::generate::{generate, overflow_list, Options, Output};
 use gyrofx_codegen::job::Job;
 
 use super::options::{ConfigSource, OutputFolder};
@@ -23,6 +23,10 @@ pub struct Args {
     /// Seed (overrides the config).
     #[arg(long)]
     seed: Option<u64>,
+    /// Refuse to write the package when a quantizer overflows or saturates on the run's data
+    /// (exit 1); without it, a warning names the signals.
+    #[arg(long)]
+    strict: bool,
 }
 
 /// Writes the package and prints what it holds: the files, the KF plan, the fixed-point
@@ -33,6 +37,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
         source,
         samples,
         seed,
+        strict,
     } = args;
     let out = folder.out.as_path();
     let mut config = source.load()?;
@@ -46,7 +51,11 @@ pub fn run(args: Args) -> Result<ExitCode> {
     let bar = indicatif::ProgressBar::new_spinner();
     let long = job.config.samples >= 1_000_000;
     let provenance = source.provenance(&job, Output::Package);
-    let summary = generate(&job, out, folder.replace(), &provenance, &mut |phase| {
+    let options = Options {
+        replace: folder.replace(),
+        strict,
+    };
+    let summary = generate(&job, out, options, &provenance, &mut |phase| {
         if long {
             bar.set_message(format!("generate: {phase}"));
             bar.tick();
@@ -54,6 +63,13 @@ pub fn run(args: Args) -> Result<ExitCode> {
     })?;
     bar.finish_and_clear();
     let run = &summary.run;
+    let overflowed = run.overflows.in_chain_run();
+    if !overflowed.is_empty() {
+        eprintln!(
+            "warning: quantizers overflowed or saturated on the chain run's data: {} (counts; the directed test segments' saturations are not counted; --strict makes this an error)",
+            overflow_list(&overflowed)
+        );
+    }
     println!(
         "wrote {} files to {}: {} chain samples; vectors: {}",
         summary.files.len(),

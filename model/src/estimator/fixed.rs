@@ -29,7 +29,9 @@ pub struct OverflowCounts {
     pub mean: [u64; 2],
     /// New bias estimates of A and B (and their smoothing).
     pub bias: [u64; 2],
-    /// Calibrated outputs of A and B.
+    /// Calibrated outputs of A and B, on valid samples only: a blanked sample's output is
+    /// computed but used nowhere, and right after a switch the resonator loop's transient can
+    /// saturate it by design.
     pub calibrated: [u64; 2],
     /// Combined output.
     pub combined: u64,
@@ -123,7 +125,11 @@ impl FixedEstimator {
                 } else {
                     y_aligned + b_aligned
                 };
+                let count = self.calibrated_q[g].overflow_count;
                 out[g] = self.calibrated_q[g].apply_mode_i64::<MODE>(corrected);
+                if !valid[g] {
+                    self.calibrated_q[g].overflow_count = count;
+                }
             }
         }
         for g in (0..2).filter(|_| !self.narrow) {
@@ -134,7 +140,11 @@ impl FixedEstimator {
             } else {
                 y_aligned + b_aligned
             };
+            let count = self.calibrated_q[g].overflow_count;
             out[g] = self.calibrated_q[g].apply_mode::<MODE>(corrected) as i64;
+            if !valid[g] {
+                self.calibrated_q[g].overflow_count = count;
+            }
         }
         let combined = match valid {
             [true, true] if self.narrow => self.combined_q.apply_mode_i64::<MODE>(out[0] + out[1]),
