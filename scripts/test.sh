@@ -60,13 +60,15 @@ verilator --lint-only -Wall --top-module gyrofx_top hdl/*.v
 for module in gyrofx_mean_filter gyrofx_nco gyrofx_demodulator gyrofx_pi gyrofx_cic; do
     verilator --lint-only -Wall --top-module "$module" "hdl/$module.v" hdl/gyrofx_quantize.v
 done
+verilator --lint-only -Wall --top-module gyrofx_gyro_loop hdl/gyrofx_gyro_loop.v hdl/gyrofx_nco.v \
+    hdl/gyrofx_demodulator.v hdl/gyrofx_pi.v hdl/gyrofx_cic.v hdl/gyrofx_quantize.v
 echo "== ghdl -a --std=08 -Werror (hdl/, compile order)"
 ghdl_work="$(mktemp -d)"
 ghdl -a --std=08 -Werror -Wunused -Wbinding -Wbody -Wspecs --workdir="$ghdl_work" \
     hdl/gyrofx_mem_pkg.vhd hdl/gyrofx_quantize.vhd hdl/gyrofx_kf.vhd hdl/gyrofx_sequencer.vhd \
     hdl/gyrofx_bias_estimator.vhd hdl/gyrofx_calibration.vhd hdl/gyrofx_top.vhd \
     hdl/gyrofx_mean_filter.vhd hdl/gyrofx_nco.vhd hdl/gyrofx_demodulator.vhd hdl/gyrofx_pi.vhd \
-    hdl/gyrofx_cic.vhd hdl/gyrofx_testbench_pkg.vhd
+    hdl/gyrofx_cic.vhd hdl/gyrofx_gyro_loop.vhd hdl/gyrofx_testbench_pkg.vhd
 rm -rf "$ghdl_work"
 echo "== cargo test"
 cargo test --workspace

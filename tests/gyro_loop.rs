@@ -120,3 +120,30 @@ fn the_resonator_plant_feeds_the_chain_and_reversal_removes_its_bias() {
     let verify = ok(&["verify", "--out", out_text, "--sim", "iverilog"]);
     assert!(verify.contains("iverilog: passed"), "{verify}");
 }
+
+/// `gyrofx loop --plot`: a PNG or an SVG of both gyros across a switch; another extension is a
+/// usage error naming `--plot`, refused before the simulation, with nothing written.
+#[test]
+fn loop_plots_the_switch_as_png_or_svg() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("switch.png");
+    let svg = dir.path().join("switch.svg");
+    ok(&["loop", "--seconds", "0.05", "--plot", png.to_str().unwrap()]);
+    let bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+    ok(&["loop", "--seconds", "0.05", "--plot", svg.to_str().unwrap()]);
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(
+        text.contains("<svg") && text.contains("locked again at"),
+        "an SVG with the re-lock"
+    );
+    let bad = dir.path().join("switch.jpg");
+    let output = common::gyrofx(&["loop", "--plot", bad.to_str().unwrap()]);
+    let log = common::text(&output);
+    assert_eq!(output.status.code(), Some(2), "{log}");
+    assert!(
+        log.contains("--plot") && log.contains(".png or .svg"),
+        "{log}"
+    );
+    assert!(!bad.exists());
+}

@@ -261,10 +261,26 @@ fn a_moved_package_verifies_in_ghdl() {
     let dir = tempfile::tempdir().unwrap();
     let first = dir.path().join("first");
     assert!(generate(dir.path(), &first, &[]).status.success());
-    let log = ok(&["verify", "--out", first.to_str().unwrap(), "--sim", "ghdl"]);
+    let log = ok(&[
+        "verify",
+        "--out",
+        first.to_str().unwrap(),
+        "--sim",
+        "ghdl",
+        "--blocks",
+        "kf",
+    ]);
     assert!(log.contains("ghdl: passed"), "{log}");
     let moved = dir.path().join("moved");
     std::fs::rename(&first, &moved).unwrap();
-    let log = ok(&["verify", "--out", moved.to_str().unwrap(), "--sim", "ghdl"]);
+    let log = ok(&[
+        "verify",
+        "--out",
+        moved.to_str().unwrap(),
+        "--sim",
+        "ghdl",
+        "--blocks",
+        "kf",
+    ]);
     assert!(log.contains("ghdl: passed"), "{log}");
 }

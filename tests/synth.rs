@@ -44,6 +44,20 @@ fn the_chain_synthesizes_and_wider_formats_cost_more_and_latches_fail() {
     }
     // The KF's two gain products and the estimator's products are real multipliers.
     assert!(resource(&narrow_manifest, "generic", "multipliers") >= 2);
+    // One gyro's loop is synthesized beside the chain: its demodulators' four products, the
+    // PIs' four, the DAC's and the two 1/SF products at least.
+    let loop_resources = &narrow_manifest["gyro_loop"]["resources"];
+    assert!(loop_resources["generic"]["multipliers"].as_u64().unwrap() >= 11);
+    assert!(loop_resources["xilinx"]["luts"].as_u64().unwrap() > 0);
+    let loop_luts = loop_resources["xilinx"]["luts"].as_u64().unwrap();
+    assert!(report.contains("gyrofx_gyro_loop") && report.contains(&format!("| {loop_luts} |")));
+    for file in [
+        "gyro_loop/generic.ys",
+        "gyro_loop/yosys/xilinx.json",
+        "gyro_loop/gyrofx_gyro_loop.v",
+    ] {
+        assert!(narrow.join(file).is_file(), "{file}");
+    }
     for file in [
         "generic.ys",
         "xilinx.ys",

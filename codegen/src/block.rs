@@ -203,6 +203,11 @@ pub struct Block {
     codes: Vec<i64>,
     /// Extra real-valued CSV columns (name, one value per row; NaN prints empty).
     pub extra: Vec<(&'static str, Vec<f64>)>,
+    /// Clocks the testbench waits after the one that follows `ce` before it compares the
+    /// registered outputs (0: they are valid 1 clock after `ce`): a pipelined block's extra
+    /// latency. `ce` stays low meanwhile, so samples come every `2 + settle_clocks` clocks at
+    /// most.
+    pub settle_clocks: u32,
 }
 
 impl Block {
@@ -224,6 +229,7 @@ impl Block {
             outputs,
             codes: Vec::new(),
             extra: Vec::new(),
+            settle_clocks: 0,
         }
     }
 

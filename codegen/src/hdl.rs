@@ -2,7 +2,7 @@
 //! in compile order (a unit before its users), and the sources one module needs.
 
 /// The reference RTL, embedded so that every package is self-contained.
-pub const RTL_SOURCES: [(&str, &str); 7] = [
+pub const RTL_SOURCES: [(&str, &str); 12] = [
     (
         "gyrofx_quantize.v",
         include_str!("../../hdl/gyrofx_quantize.v"),
@@ -24,6 +24,17 @@ pub const RTL_SOURCES: [(&str, &str); 7] = [
     (
         "gyrofx_mean_filter.v",
         include_str!("../../hdl/gyrofx_mean_filter.v"),
+    ),
+    ("gyrofx_nco.v", include_str!("../../hdl/gyrofx_nco.v")),
+    (
+        "gyrofx_demodulator.v",
+        include_str!("../../hdl/gyrofx_demodulator.v"),
+    ),
+    ("gyrofx_pi.v", include_str!("../../hdl/gyrofx_pi.v")),
+    ("gyrofx_cic.v", include_str!("../../hdl/gyrofx_cic.v")),
+    (
+        "gyrofx_gyro_loop.v",
+        include_str!("../../hdl/gyrofx_gyro_loop.v"),
     ),
 ];
 
@@ -57,7 +68,7 @@ pub fn verilog_sources_of(module: &str) -> Vec<&'static (&'static str, &'static 
 
 /// The reference RTL in VHDL-2008, in compile order (packages first), and the package the VHDL
 /// testbenches share (last: simulation only).
-pub const VHDL_SOURCES: [(&str, &str); 9] = [
+pub const VHDL_SOURCES: [(&str, &str); 14] = [
     (
         "gyrofx_mem_pkg.vhd",
         include_str!("../../hdl/gyrofx_mem_pkg.vhd"),
@@ -83,6 +94,17 @@ pub const VHDL_SOURCES: [(&str, &str); 9] = [
     (
         "gyrofx_mean_filter.vhd",
         include_str!("../../hdl/gyrofx_mean_filter.vhd"),
+    ),
+    ("gyrofx_nco.vhd", include_str!("../../hdl/gyrofx_nco.vhd")),
+    (
+        "gyrofx_demodulator.vhd",
+        include_str!("../../hdl/gyrofx_demodulator.vhd"),
+    ),
+    ("gyrofx_pi.vhd", include_str!("../../hdl/gyrofx_pi.vhd")),
+    ("gyrofx_cic.vhd", include_str!("../../hdl/gyrofx_cic.vhd")),
+    (
+        "gyrofx_gyro_loop.vhd",
+        include_str!("../../hdl/gyrofx_gyro_loop.vhd"),
     ),
     (
         "gyrofx_testbench_pkg.vhd",
@@ -119,5 +141,16 @@ mod tests {
             ["gyrofx_quantize.v", "gyrofx_mean_filter.v"]
         );
         assert_eq!(names("gyrofx_sequencer"), ["gyrofx_sequencer.v"]);
+        assert_eq!(
+            names("gyrofx_gyro_loop"),
+            [
+                "gyrofx_quantize.v",
+                "gyrofx_nco.v",
+                "gyrofx_demodulator.v",
+                "gyrofx_pi.v",
+                "gyrofx_cic.v",
+                "gyrofx_gyro_loop.v",
+            ]
+        );
     }
 }

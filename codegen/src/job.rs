@@ -8,7 +8,7 @@ use gyrofx_model::kf::design::{design_for_bandwidth, Design, Noise};
 use gyrofx_model::kf::{Plan, Spec};
 use gyrofx_model::mean_filter;
 
-use crate::config::{Config, KfSettings, Settings, Source};
+use crate::config::{Config, GyroLoop, KfSettings, Settings, Source};
 use crate::error::{Error, Result};
 use crate::input::read_column;
 
@@ -25,6 +25,9 @@ pub struct Job {
     pub chain: chain::Plan,
     /// The mean filter's plan.
     pub mean_filter: mean_filter::Plan,
+    /// Both gyros' resonator-level loops (resolved for every plant: the loop's RTL block is in
+    /// every package).
+    pub gyro_loops: [GyroLoop; 2],
 }
 
 /// Designs one filter per bandwidth of `settings` at `fs_hz` for the noise model (°/√h, °/h/√h).
@@ -81,6 +84,10 @@ impl Job {
     /// The first config, design or plan error.
     pub fn new(config: Config) -> Result<Job> {
         let settings = config.validate()?;
+        let gyro_loops = match &settings.resonator {
+            Some(loops) => loops.clone(),
+            None => config.gyro_loops()?,
+        };
         let designs = design_bandwidths(
             &settings.kf,
             config.stimulus.fs_hz,
@@ -102,6 +109,7 @@ impl Job {
             designs,
             chain,
             mean_filter,
+            gyro_loops,
         })
     }
 

@@ -17,6 +17,7 @@ use plotters::prelude::*;
 use gyrofx_model::analysis::allan::Point;
 use gyrofx_model::analysis::davar::{Coefficients, Davar};
 use gyrofx_model::analysis::noise::{Terms, FLICKER_FLOOR};
+use gyrofx_model::gyro_loop::trace::TracePoint;
 
 use crate::error::{Error, Result};
 
@@ -284,6 +285,147 @@ fn draw_davar<DB: DrawingBackend>(
             .map_err(|x| e(&x))?;
     }
     area.present().map_err(|x| e(&x))
+}
+
+/// One gyro's trace across a switch, for [`gyro_loop`].
+pub struct LoopTrace<'a> {
+    /// Legend label (`gyro a`).
+    pub label: String,
+    /// The points.
+    pub points: &'a [TracePoint],
+}
+
+/// The first time after the switch (s) from which the trace stays locked, if it does.
+pub fn relock_time_s(points: &[TracePoint]) -> Option<f64> {
+    let after: Vec<&TracePoint> = points.iter().filter(|p| p.time_s > 0.0).collect();
+    let last_unlocked = after.iter().rposition(|p| !p.locked);
+    match last_unlocked {
+        Some(i) if i + 1 < after.len() => Some(after[i + 1].time_s),
+        Some(_) => None,
+        None => after.first().map(|p| p.time_s),
+    }
+}
+
+fn draw_gyro_loop<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    traces: &[LoopTrace],
+) -> std::result::Result<(), String> {
+    let e = |x: &dyn std::fmt::Display| x.to_string();
+    area.fill(&WHITE).map_err(|x| e(&x))?;
+    let (title, body) = area.split_vertically(40);
+    title
+        .titled(
+            "Mode switch at t = 0 (normal → reverse): drive amplitude, NCO frequency, rate",
+            ("sans-serif", 20),
+        )
+        .map_err(|x| e(&x))?;
+    let panels = body.split_evenly((3, 1));
+    let all = || traces.iter().flat_map(|t| t.points.iter());
+    let t0 = all().map(|p| p.time_s).fold(f64::MAX, f64::min);
+    let t1 = all()
+        .map(|p| p.time_s)
+        .fold(f64::MIN, f64::max)
+        .max(t0 + 1e-3);
+    type Value = fn(&TracePoint) -> Option<f64>;
+    let quantities: [(&str, Value); 3] = [
+        ("drive amplitude (µm)", |p| Some(p.drive_amplitude_m * 1e6)),
+        ("NCO frequency (Hz)", |p| Some(p.frequency_hz)),
+        ("rate output (°/s)", |p| p.rate_dps),
+    ];
+    for ((name, value), panel) in quantities.iter().zip(panels.iter()) {
+        let values: Vec<f64> = all().filter_map(value).filter(|v| v.is_finite()).collect();
+        let lo = values.iter().copied().fold(f64::MAX, f64::min);
+        let hi = values.iter().copied().fold(f64::MIN, f64::max);
+        if values.is_empty() {
+            continue;
+        }
+        let pad = ((hi - lo) * 0.05).max(1e-9);
+        let (lo, hi) = (lo - pad, hi + pad);
+        let mut chart = ChartBuilder::on(panel)
+            .margin(8)
+            .x_label_area_size(34)
+            .y_label_area_size(80)
+            .build_cartesian_2d(t0 * 1e3..t1 * 1e3, lo..hi)
+            .map_err(|x| e(&x))?;
+        chart
+            .configure_mesh()
+            .x_desc("time from the switch (ms)")
+            .y_desc(*name)
+            .draw()
+            .map_err(|x| e(&x))?;
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                vec![(0.0, lo), (0.0, hi)],
+                BLACK.stroke_width(1),
+            )))
+            .map_err(|x| e(&x))?;
+        for (i, trace) in traces.iter().enumerate() {
+            let color = COLORS[i % COLORS.len()];
+            let points: Vec<(f64, f64)> = trace
+                .points
+                .iter()
+                .filter_map(|p| value(p).map(|v| (p.time_s * 1e3, v)))
+                .filter(|(_, v)| v.is_finite())
+                .collect();
+            let label = match relock_time_s(trace.points) {
+                Some(t) => format!("{} (locked again at {:.1} ms)", trace.label, t * 1e3),
+                None => format!("{} (not locked again)", trace.label),
+            };
+            chart
+                .draw_series(LineSeries::new(points, color.stroke_width(2)))
+                .map_err(|x| e(&x))?
+                .label(label)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color));
+            if let Some(t) = relock_time_s(trace.points) {
+                chart
+                    .draw_series(std::iter::once(PathElement::new(
+                        vec![(t * 1e3, lo), (t * 1e3, hi)],
+                        color.mix(0.5).stroke_width(1),
+                    )))
+                    .map_err(|x| e(&x))?;
+            }
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 14))
+            .draw()
+            .map_err(|x| e(&x))?;
+    }
+    area.present().map_err(|x| e(&x))
+}
+
+/// Checks that `path` names a plot gyrofx can write (`.png` or `.svg`), before any work.
+///
+/// # Errors
+/// [`Error::Plot`]-style error naming the path.
+pub fn check_path(path: &Path) -> Result<()> {
+    is_svg(path).map(|_| ())
+}
+
+/// Writes the gyro loop's switch traces (amplitude, NCO frequency, rate against time; the
+/// switch and each gyro's re-lock marked) to `path` (PNG or SVG).
+///
+/// # Errors
+/// A bad extension, no font, an empty trace, or a failure to draw or write.
+pub fn gyro_loop(path: &Path, traces: &[LoopTrace]) -> Result<()> {
+    let svg = is_svg(path)?;
+    ensure_font()?;
+    if traces.iter().all(|t| t.points.is_empty()) {
+        return Err(plot_error(path, "no trace to plot"));
+    }
+    let size = (1100, 1000);
+    atomically(path, |staged| {
+        if svg {
+            draw_gyro_loop(&SVGBackend::new(staged, size).into_drawing_area(), traces)
+        } else {
+            draw_gyro_loop(
+                &BitMapBackend::new(staged, size).into_drawing_area(),
+                traces,
+            )
+        }
+    })
 }
 
 /// Draws into a temporary file beside `path` (same extension) and renames it into place only

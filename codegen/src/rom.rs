@@ -7,6 +7,7 @@
 
 use gyrofx_model::estimator;
 use gyrofx_model::fx::Format;
+use gyrofx_model::gyro_loop;
 use gyrofx_model::kf::{Plan, COEFFICIENT_NAMES};
 use gyrofx_model::mean_filter;
 
@@ -125,6 +126,52 @@ impl Rom {
             }],
             codes: plan.rom.iter().map(|c| vec![*c]).collect(),
             notes,
+        }
+    }
+
+    /// The gyro loop's quarter-wave sine ROM (shared by its three NCOs): address `k` holds
+    /// `round(A sin(π/2 (k + ½) / 2^ADDR_W))`.
+    pub fn gyro_loop_sine(plan: &gyro_loop::nco::Plan) -> Rom {
+        let codes = plan.rom_codes();
+        let depth = codes.len();
+        Rom {
+            name: "gyro_loop_nco_sine".into(),
+            description: format!(
+                "gyro-loop NCO quarter-wave sine ({}), address k: sin(pi/2 (k + 1/2) / {depth})",
+                plan.output
+            ),
+            fields: vec![Field {
+                name: "sine".into(),
+                format: plan.output,
+            }],
+            codes: codes.iter().map(|c| vec![*c]).collect(),
+            notes: codes
+                .iter()
+                .enumerate()
+                .map(|(k, c)| format!("k = {k}: {}", plan.output.to_f64(*c)))
+                .collect(),
+        }
+    }
+
+    /// The gyro loop's CIC droop-compensator taps (shared by both CICs), `h_0` first.
+    pub fn gyro_loop_cic(plan: &gyro_loop::cic::Plan) -> Rom {
+        let format = plan.taps[0].format;
+        Rom {
+            name: "gyro_loop_cic_taps".into(),
+            description: format!(
+                "gyro-loop CIC droop-compensator taps ({format}), address = tap index (h_0 first, symmetric)"
+            ),
+            fields: vec![Field {
+                name: "tap".into(),
+                format,
+            }],
+            codes: plan.taps.iter().map(|t| vec![t.code]).collect(),
+            notes: plan
+                .taps
+                .iter()
+                .enumerate()
+                .map(|(t, tap)| format!("h_{t} = {:e}", format.to_f64(tap.code)))
+                .collect(),
         }
     }
 

@@ -57,7 +57,7 @@ impl std::str::FromStr for Simulator {
 }
 
 /// Testbench options (the Makefile's `MASK`, `MAX_REPORTED`, `MAX_MISMATCHES`, `WAVES`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Options {
     /// Samples not compared at the start and from every reset sample on.
     pub mask: u64,
@@ -67,6 +67,8 @@ pub struct Options {
     pub max_mismatches: u64,
     /// Write a VCD per testbench.
     pub waves: bool,
+    /// Only these blocks (all when `None`).
+    pub blocks: Option<Vec<String>>,
 }
 
 impl Default for Options {
@@ -76,6 +78,7 @@ impl Default for Options {
             max_reported: u64::from(crate::testbench::MAX_REPORTED),
             max_mismatches: 0,
             waves: false,
+            blocks: None,
         }
     }
 }
@@ -157,7 +160,16 @@ fn blocks(out: &Path, simulator: Simulator) -> Result<Vec<String>> {
 /// [`Error::Simulation`] when the folder is not a package or a program is missing (a missing
 /// simulator is an error, never a skipped check).
 pub fn run(out: &Path, simulator: Simulator, options: &Options) -> Result<Outcome> {
-    let names = blocks(out, simulator)?;
+    let mut names = blocks(out, simulator)?;
+    if let Some(wanted) = &options.blocks {
+        if let Some(unknown) = wanted.iter().find(|w| !names.contains(w)) {
+            return Err(Error::Simulation(format!(
+                "--blocks {unknown}: the package has no such block; it has {}",
+                names.join(", ")
+            )));
+        }
+        names.retain(|n| wanted.contains(n));
+    }
     for program in simulator.programs() {
         if !on_path(program) {
             return Err(Error::Simulation(format!(

@@ -155,6 +155,8 @@ pub struct Results {
     pub kf_directed: Option<KfCounts>,
     /// The mean filter's output overflows.
     pub mean_filter_overflows: Option<u64>,
+    /// What the gyro loop's recorded run covered.
+    pub gyro_loop_record: Option<crate::blocks::gyro_loop::RecordSummary>,
 }
 
 /// Everything the run produced.
@@ -179,6 +181,8 @@ pub struct Run {
     pub report: Report,
     /// Chain samples (excluding resets).
     pub samples: usize,
+    /// What the gyro loop's recorded run covered.
+    pub gyro_loop_record: crate::blocks::gyro_loop::RecordSummary,
 }
 
 /// Runs the chain for `job` and builds the vectors of every registered block that has them;
@@ -333,6 +337,7 @@ pub fn run(job: &Job, roms: &RomImages) -> Result<Run> {
             ties: results.ties.expect(REGISTERED),
             report,
             samples: n,
+            gyro_loop_record: results.gyro_loop_record.expect(REGISTERED),
         })
     })
 }
@@ -468,8 +473,25 @@ mod tests {
         let names: Vec<&str> = run.blocks.iter().map(|b| b.name).collect();
         assert_eq!(
             names,
-            ["sequencer", "estimator", "kf", "top", "mean_filter"]
+            [
+                "sequencer",
+                "estimator",
+                "kf",
+                "top",
+                "mean_filter",
+                "gyro_loop"
+            ]
         );
+        // The loop's recorded window covers lock acquisition in normal mode, the switch and
+        // the re-lock in reverse mode, with a decimated output every 1000 samples.
+        let record = run.gyro_loop_record;
+        let [normal, reverse] = record.first_lock_sample;
+        let normal = normal.expect("the loop locks in normal mode");
+        let reverse = reverse.expect("the loop re-locks in reverse mode");
+        assert!(normal < record.switch_sample && reverse > record.switch_sample);
+        assert!(reverse < record.samples);
+        assert_eq!(record.outputs, record.samples / 1000);
+        assert_eq!(run.blocks[5].len(), record.samples);
         // One row per sample plus the reset, in every chain block.
         for b in [&run.blocks[0], &run.blocks[1], &run.blocks[3]] {
             assert_eq!(b.len(), 4001, "{}", b.name);

@@ -1,9 +1,10 @@
 //! `gyrofx loop`: both resonator-level gyros closed by their fixed-point loops, in both modes at
 //! a constant input rate, each figure beside SPEC §1.6's closed-form prediction.
 
+use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::{bail, Result};
+use anyhow::Result;
 use serde::Serialize;
 
 use gyrofx_model::gyro_loop::closed::FixedHarness;
@@ -11,7 +12,11 @@ use gyrofx_model::gyro_loop::figures::{
     characterize, Characterization, Figure, ModeCharacterization, Procedure,
 };
 
+use gyrofx_codegen::plot;
+use gyrofx_model::gyro_loop::trace::{switch_trace, TraceSpec};
+
 use super::options::ConfigSource;
+use super::usage;
 
 /// Run both gyros' closed loops (resonator physics, NCO, PLL, AGC, sense demodulation, CIC,
 /// 1/SF) in normal and reverse mode at a constant rate and print, per gyro and mode, the
@@ -35,6 +40,10 @@ pub struct Args {
     /// Print JSON instead of the table.
     #[arg(long)]
     json: bool,
+    /// Also plot both gyros across a switch (normal to reverse at t = 0): drive amplitude, NCO
+    /// frequency and rate output against time, the re-lock marked (.png or .svg).
+    #[arg(long)]
+    plot: Option<PathBuf>,
 }
 
 /// One gyro's figures.
@@ -48,16 +57,19 @@ struct GyroFigures {
 /// Characterizes both gyros and prints the figures.
 pub fn run(args: Args) -> Result<ExitCode> {
     if !(args.seconds.is_finite() && args.seconds > 0.0 && args.seconds <= 100.0) {
-        bail!(
+        usage!(
             "--seconds {} is not allowed: a number of seconds in (0, 100]",
             args.seconds
         );
     }
     if !(args.rate_dps.is_finite() && args.rate_dps != 0.0 && args.rate_dps.abs() <= 1e4) {
-        bail!(
+        usage!(
             "--rate-dps {} is not allowed: a non-zero rate within ±10000 °/s",
             args.rate_dps
         );
+    }
+    if let Some(path) = &args.plot {
+        plot::check_path(path).map_err(|e| super::Usage(format!("--plot: {e}")))?;
     }
     let config = args.source.load()?;
     let loops = config.gyro_loops()?;
@@ -97,6 +109,39 @@ pub fn run(args: Args) -> Result<ExitCode> {
         println!("{}", serde_json::to_string_pretty(&figures)?);
     } else {
         print_table(&figures);
+    }
+    if let Some(path) = &args.plot {
+        let traces = std::thread::scope(|scope| {
+            let handles: Vec<_> = loops
+                .iter()
+                .enumerate()
+                .map(|(index, gyro)| {
+                    let spec = TraceSpec {
+                        rate_dps: args.rate_dps,
+                        noise: args.noise,
+                        seed: config.seed.wrapping_mul(2).wrapping_add(index as u64),
+                        ..TraceSpec::default()
+                    };
+                    scope.spawn(move || {
+                        switch_trace(&gyro.plan, &gyro.params, &gyro.front_end, &spec)
+                    })
+                })
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| h.join().expect("the loop simulation does not panic"))
+                .collect::<std::result::Result<Vec<_>, _>>()
+        })?;
+        let series: Vec<plot::LoopTrace> = loops
+            .iter()
+            .zip(&traces)
+            .map(|(gyro, points)| plot::LoopTrace {
+                label: format!("gyro {}", gyro.name),
+                points,
+            })
+            .collect();
+        plot::gyro_loop(path, &series)?;
+        eprintln!("wrote {}", path.display());
     }
     Ok(ExitCode::SUCCESS)
 }

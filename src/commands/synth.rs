@@ -7,7 +7,7 @@ use anyhow::Result;
 
 use gyrofx_codegen::generate::Output;
 use gyrofx_codegen::job::Job;
-use gyrofx_codegen::synth::{synthesize, TOP};
+use gyrofx_codegen::synth::{synthesize, LOOP_TOP, TOP};
 
 use super::options::{ConfigSource, OutputFolder};
 
@@ -32,20 +32,17 @@ pub fn run(args: Args) -> Result<ExitCode> {
     let config = source.load()?;
     let job = Job::new(config)?;
     let provenance = source.provenance(&job, Output::Synthesis);
-    let resources = synthesize(&job, out, folder.replace(), &provenance)?;
-    let (g, x) = (&resources.generic, &resources.xilinx);
+    let synthesis = synthesize(&job, out, folder.replace(), &provenance)?;
     println!(
-        "synthesis check passed: {}; report in {}",
-        TOP,
+        "synthesis check passed: {TOP}, {LOOP_TOP}; report in {}",
         out.join("report.md").display()
     );
-    println!(
-        "generic: {} cells, {} flip-flops, {} multipliers",
-        g.cells, g.flip_flops, g.multipliers
-    );
-    println!(
-        "xilinx 7-series: {} LUTs, {} flip-flops, {} DSP48E1, {} block RAM",
-        x.luts, x.flip_flops, x.dsp48, x.block_rams
-    );
+    for (module, resources) in [(TOP, &synthesis.chain), (LOOP_TOP, &synthesis.gyro_loop)] {
+        let (g, x) = (&resources.generic, &resources.xilinx);
+        println!(
+            "{module} generic: {} cells, {} flip-flops, {} multipliers; xilinx 7-series: {} LUTs, {} flip-flops, {} DSP48E1, {} block RAM",
+            g.cells, g.flip_flops, g.multipliers, x.luts, x.flip_flops, x.dsp48, x.block_rams
+        );
+    }
     Ok(ExitCode::SUCCESS)
 }

@@ -30,6 +30,9 @@ pub struct Args {
     /// Write a VCD per testbench (tb_<module>.vcd in each block folder).
     #[arg(long)]
     waves: bool,
+    /// Only these blocks, comma-separated (default: every block of the package).
+    #[arg(long, value_delimiter = ',')]
+    blocks: Option<Vec<String>>,
     /// Write a JUnit XML summary here (one testsuite per simulator, one testcase per block).
     #[arg(long)]
     junit: Option<PathBuf>,
@@ -45,6 +48,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
         max_reported,
         max_mismatches,
         waves,
+        blocks,
         junit: junit_path,
     } = args;
     let options = simulate::Options {
@@ -52,6 +56,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
         max_reported,
         max_mismatches,
         waves,
+        blocks,
     };
     let simulators: Vec<Simulator> = if sim == "all" {
         Simulator::ALL.to_vec()

@@ -13,6 +13,7 @@
 
 pub mod calibration;
 pub mod estimator;
+pub mod gyro_loop;
 pub mod kf;
 pub mod mean_filter;
 pub mod sequencer;
@@ -71,6 +72,7 @@ pub static REGISTRY: &[&dyn RtlBlock] = &[
     &kf::Kf,
     &top::Top,
     &mean_filter::MeanFilter,
+    &gyro_loop::GyroLoop,
 ];
 
 /// The registered block called `name`.

@@ -44,7 +44,7 @@ pub fn header(fields: &[&Signal], with_rst: bool) -> String {
 }
 
 /// Clocks the testbench may take for `vectors` samples before it declares a timeout: one per
-/// sample, one idle per four, the reset and slack.
-pub fn timeout_clocks(vectors: usize) -> u64 {
-    3 * vectors as u64 + 100
+/// sample, one idle per four, `settle` per sample, the reset and slack.
+pub fn timeout_clocks(vectors: usize, settle: u32) -> u64 {
+    (3 + u64::from(settle)) * vectors as u64 + 100
 }

@@ -91,7 +91,7 @@ reg ce = 1'b0;",
         title = block.title,
         max = MAX_REPORTED,
         params = block.file("params.vh"),
-        timeout_clocks = super::timeout_clocks(block.len()),
+        timeout_clocks = super::timeout_clocks(block.len(), block.settle_clocks),
     );
     for s in &block.inputs {
         let _ = writeln!(out, "{}", declaration("reg", s, "", true));
@@ -302,6 +302,13 @@ initial begin
         out,
         "        @(negedge clk);\n        rst = 1'b0;\n        ce = 1'b0;"
     );
+    if block.settle_clocks > 0 {
+        let _ = writeln!(
+            out,
+            "        // The pipeline's latency: registered outputs settle these clocks later.\n        repeat ({}) @(negedge clk);",
+            block.settle_clocks
+        );
+    }
     for o in block
         .outputs
         .iter()

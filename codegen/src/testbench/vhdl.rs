@@ -126,7 +126,7 @@ architecture sim of {tb} is
     signal rst : std_logic := '1';
     signal ce : std_logic := '0';",
         count = block.len(),
-        timeout = timeout_clocks(block.len()),
+        timeout = timeout_clocks(block.len(), block.settle_clocks),
     );
     for s in &block.inputs {
         let zero = if s.flag { "'0'" } else { "(others => '0')" };
@@ -327,9 +327,19 @@ begin
         out,
         "            wait until falling_edge(clk);
             rst <= '0';
-            ce <= '0';
-            if not masked then"
+            ce <= '0';"
     );
+    if block.settle_clocks > 0 {
+        let _ = writeln!(
+            out,
+            "            -- The pipeline's latency: registered outputs settle these clocks later.
+            for settle in 1 to {} loop
+                wait until falling_edge(clk);
+            end loop;",
+            block.settle_clocks
+        );
+    }
+    let _ = writeln!(out, "            if not masked then");
     for o in block
         .outputs
         .iter()

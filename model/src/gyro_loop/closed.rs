@@ -12,7 +12,7 @@
 //! only what the caller keeps is stored. A mode change calls [`Resonator::set_mode`] and is
 //! given to the loop's `mode` input at the same sample.
 
-use super::gyro::{FixedGyroLoop, FloatGyroLoop, Plan};
+use super::gyro::{FixedGyroLoop, FixedStep, FloatGyroLoop, Plan};
 use crate::resonator::{
     Mode, ModeFigures, ParamError, PhysicsSettings, Resonator, ResonatorParams,
 };
@@ -269,6 +269,62 @@ pub fn run<L: LoopUnderTest>(
     Ok((0..chain_samples)
         .map(|n| closed.step_chain(rate(n), mode(n)))
         .collect())
+}
+
+/// One ADC sample of a recorded closed-loop run: what the fixed loop was given and what it
+/// did, as the loop's RTL sees it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RecordedSample {
+    /// The ADC codes `[x, y]` the loop took (ADC format).
+    pub adc: [i64; 2],
+    /// The mode input.
+    pub mode: Mode,
+    /// The DAC codes and the chain-rate output.
+    pub step: FixedStep,
+    /// The lock flag after the sample.
+    pub locked: bool,
+}
+
+/// The fixed loop of `plan` closed around the physics (`params`, `physics`, random streams
+/// from `seed`) from reset, at the input rate `rate_dps` (°/s): `samples` ADC samples in normal
+/// mode up to sample `switch_at` and in reverse mode from it, each recorded. The loop's RTL
+/// given the recorded ADC codes and modes must reproduce every recorded output.
+///
+/// # Errors
+/// [`ParamError`] for invalid physics.
+pub fn record(
+    plan: &Plan,
+    params: &ResonatorParams,
+    physics: &PhysicsSettings,
+    seed: u64,
+    rate_dps: f64,
+    samples: usize,
+    switch_at: usize,
+) -> Result<Vec<RecordedSample>, ParamError> {
+    let mut resonator = Resonator::new(params, physics, seed)?;
+    resonator.set_rate(rate_dps.to_radians());
+    let mut gyro = FixedGyroLoop::new(plan);
+    let mut adc = [0i64; 2];
+    let mut out = Vec::with_capacity(samples);
+    for k in 0..samples {
+        let mode = if k < switch_at {
+            Mode::Normal
+        } else {
+            Mode::Reverse
+        };
+        if k == switch_at {
+            resonator.set_mode(mode);
+        }
+        let step = gyro.step(adc, mode);
+        out.push(RecordedSample {
+            adc,
+            mode,
+            step,
+            locked: gyro.locked(),
+        });
+        adc = resonator.step_codes(step.dac);
+    }
+    Ok(out)
 }
 
 #[cfg(test)]
