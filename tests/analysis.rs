@@ -475,6 +475,32 @@ fn reproduce_paper_004_compares_its_table_2() {
     let out = ok(&["reproduce", "--paper", "004", "--samples", "20000"]);
     assert!(out.contains("| N (°/√s) | 1.180e-4 \\|"), "{out}");
     assert!(out.contains("ADEV at 1 s"), "{out}");
+    // At resonator level: the damping coupling is the same in both modes and leaves nothing
+    // after reversal; the quadrature leak leaves the residual, measured on the closed loop
+    // within a few mdps of its closed form.
+    let row = |gyro: &str, term: &str| -> Vec<String> {
+        out.lines()
+            .find(|l| l.starts_with(&format!("| {gyro} | {term}")))
+            .unwrap_or_else(|| panic!("no {gyro} {term} row: {out}"))
+            .split('|')
+            .map(|c| c.trim().to_string())
+            .collect()
+    };
+    for gyro in ["a", "b"] {
+        let damping = row(gyro, "damping coupling");
+        assert_eq!(damping[3], damping[4], "{damping:?}");
+        assert_eq!(damping[5], "+0.00e0", "{damping:?}");
+        let leak = row(gyro, "quadrature leak");
+        let left: f64 = leak[5].parse().unwrap();
+        assert!(left < -5e-3 && left > -2e-2, "{leak:?}");
+        let bias = row(gyro, "bias, measured");
+        let residual: Vec<f64> = bias[5]
+            .split(['(', ')', ' '])
+            .filter_map(|t| t.parse().ok())
+            .collect();
+        assert!((residual[0] - residual[1]).abs() < 5e-3, "{bias:?}");
+    }
+    assert!(out.contains("**Cancelled exactly:**") && out.contains("**Left:**"));
     let log = fails(&["reproduce", "--paper", "004", "--samples", "100"]);
     assert!(log.contains("--samples 100 is too few"), "{log}");
 }
