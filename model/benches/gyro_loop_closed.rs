@@ -1,5 +1,7 @@
 //! One gyro closed: the resonator physics and the fixed-point loop, per ADC sample (goal:
-//! >= 10 M gyro-samples/s on one core), and the fixed loop alone on recorded ADC codes.
+//! >= 10 M gyro-samples/s on one core), noiseless and with the front end's noise and drift;
+//! both gyros on two threads (as `generate` runs them); and the fixed loop alone on recorded
+//! ADC codes.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 
@@ -20,6 +22,28 @@ fn closed_loop(c: &mut Criterion) {
     group.bench_function("physics_and_fixed_loop_64k", |b| {
         b.iter(|| black_box(closed.advance(N)))
     });
+
+    let mut noisy = FixedClosedLoop::new(&plan, &spec.resonator, &spec.front_end, 1).unwrap();
+    noisy.set(10.0, Mode::Normal);
+    noisy.advance(200_000);
+    group.bench_function("physics_with_noise_and_fixed_loop_64k", |b| {
+        b.iter(|| black_box(noisy.advance(N)))
+    });
+
+    // Two gyros, one thread each: twice the samples per iteration.
+    let mut pair = [noisy.clone(), noisy.clone()];
+    group.throughput(Throughput::Elements(2 * u64::from(N)));
+    group.bench_function("two_gyros_with_noise_on_two_threads_2x64k", |b| {
+        b.iter(|| {
+            let [a, b] = &mut pair;
+            std::thread::scope(|scope| {
+                let other = scope.spawn(|| black_box(b.advance(N)));
+                black_box(a.advance(N));
+                other.join().expect("no panic");
+            })
+        })
+    });
+    group.throughput(Throughput::Elements(u64::from(N)));
 
     // The loop alone, on ADC codes recorded from the locked closed loop.
     let mut recorder = closed.clone();
