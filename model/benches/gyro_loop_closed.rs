@@ -1,7 +1,7 @@
-//! One gyro closed: the resonator physics and the fixed-point loop, per ADC sample (goal:
-//! >= 10 M gyro-samples/s on one core), noiseless and with the front end's noise and drift;
-//! both gyros on two threads (as `generate` runs them); and the fixed loop alone on recorded
-//! ADC codes.
+//! One gyro closed: the resonator physics and the fixed-point loop, per ADC sample (goal: at
+//! least 10 M gyro-samples/s on one core), noiseless and with the front end's noise and
+//! drift; both gyros on two threads (as `generate` runs them); and the fixed loop alone on
+//! recorded ADC codes.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 
