@@ -565,3 +565,88 @@ fn overflow_is_a_warning_and_strict_makes_it_an_error() {
     assert!(clean.status.success(), "{}", text(&clean));
     assert!(!text(&clean).contains("warning"), "{}", text(&clean));
 }
+
+/// `allan` and `davar` refuse what they cannot analyse, naming it: values whose Allan sums
+/// would overflow (the row), a constant record, a non-finite PID gain, PID options without
+/// `--adaptive`, an unknown kind (usage errors exit 2); the plot's title names the kind.
+#[test]
+fn allan_and_davar_refuse_what_they_cannot_analyse() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, values: &[f64]| {
+        let rows: String = values.iter().map(|v| format!("{v:e}\n")).collect();
+        let path = dir.path().join(name);
+        std::fs::write(&path, format!("rate_dps\n{rows}")).unwrap();
+        path.to_string_lossy().into_owned()
+    };
+    let mut huge = vec![0.5; 100];
+    huge[37] = 1e300;
+    let huge = write("huge.csv", &huge);
+    let log = fails(&["allan", "--input", &huge, "--rate", "100"]);
+    assert!(
+        log.contains("value 37 = 1e300") && log.contains("overflow"),
+        "{log}"
+    );
+    let constant = write("constant.csv", &[2.5; 100]);
+    let log = fails(&["allan", "--input", &constant, "--rate", "100"]);
+    assert!(log.contains("constant (2.5 at every sample)"), "{log}");
+    assert!(!log.contains("NaN"), "{log}");
+
+    let noise: Vec<f64> = (0..4000)
+        .map(|k| ((k * 7919) % 1000) as f64 / 1000.0)
+        .collect();
+    let noise = write("noise.csv", &noise);
+    for (args, needle) in [
+        (
+            vec![
+                "davar",
+                "--input",
+                &noise,
+                "--rate",
+                "100",
+                "--window",
+                "401",
+                "--adaptive",
+                "--kp",
+                "nan",
+            ],
+            "--kp NaN is not allowed",
+        ),
+        (
+            vec![
+                "davar", "--input", &noise, "--rate", "100", "--window", "401", "--kp", "3",
+            ],
+            "--adaptive",
+        ),
+        (
+            vec![
+                "allan", "--input", &noise, "--rate", "100", "--kind", "total",
+            ],
+            "--kind total is not a deviation",
+        ),
+        (
+            vec![
+                "allan", "--input", &noise, "--rate", "100", "--taus", "some",
+            ],
+            "--taus",
+        ),
+    ] {
+        let output = gyrofx(&args);
+        let log = text(&output);
+        assert_eq!(output.status.code(), Some(2), "{args:?}: {log}");
+        assert!(log.contains(needle), "{args:?}: {log}");
+    }
+    let svg = dir.path().join("hadamard.svg");
+    ok(&[
+        "allan",
+        "--input",
+        &noise,
+        "--rate",
+        "100",
+        "--kind",
+        "hadamard",
+        "--plot",
+        svg.to_str().unwrap(),
+    ]);
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.contains("Hadamard deviation") && !text.contains(">Allan deviation<"));
+}

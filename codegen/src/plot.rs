@@ -82,6 +82,7 @@ const COLORS: [RGBColor; 6] = [
 fn draw_allan<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     series: &[AllanSeries],
+    title: &str,
 ) -> std::result::Result<(), String> {
     let e = |x: &dyn std::fmt::Display| x.to_string();
     area.fill(&WHITE).map_err(|x| e(&x))?;
@@ -107,7 +108,7 @@ fn draw_allan<DB: DrawingBackend>(
         dmax = dmin * 10.0;
     }
     let mut chart = ChartBuilder::on(area)
-        .caption("Allan deviation", ("sans-serif", 24))
+        .caption(title, ("sans-serif", 24))
         .margin(12)
         .x_label_area_size(48)
         .y_label_area_size(80)
@@ -472,16 +473,30 @@ fn is_svg(path: &Path) -> Result<bool> {
 /// # Errors
 /// A bad extension, no font, or a failure to draw or write.
 pub fn allan(path: &Path, series: &[AllanSeries]) -> Result<()> {
+    deviation(path, series, "Allan deviation")
+}
+
+/// Writes the plot of `series` to `path` (PNG or SVG) titled `title` (the deviation's kind:
+/// "Modified Allan deviation", "Hadamard deviation", ...).
+///
+/// # Errors
+/// A bad extension, no font, or a failure to draw or write.
+pub fn deviation(path: &Path, series: &[AllanSeries], title: &str) -> Result<()> {
     let svg = is_svg(path)?;
     ensure_font()?;
     let size = (1000, 700);
     atomically(path, |staged| {
         if svg {
-            draw_allan(&SVGBackend::new(staged, size).into_drawing_area(), series)
+            draw_allan(
+                &SVGBackend::new(staged, size).into_drawing_area(),
+                series,
+                title,
+            )
         } else {
             draw_allan(
                 &BitMapBackend::new(staged, size).into_drawing_area(),
                 series,
+                title,
             )
         }
     })

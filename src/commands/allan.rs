@@ -10,6 +10,7 @@ use gyrofx_codegen::input::read_column_with_gaps;
 use gyrofx_model::analysis::{allan, noise};
 
 use super::options::SampleRate;
+use super::usage;
 
 /// Allan deviation of rate records (°/s) with 1σ confidence intervals, and the five noise
 /// terms fitted to it.
@@ -50,13 +51,15 @@ pub fn run(args: Args) -> Result<ExitCode> {
         plot,
     } = args;
     let rate = rate.hz()?;
-    let grid: allan::Grid = taus.parse().map_err(anyhow::Error::msg)?;
+    let grid: allan::Grid = taus
+        .parse()
+        .map_err(|e: String| super::Usage(format!("--taus: {e}")))?;
     let kind = match kind.as_str() {
         "overlapping" => allan::Kind::Overlapping,
         "nonoverlapping" => allan::Kind::NonOverlapping,
         "modified" => allan::Kind::Modified,
         "hadamard" => allan::Kind::Hadamard,
-        other => bail!("--kind {other} is not a deviation: expected overlapping, nonoverlapping, modified or hadamard"),
+        other => usage!("--kind {other} is not a deviation: expected overlapping, nonoverlapping, modified or hadamard"),
     };
     let mut results = Vec::new();
     let mut curves = Vec::new();
@@ -79,6 +82,22 @@ pub fn run(args: Args) -> Result<ExitCode> {
                 values.len()
             );
         }
+        // The phase sums N·max|y| and their squares must stay finite.
+        let limit = 1e150 / values.len() as f64;
+        if let Some((row, v)) = values.iter().enumerate().find(|(_, v)| v.abs() > limit) {
+            bail!(
+                "{}: column {column}, value {row} = {v:e} is beyond ±{limit:.1e}: the Allan sums of {} such samples would overflow",
+                path.display(),
+                values.len()
+            );
+        }
+        if values.iter().all(|v| *v == values[0]) {
+            bail!(
+                "{}: column {column} is constant ({} at every sample): its deviation is 0 at every τ and there is no noise to fit",
+                path.display(),
+                values[0]
+            );
+        }
         let points = allan::curve(kind, &values, rate, grid);
         let terms = noise::fit(&points);
         let report = noise::report(&points, &terms);
@@ -88,7 +107,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
             path.display().to_string()
         };
         curves.push((label, points.clone(), terms));
-        // Welch with the largest power-of-two segment up to N/8 (at most 4096).
+        // Welch with the largest power-of-two segment up to N/8 (at most 2048).
         let segment = (values.len() / 8).clamp(8, 4096).next_power_of_two() / 2;
         let density = (segment >= 8)
             .then(|| gyrofx_model::analysis::spectrum::welch(&values, rate, segment.max(8)))
@@ -173,7 +192,13 @@ pub fn run(args: Args) -> Result<ExitCode> {
                 terms: Some(terms),
             })
             .collect();
-        gyrofx_codegen::plot::allan(path, &series)?;
+        let title = match kind {
+            allan::Kind::Overlapping => "Overlapping Allan deviation",
+            allan::Kind::NonOverlapping => "Allan deviation (non-overlapping)",
+            allan::Kind::Modified => "Modified Allan deviation",
+            allan::Kind::Hadamard => "Overlapping Hadamard deviation",
+        };
+        gyrofx_codegen::plot::deviation(path, &series, title)?;
         if !json {
             println!("plot: {}", path.display());
         }

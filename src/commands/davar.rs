@@ -26,15 +26,20 @@ pub struct Args {
     /// Adapt the window with the PID controller.
     #[arg(long)]
     adaptive: bool,
-    /// Shortest adaptive window, samples (default: window / 10).
-    #[arg(long)]
+    /// Shortest adaptive window, samples (default: window / 10; needs --adaptive).
+    #[arg(long, requires = "adaptive")]
     min_window: Option<usize>,
-    /// PID gains, samples per unit of the deviation index (defaults: window/25, window/50, 0).
-    #[arg(long, allow_negative_numbers = true)]
+    /// PID proportional gain, samples per unit of the deviation index (default: window / 25;
+    /// needs --adaptive).
+    #[arg(long, allow_negative_numbers = true, requires = "adaptive")]
     kp: Option<f64>,
-    #[arg(long, allow_negative_numbers = true)]
+    /// PID integral gain, samples per unit of the summed deviation index (default: window / 50;
+    /// needs --adaptive).
+    #[arg(long, allow_negative_numbers = true, requires = "adaptive")]
     ki: Option<f64>,
-    #[arg(long, allow_negative_numbers = true)]
+    /// PID derivative gain, samples per unit of the index's change (default: 0; needs
+    /// --adaptive).
+    #[arg(long, allow_negative_numbers = true, requires = "adaptive")]
     kd: Option<f64>,
     /// Samples between window centres (default: window / 20).
     #[arg(long)]
@@ -64,6 +69,11 @@ pub fn run(args: Args) -> Result<ExitCode> {
         plot,
     } = args;
     let rate = rate.hz()?;
+    for (name, gain) in [("--kp", kp), ("--ki", ki), ("--kd", kd)] {
+        if let Some(g) = gain.filter(|g| !g.is_finite()) {
+            usage!("{name} {g} is not allowed: a PID gain is a finite number");
+        }
+    }
     let (values, skipped) = csv.read_with_gaps()?;
     if window < 4 || window > values.len() {
         usage!(

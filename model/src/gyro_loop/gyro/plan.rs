@@ -142,41 +142,25 @@ fn config_key(keys: Keys) -> impl Fn(PlanError) -> PlanError {
                 Some(key) => field_error("loop", key, value, allowed.clone()),
                 None => error,
             },
-            PlanError::CoefficientOverflow {
-                name,
-                value,
-                format,
-                bits_needed,
-                ..
-            } => match key(&format!("coefficient {name}")) {
-                Some(key) => field_error(
-                    "loop",
-                    key,
-                    format.width,
-                    format!(
-                        "a width that holds the designed {} {name} = {value:e}: it needs {bits_needed} bits in {format}",
-                        key.split('_').next().unwrap_or("loop")
+            PlanError::CoefficientOverflow { name, format, .. }
+            | PlanError::CoefficientZero { name, format, .. } => {
+                let Some(key) = key(&format!("coefficient {name}")) else {
+                    return error.clone();
+                };
+                let block = key.split('_').next().unwrap_or("loop");
+                let allowed = match &error {
+                    PlanError::CoefficientOverflow {
+                        value, bits_needed, ..
+                    } => format!(
+                        "a width that holds the designed {block} {name} = {value:e}: it needs {bits_needed} bits in {format}"
                     ),
-                ),
-                None => error,
-            },
-            PlanError::CoefficientZero {
-                name,
-                value,
-                format,
-                ..
-            } => match key(&format!("coefficient {name}")) {
-                Some(key) => field_error(
-                    "loop",
-                    key,
-                    format.width,
-                    format!(
-                        "a width at which the designed {} {name} = {value:e} does not round to zero (it does in {format})",
-                        key.split('_').next().unwrap_or("loop")
+                    PlanError::CoefficientZero { value, .. } => format!(
+                        "a width at which the designed {block} {name} = {value:e} does not round to zero (it does in {format})"
                     ),
-                ),
-                None => error,
-            },
+                    _ => unreachable!("the arm matched a coefficient error"),
+                };
+                field_error("loop", key, format.width, allowed)
+            }
             PlanError::Intermediate { .. } => error,
         }
     }
