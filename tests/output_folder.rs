@@ -284,3 +284,32 @@ fn a_moved_package_verifies_in_ghdl() {
     ]);
     assert!(log.contains("ghdl: passed"), "{log}");
 }
+
+/// `generate --blocks` writes only the named blocks' folders and Makefile targets, `--no-csv`
+/// leaves out the CSV twins, and the package still verifies; an unknown block is a usage error
+/// that writes nothing.
+#[test]
+fn generate_writes_only_the_blocks_asked_for() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("pkg");
+    let output = generate(dir.path(), &out, &["--blocks", "kf,top", "--no-csv"]);
+    assert!(output.status.success(), "{}", text(&output));
+    for block in ["sequencer", "estimator", "mean_filter", "gyro_loop"] {
+        assert!(!out.join(block).exists(), "{block}");
+    }
+    assert!(out.join("kf/kf_expected.hex").is_file());
+    assert!(!out.join("kf/kf_vectors.csv").exists());
+    let makefile = std::fs::read_to_string(out.join("Makefile")).unwrap();
+    assert!(
+        makefile.contains("sim-iverilog: iverilog-kf iverilog-top\n"),
+        "{makefile}"
+    );
+    let log = ok(&["verify", "--out", out.to_str().unwrap()]);
+    assert_eq!(log.matches("PASS n=").count(), 2, "{log}");
+
+    let other = dir.path().join("other");
+    let output = generate(dir.path(), &other, &["--blocks", "kf,foo"]);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(text(&output).contains("--blocks foo: no such block"));
+    assert!(!other.exists());
+}

@@ -4,7 +4,7 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 
 use gyrofx_codegen::config::Config;
-use gyrofx_codegen::generate::{generate, provenance, Options, Output};
+use gyrofx_codegen::generate::{generate, provenance, Contents, Options, Output};
 use gyrofx_codegen::job::Job;
 use gyrofx_codegen::output_folder::Replace;
 
@@ -26,6 +26,7 @@ fn generate_million(c: &mut Criterion) {
                 Options {
                     replace: Replace::IfOwned,
                     strict: false,
+                    contents: Contents::default(),
                 },
                 &provenance,
                 &mut |_| {},

@@ -69,7 +69,7 @@ pub fn provenance(
 }
 
 /// Every file of one block's folder.
-fn block_files(block: &Block, provenance: &Provenance) -> Vec<(String, String)> {
+fn block_files(block: &Block, csv: bool, provenance: &Provenance) -> Vec<(String, String)> {
     let (stimulus, expected) = writers::vector_hex(block, provenance);
     let mut files = vec![
         (
@@ -78,13 +78,17 @@ fn block_files(block: &Block, provenance: &Provenance) -> Vec<(String, String)> 
         ),
         (block.file("stimulus.hex"), stimulus),
         (block.file("expected.hex"), expected),
-        (
+    ];
+    if csv {
+        files.push((
             block.file("vectors.csv"),
             writers::vector_csv(block, provenance),
-        ),
+        ));
+    }
+    files.extend([
         (block.file("tb"), verilog::testbench(block, provenance)),
         (block.file("tb.vhd"), vhdl::testbench(block, provenance)),
-    ];
+    ]);
     files.extend(
         block
             .roms
@@ -138,12 +142,16 @@ fn block_manifest(block: &Block) -> serde_json::Value {
 /// Stimulus errors (a bad CSV file).
 pub fn build_package(
     job: &Job,
+    contents: &Contents,
     provenance: &Provenance,
     progress: &mut dyn FnMut(&str),
 ) -> Result<(Package, Summary)> {
     progress("chain run");
     let roms = RomImages::new(job, provenance);
-    let run = vectors::run(job, &roms)?;
+    let mut run = vectors::run(job, &roms)?;
+    if let Some(names) = &contents.blocks {
+        run.blocks.retain(|b| names.iter().any(|n| n == b.name));
+    }
     progress("files");
     let mut package = Package::new(Kind::Generate, writers::build_outputs(&run.blocks));
     package.add("README.md", writers::package_readme(&run, provenance));
@@ -164,7 +172,7 @@ pub fn build_package(
         let handles: Vec<_> = run
             .blocks
             .iter()
-            .map(|b| scope.spawn(move || block_files(b, provenance)))
+            .map(|b| scope.spawn(move || block_files(b, contents.csv, provenance)))
             .collect();
         handles
             .into_iter()
@@ -209,14 +217,58 @@ pub fn build_package(
     Ok((package, Summary { run, files }))
 }
 
-/// How [`generate`] treats its output folder and overflows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// What a package holds.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Contents {
+    /// Only these blocks' folders and Makefile targets (all when `None`); every block's
+    /// vectors are still computed and the manifest still reports the whole run.
+    pub blocks: Option<Vec<String>>,
+    /// The `<block>_vectors.csv` twins of the hex files.
+    pub csv: bool,
+}
+
+impl Default for Contents {
+    /// Every block, with its CSV.
+    fn default() -> Self {
+        Contents {
+            blocks: None,
+            csv: true,
+        }
+    }
+}
+
+impl Contents {
+    /// Refuses a block name the registry does not have.
+    ///
+    /// # Errors
+    /// A message naming the block and listing the registry's.
+    pub fn check(&self) -> std::result::Result<(), String> {
+        let known: Vec<&str> = REGISTRY.iter().map(|b| b.name()).collect();
+        match self
+            .blocks
+            .iter()
+            .flatten()
+            .find(|n| !known.contains(&n.as_str()))
+        {
+            Some(unknown) => Err(format!(
+                "--blocks {unknown}: no such block; the package's blocks are {}",
+                known.join(", ")
+            )),
+            None => Ok(()),
+        }
+    }
+}
+
+/// How [`generate`] treats its output folder and overflows, and what it writes.
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Options {
     /// Whether an existing folder may be replaced.
     pub replace: Replace,
     /// Refuse to write when a quantizer overflowed on the run's data
     /// ([`crate::vectors::Overflows::in_chain_run`]).
     pub strict: bool,
+    /// What the package holds.
+    pub contents: Contents,
 }
 
 /// `name count, name count, …` of [`crate::vectors::Overflows::in_chain_run`].
@@ -243,7 +295,7 @@ pub fn generate(
     progress: &mut dyn FnMut(&str),
 ) -> Result<Summary> {
     output_folder::check(out, Kind::Generate, options.replace)?;
-    let (package, summary) = build_package(job, provenance, progress)?;
+    let (package, summary) = build_package(job, &options.contents, provenance, progress)?;
     let overflowed = summary.run.overflows.in_chain_run();
     if options.strict && !overflowed.is_empty() {
         return Err(crate::error::Error::Overflow(overflow_list(&overflowed)));

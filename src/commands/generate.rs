@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::Result;
 
-use gyrofx_codegen::generate::{generate, overflow_list, Options, Output};
+use gyrofx_codegen::generate::{generate, overflow_list, Contents, Options, Output};
 use gyrofx_codegen::job::Job;
 
 use super::options::{ConfigSource, OutputFolder};
@@ -27,6 +27,13 @@ pub struct Args {
     /// (exit 1); without it, a warning names the signals.
     #[arg(long)]
     strict: bool,
+    /// Write only these blocks' folders and Makefile targets, comma-separated (e.g. kf,top;
+    /// calibration has none of its own: top checks it).
+    #[arg(long, value_delimiter = ',')]
+    blocks: Option<Vec<String>>,
+    /// Leave out the <block>_vectors.csv twins of the hex vector files.
+    #[arg(long)]
+    no_csv: bool,
 }
 
 /// Writes the package and prints what it holds: the files, the KF plan, the fixed-point
@@ -38,7 +45,14 @@ pub fn run(args: Args) -> Result<ExitCode> {
         samples,
         seed,
         strict,
+        blocks,
+        no_csv,
     } = args;
+    let contents = Contents {
+        blocks,
+        csv: !no_csv,
+    };
+    contents.check().map_err(super::Usage)?;
     let out = folder.out.as_path();
     let mut config = source.load()?;
     if let Some(n) = samples {
@@ -54,6 +68,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
     let options = Options {
         replace: folder.replace(),
         strict,
+        contents,
     };
     let summary = generate(&job, out, options, &provenance, &mut |phase| {
         if long {
