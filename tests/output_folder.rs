@@ -313,3 +313,39 @@ fn generate_writes_only_the_blocks_asked_for() {
     assert!(text(&output).contains("--blocks foo: no such block"));
     assert!(!other.exists());
 }
+
+/// Progress: on a terminal `verify` shows a bar with percent and ETA, `--quiet` hides it, and
+/// with stderr not a terminal nothing extra is printed. The terminal is `script`'s
+/// pseudo-terminal (util-linux, on every Debian).
+#[test]
+fn verify_shows_progress_only_on_a_terminal() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("pkg");
+    assert!(generate(dir.path(), &out, &["--blocks", "kf"])
+        .status
+        .success());
+    let command = |quiet: &str| {
+        format!(
+            "{} verify --out {} {quiet}",
+            env!("CARGO_BIN_EXE_gyrofx"),
+            out.display()
+        )
+    };
+    let on_terminal = |quiet: &str| {
+        let output = Command::new("script")
+            .args(["-qec", &command(quiet), "/dev/null"])
+            .output()
+            .expect("script (util-linux) runs");
+        assert!(output.status.success(), "{}", text(&output));
+        text(&output)
+    };
+    let shown = on_terminal("");
+    assert!(shown.contains("100%") && shown.contains("ETA"), "{shown}");
+    let hidden = on_terminal("--quiet");
+    assert!(
+        !hidden.contains("ETA") && hidden.contains("PASS n="),
+        "{hidden}"
+    );
+    let piped = ok(&["verify", "--out", out.to_str().unwrap()]);
+    assert!(!piped.contains("ETA") && !piped.contains('\r'), "{piped}");
+}

@@ -160,6 +160,14 @@ fn blocks(out: &Path, simulator: Simulator) -> Result<Vec<String>> {
 /// [`Error::Simulation`] when the folder is not a package or a program is missing (a missing
 /// simulator is an error, never a skipped check).
 pub fn run(out: &Path, simulator: Simulator, options: &Options) -> Result<Outcome> {
+    run_reporting(out, simulator, options, &mut |_| {})
+}
+
+/// The blocks [`run`] runs for `simulator`: the package's, or those of `options.blocks`.
+///
+/// # Errors
+/// [`Error::Simulation`] when the folder is not a package or names a block it lacks.
+pub fn block_names(out: &Path, simulator: Simulator, options: &Options) -> Result<Vec<String>> {
     let mut names = blocks(out, simulator)?;
     if let Some(wanted) = &options.blocks {
         if let Some(unknown) = wanted.iter().find(|w| !names.contains(w)) {
@@ -170,6 +178,20 @@ pub fn run(out: &Path, simulator: Simulator, options: &Options) -> Result<Outcom
         }
         names.retain(|n| wanted.contains(n));
     }
+    Ok(names)
+}
+
+/// [`run`], calling `done` after each block.
+///
+/// # Errors
+/// Those of [`run`].
+pub fn run_reporting(
+    out: &Path,
+    simulator: Simulator,
+    options: &Options,
+    done: &mut dyn FnMut(&BlockOutcome),
+) -> Result<Outcome> {
+    let names = block_names(out, simulator, options)?;
     for program in simulator.programs() {
         if !on_path(program) {
             return Err(Error::Simulation(format!(
@@ -201,13 +223,15 @@ pub fn run(out: &Path, simulator: Simulator, options: &Options) -> Result<Outcom
             .map(str::to_string)
             .collect();
         let passed = output.status.success() && report.iter().any(|l| l.starts_with("PASS "));
-        blocks.push(BlockOutcome {
+        let outcome = BlockOutcome {
             block,
             passed,
             report,
             log,
             seconds,
-        });
+        };
+        done(&outcome);
+        blocks.push(outcome);
     }
     Ok(Outcome { simulator, blocks })
 }

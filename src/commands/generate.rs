@@ -34,6 +34,9 @@ pub struct Args {
     /// Leave out the <block>_vectors.csv twins of the hex vector files.
     #[arg(long)]
     no_csv: bool,
+    /// No progress spinner (it shows only on a terminal).
+    #[arg(long)]
+    quiet: bool,
 }
 
 /// Writes the package and prints what it holds: the files, the KF plan, the fixed-point
@@ -47,6 +50,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
         strict,
         blocks,
         no_csv,
+        quiet,
     } = args;
     let contents = Contents {
         blocks,
@@ -62,8 +66,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
         config.seed = s;
     }
     let job = Job::new(config)?;
-    let bar = indicatif::ProgressBar::new_spinner();
-    let long = job.config.samples >= 1_000_000;
+    let bar = super::progress::spinner("generate", quiet);
     let provenance = source.provenance(&job, Output::Package);
     let options = Options {
         replace: folder.replace(),
@@ -71,12 +74,10 @@ pub fn run(args: Args) -> Result<ExitCode> {
         contents,
     };
     let summary = generate(&job, out, options, &provenance, &mut |phase| {
-        if long {
-            bar.set_message(format!("generate: {phase}"));
-            bar.tick();
-        }
-    })?;
+        bar.set_message(format!("generate: {phase}"));
+    });
     bar.finish_and_clear();
+    let summary = summary?;
     let run = &summary.run;
     let overflowed = run.overflows.in_chain_run();
     if !overflowed.is_empty() {

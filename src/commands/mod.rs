@@ -9,6 +9,7 @@ pub mod generate;
 pub mod gyro_loop;
 pub mod init;
 mod options;
+mod progress;
 pub mod reproduce;
 pub mod synth;
 pub mod verify;

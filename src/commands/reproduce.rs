@@ -30,6 +30,9 @@ pub struct Args {
     /// Replace --out even if it holds other files or another kind of package.
     #[arg(long, requires = "out")]
     force: bool,
+    /// No progress spinner (it shows only on a terminal).
+    #[arg(long)]
+    quiet: bool,
 }
 
 /// Prints the report; with `--out`, also writes it and its plots.
@@ -40,6 +43,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
         seed,
         out,
         force,
+        quiet,
     } = args;
     let paper = paper.as_str();
     let replace = super::options::replace(force);
@@ -47,6 +51,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
         // Before the simulation: a folder that cannot be written fails now, not minutes later.
         output_folder::check(folder, output_folder::Kind::Reproduce, replace)?;
     }
+    let spinner = super::progress::spinner(&format!("reproduce: paper {paper}"), quiet);
     let (report, curves, davar) = match paper {
         "000" => {
             let p = reproduce::paper_000(samples.unwrap_or(reproduce::SAMPLES_000), seed)?;
@@ -66,6 +71,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
         }
         other => usage!("--paper {other:?} is not one of the papers: use 000, 002, 003 or 004"),
     };
+    spinner.finish_and_clear();
     print!("{report}");
     if let Some(folder) = &out {
         let davar = davar.as_ref().map(|(d, c)| (d, c));

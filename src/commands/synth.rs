@@ -20,6 +20,9 @@ pub struct Args {
     out: OutputFolder,
     #[command(flatten)]
     source: ConfigSource,
+    /// No progress spinner (it shows only on a terminal).
+    #[arg(long)]
+    quiet: bool,
 }
 
 /// Synthesizes the chain and prints the resources of both targets.
@@ -27,12 +30,16 @@ pub fn run(args: Args) -> Result<ExitCode> {
     let Args {
         out: folder,
         source,
+        quiet,
     } = args;
     let out = folder.out.as_path();
     let config = source.load()?;
     let job = Job::new(config)?;
     let provenance = source.provenance(&job, Output::Synthesis);
-    let synthesis = synthesize(&job, out, folder.replace(), &provenance)?;
+    let spinner = super::progress::spinner("synth: yosys on the chain and the gyro loop", quiet);
+    let synthesis = synthesize(&job, out, folder.replace(), &provenance);
+    spinner.finish_and_clear();
+    let synthesis = synthesis?;
     println!(
         "synthesis check passed: {TOP}, {LOOP_TOP}; report in {}",
         out.join("report.md").display()

@@ -33,6 +33,9 @@ pub struct Args {
     /// Only these blocks, comma-separated (default: every block of the package).
     #[arg(long, value_delimiter = ',')]
     blocks: Option<Vec<String>>,
+    /// No progress bar (it shows only on a terminal).
+    #[arg(long)]
+    quiet: bool,
     /// Write a JUnit XML summary here (one testsuite per simulator, one testcase per block).
     #[arg(long)]
     junit: Option<PathBuf>,
@@ -49,6 +52,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
         max_mismatches,
         waves,
         blocks,
+        quiet,
         junit: junit_path,
     } = args;
     let options = simulate::Options {
@@ -65,26 +69,35 @@ pub fn run(args: Args) -> Result<ExitCode> {
             .map(|name| name.trim().parse())
             .collect::<std::result::Result<_, _>>()?
     };
+    let mut total = 0;
+    for simulator in &simulators {
+        total += simulate::block_names(&out, *simulator, &options)?.len() as u64;
+    }
+    let bar = super::progress::bar(total, "verify", quiet);
     let mut outcomes = Vec::with_capacity(simulators.len());
     for simulator in simulators {
-        let outcome = simulate::run(&out, simulator, &options)?;
-        for line in outcome.report() {
-            println!("{line}");
-        }
-        for block in outcome
-            .blocks
-            .iter()
-            .filter(|b| !b.passed && b.report.is_empty())
-        {
-            eprintln!("{}", block.log);
-        }
-        if outcome.passed() {
-            println!("{}: passed", simulator.name());
-        } else {
-            eprintln!("{}: FAILED", simulator.name());
-        }
+        bar.set_message(format!("verify: {}", simulator.name()));
+        let outcome = simulate::run_reporting(&out, simulator, &options, &mut |_| bar.inc(1))?;
+        bar.suspend(|| {
+            for line in outcome.report() {
+                println!("{line}");
+            }
+            for block in outcome
+                .blocks
+                .iter()
+                .filter(|b| !b.passed && b.report.is_empty())
+            {
+                eprintln!("{}", block.log);
+            }
+            if outcome.passed() {
+                println!("{}: passed", simulator.name());
+            } else {
+                eprintln!("{}: FAILED", simulator.name());
+            }
+        });
         outcomes.push(outcome);
     }
+    bar.finish_and_clear();
     if let Some(path) = &junit_path {
         std::fs::write(path, junit::report(&outcomes))
             .with_context(|| format!("cannot write the JUnit summary {}", path.display()))?;
