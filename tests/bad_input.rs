@@ -567,7 +567,7 @@ fn overflow_is_a_warning_and_strict_makes_it_an_error() {
 }
 
 /// `allan` and `davar` refuse what they cannot analyse, naming it: values whose Allan sums
-/// would overflow (the row), a constant record, a non-finite PID gain, PID options without
+/// would overflow (the row), a non-finite PID gain, PID options without
 /// `--adaptive`, an unknown kind (usage errors exit 2); the plot's title names the kind.
 #[test]
 fn allan_and_davar_refuse_what_they_cannot_analyse() {
@@ -586,10 +586,18 @@ fn allan_and_davar_refuse_what_they_cannot_analyse() {
         log.contains("value 37 = 1e300") && log.contains("overflow"),
         "{log}"
     );
+    // A constant record: every deviation 0, every noise term 0 (it was Q = NaN).
     let constant = write("constant.csv", &[2.5; 100]);
-    let log = fails(&["allan", "--input", &constant, "--rate", "100"]);
-    assert!(log.contains("constant (2.5 at every sample)"), "{log}");
-    assert!(!log.contains("NaN"), "{log}");
+    let log = ok(&["allan", "--input", &constant, "--rate", "100"]);
+    assert!(
+        log.contains("quantization Q") && !log.contains("NaN"),
+        "{log}"
+    );
+    let json = ok(&["allan", "--input", &constant, "--rate", "100", "--json"]);
+    assert!(
+        !json.contains("NaN") && !json.contains("null,\n    \"lo\""),
+        "{json}"
+    );
 
     let noise: Vec<f64> = (0..4000)
         .map(|k| ((k * 7919) % 1000) as f64 / 1000.0)

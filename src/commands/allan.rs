@@ -91,13 +91,6 @@ pub fn run(args: Args) -> Result<ExitCode> {
                 values.len()
             );
         }
-        if values.iter().all(|v| *v == values[0]) {
-            bail!(
-                "{}: column {column} is constant ({} at every sample): its deviation is 0 at every τ and there is no noise to fit",
-                path.display(),
-                values[0]
-            );
-        }
         let points = allan::curve(kind, &values, rate, grid);
         let terms = noise::fit(&points);
         let report = noise::report(&points, &terms);

@@ -118,6 +118,21 @@ struct Candidate {
 /// On an empty curve.
 pub fn fit(curve: &[Point]) -> Terms {
     assert!(!curve.is_empty(), "an Allan curve to fit");
+    let zero = Estimate {
+        value: 0.0,
+        lo: 0.0,
+        hi: 0.0,
+    };
+    if curve.iter().all(|p| p.dev == 0.0) {
+        // A constant record: no noise, and weights 1/σ⁴ that would divide by zero.
+        return Terms {
+            q: zero,
+            n: zero,
+            b: zero,
+            k: zero,
+            r: zero,
+        };
+    }
     let rows = curve.len();
     let weights: Vec<f64> = curve
         .iter()
@@ -151,11 +166,7 @@ pub fn fit(curve: &[Point]) -> Terms {
             });
         }
     }
-    let mut terms = [Estimate {
-        value: 0.0,
-        lo: 0.0,
-        hi: 0.0,
-    }; 5];
+    let mut terms = [zero; 5];
     if let Some(Candidate {
         active,
         c,
