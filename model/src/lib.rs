@@ -18,3 +18,4 @@ pub mod plant;
 pub mod resonator;
 pub mod sequencer;
 pub mod stimulus;
+pub mod system;
