@@ -26,6 +26,17 @@ if [ ${#missing[@]} -gt 0 ]; then
     DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq \
         iverilog verilator ghdl yosys make coreutils fonts-dejavu-core >/dev/null
 fi
+# GHDL's LLVM back end runs the closed-loop testbenches about 3x faster than the default mcode
+# one (2310 us of the system testbench: 90 s against 258 s); Debian's ghdl wrapper takes it from
+# GHDL_BACKEND. Where the package is not to be had, mcode runs the same tests, slower.
+if [ ! -x /usr/bin/ghdl-llvm ] && command -v apt-get >/dev/null 2>&1; then
+    echo "== installing ghdl-llvm"
+    sudo=""
+    if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
+    { $sudo apt-get update -qq && DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq ghdl-llvm >/dev/null; } \
+        || echo "== ghdl-llvm could not be installed: GHDL runs on its mcode back end"
+fi
+if [ -x /usr/bin/ghdl-llvm ]; then export GHDL_BACKEND=llvm; fi
 [ -f "$font" ] || { echo "FAIL: $font is still missing after apt-get (plots need it)" >&2; exit 1; }
 for program in iverilog vvp verilator ghdl yosys make sha256sum; do
     command -v "$program" >/dev/null 2>&1 || { echo "FAIL: $program is still missing after apt-get" >&2; exit 1; }
@@ -50,7 +61,7 @@ if ! command -v fusesoc >/dev/null 2>&1; then
 fi
 command -v fusesoc >/dev/null 2>&1 || { echo "FAIL: fusesoc is still missing" >&2; exit 1; }
 
-echo "== tools: $(iverilog -V 2>&1 | head -1); $(verilator --version); $(ghdl --version | head -1); $(yosys -V); fusesoc $(fusesoc --version)"
+echo "== tools: $(iverilog -V 2>&1 | head -1); $(verilator --version); $(ghdl --version | head -1) ($(ghdl --version | grep -i 'code generator' | sed 's/^ *//')); $(yosys -V); fusesoc $(fusesoc --version)"
 echo "== cargo fmt --check"
 cargo fmt --all -- --check
 echo "== cargo clippy --all-targets -D warnings"
@@ -62,13 +73,14 @@ for module in gyrofx_mean_filter gyrofx_nco gyrofx_demodulator gyrofx_pi gyrofx_
 done
 verilator --lint-only -Wall --top-module gyrofx_gyro_loop hdl/gyrofx_gyro_loop.v hdl/gyrofx_nco.v \
     hdl/gyrofx_demodulator.v hdl/gyrofx_pi.v hdl/gyrofx_cic.v hdl/gyrofx_quantize.v
+verilator --lint-only -Wall --top-module gyrofx_system hdl/*.v
 echo "== ghdl -a --std=08 -Werror (hdl/, compile order)"
 ghdl_work="$(mktemp -d)"
 ghdl -a --std=08 -Werror -Wunused -Wbinding -Wbody -Wspecs --workdir="$ghdl_work" \
     hdl/gyrofx_mem_pkg.vhd hdl/gyrofx_quantize.vhd hdl/gyrofx_kf.vhd hdl/gyrofx_sequencer.vhd \
     hdl/gyrofx_bias_estimator.vhd hdl/gyrofx_calibration.vhd hdl/gyrofx_top.vhd \
     hdl/gyrofx_mean_filter.vhd hdl/gyrofx_nco.vhd hdl/gyrofx_demodulator.vhd hdl/gyrofx_pi.vhd \
-    hdl/gyrofx_cic.vhd hdl/gyrofx_gyro_loop.vhd hdl/gyrofx_testbench_pkg.vhd
+    hdl/gyrofx_cic.vhd hdl/gyrofx_gyro_loop.vhd hdl/gyrofx_system.vhd hdl/gyrofx_testbench_pkg.vhd
 rm -rf "$ghdl_work"
 echo "== cargo test"
 cargo test --workspace

@@ -23,6 +23,9 @@ pub struct Signal {
     /// A 1-bit flag (`std_logic` in VHDL) rather than a vector (an index of any width, even
     /// 1 bit, is an `unsigned` there).
     pub flag: bool,
+    /// The unit of a signed signal's real value, the suffix of its CSV column (`dps`: °/s;
+    /// `fs`: full-scale units); empty where the code is all there is to say (DAC codes).
+    pub unit: &'static str,
 }
 
 impl Signal {
@@ -32,7 +35,13 @@ impl Signal {
             name,
             format,
             flag: false,
+            unit: "dps",
         }
+    }
+
+    /// The same signal with its real value in `unit` (empty: no real value).
+    pub fn with_unit(self, unit: &'static str) -> Self {
+        Signal { unit, ..self }
     }
 
     /// A 1-bit flag.
@@ -54,6 +63,11 @@ impl Signal {
     /// Whether it carries a real value worth printing (not a flag or an index).
     pub fn is_real(&self) -> bool {
         self.format.signed
+    }
+
+    /// The unit of the real-value CSV column beside its code, if it has one.
+    pub fn csv_unit(&self) -> Option<&'static str> {
+        (self.is_real() && !self.unit.is_empty()).then_some(self.unit)
     }
 }
 

@@ -118,8 +118,9 @@ fn block_manifest(block: &Block) -> serde_json::Value {
                 "name": o.signal.name,
                 "format": o.signal.format.to_string(),
                 "checked": match o.timing {
-                    Timing::Combinational => "before the clock edge that takes the sample (not on resets)",
-                    Timing::Registered => "1 clock after the sample's ce",
+                    Timing::Combinational => "before the clock edge that takes the sample (not on resets)".to_string(),
+                    Timing::Registered if block.settle_clocks == 0 => "1 clock after the sample's ce".to_string(),
+                    Timing::Registered => format!("{} clocks after the sample's ce (a pipeline of {} settle clocks)", 1 + block.settle_clocks, block.settle_clocks),
                 },
                 "only_where": o.gate.map(|g| format!("{g} = 1")),
                 "pulse": o.pulse,
@@ -204,7 +205,7 @@ pub fn build_package(
         "report": run.report,
     });
     let sections = manifest.as_object_mut().expect("an object");
-    for block in REGISTRY {
+    for block in crate::blocks::of(job) {
         if let Some((key, section)) = block.manifest(job, &roms, &run) {
             sections.insert(key.to_string(), section);
         }
@@ -253,6 +254,29 @@ impl Contents {
             Some(unknown) => Err(format!(
                 "--blocks {unknown}: no such block; the package's blocks are {}",
                 known.join(", ")
+            )),
+            None => Ok(()),
+        }
+    }
+}
+
+impl Contents {
+    /// Refuses a block that `job`'s package does not have (the system block on the rate
+    /// plant).
+    ///
+    /// # Errors
+    /// A message naming the block and listing the package's.
+    pub fn check_for(&self, job: &Job) -> std::result::Result<(), String> {
+        let present: Vec<&str> = crate::blocks::of(job).map(|b| b.name()).collect();
+        match self
+            .blocks
+            .iter()
+            .flatten()
+            .find(|n| !present.contains(&n.as_str()))
+        {
+            Some(absent) => Err(format!(
+                "--blocks {absent}: not in this package (the system block needs plant.model = \"resonator\"); its blocks are {}",
+                present.join(", ")
             )),
             None => Ok(()),
         }

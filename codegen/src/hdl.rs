@@ -2,7 +2,7 @@
 //! in compile order (a unit before its users), and the sources one module needs.
 
 /// The reference RTL, embedded so that every package is self-contained.
-pub const RTL_SOURCES: [(&str, &str); 12] = [
+pub const RTL_SOURCES: [(&str, &str); 13] = [
     (
         "gyrofx_quantize.v",
         include_str!("../../hdl/gyrofx_quantize.v"),
@@ -36,6 +36,7 @@ pub const RTL_SOURCES: [(&str, &str); 12] = [
         "gyrofx_gyro_loop.v",
         include_str!("../../hdl/gyrofx_gyro_loop.v"),
     ),
+    ("gyrofx_system.v", include_str!("../../hdl/gyrofx_system.v")),
 ];
 
 /// The Verilog sources `module` is made of: its own file and those of every module it
@@ -68,7 +69,7 @@ pub fn verilog_sources_of(module: &str) -> Vec<&'static (&'static str, &'static 
 
 /// The reference RTL in VHDL-2008, in compile order (packages first), and the package the VHDL
 /// testbenches share (last: simulation only).
-pub const VHDL_SOURCES: [(&str, &str); 14] = [
+pub const VHDL_SOURCES: [(&str, &str); 15] = [
     (
         "gyrofx_mem_pkg.vhd",
         include_str!("../../hdl/gyrofx_mem_pkg.vhd"),
@@ -105,6 +106,10 @@ pub const VHDL_SOURCES: [(&str, &str); 14] = [
     (
         "gyrofx_gyro_loop.vhd",
         include_str!("../../hdl/gyrofx_gyro_loop.vhd"),
+    ),
+    (
+        "gyrofx_system.vhd",
+        include_str!("../../hdl/gyrofx_system.vhd"),
     ),
     (
         "gyrofx_testbench_pkg.vhd",

@@ -28,6 +28,10 @@ pub struct Job {
     /// Both gyros' resonator-level loops (resolved for every plant: the loop's RTL block is in
     /// every package).
     pub gyro_loops: [GyroLoop; 2],
+    /// The chain of the system vectors (both loops feeding the chain), on its short schedule
+    /// ([`crate::blocks::system::chain_plan`]); `None` on the rate plant, whose loops' output
+    /// need not be the chain's input.
+    pub system_chain: Option<chain::Plan>,
 }
 
 /// Designs one filter per bandwidth of `settings` at `fs_hz` for the noise model (°/√h, °/h/√h).
@@ -103,6 +107,22 @@ impl Job {
         })?;
         let mean_filter =
             mean_filter::Plan::new(&settings.mean_filter).map_err(Error::MeanFilter)?;
+        let system_chain = match settings.resonator {
+            Some(_) => {
+                // gyrofx_system gives both loops one value of every shared parameter: refuse
+                // resonators whose loop designs differ in one (ROM file names do not matter).
+                crate::blocks::system::loop_params(
+                    [&gyro_loops[0].plan, &gyro_loops[1].plan],
+                    "",
+                    "",
+                )?;
+                Some(crate::blocks::system::chain_plan(
+                    &settings.estimator,
+                    &chain.kf,
+                )?)
+            }
+            None => None,
+        };
         Ok(Job {
             config,
             settings,
@@ -110,6 +130,7 @@ impl Job {
             chain,
             mean_filter,
             gyro_loops,
+            system_chain,
         })
     }
 

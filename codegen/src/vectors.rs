@@ -21,7 +21,7 @@ use serde::Serialize;
 
 use crate::block::Block;
 use crate::blocks::kf::TieCases;
-use crate::blocks::{ChainSample, RomImages, REGISTRY};
+use crate::blocks::{ChainSample, RomImages};
 use crate::config::GyroLoop;
 use crate::error::{Error, Result};
 use crate::job::Job;
@@ -157,6 +157,8 @@ pub struct Results {
     pub mean_filter_overflows: Option<u64>,
     /// What the gyro loop's recorded run covered.
     pub gyro_loop_record: Option<crate::blocks::gyro_loop::RecordSummary>,
+    /// What the system's recorded run covered.
+    pub system_record: Option<crate::blocks::system::SystemSummary>,
 }
 
 /// Everything the run produced.
@@ -183,6 +185,8 @@ pub struct Run {
     pub samples: usize,
     /// What the gyro loop's recorded run covered.
     pub gyro_loop_record: crate::blocks::gyro_loop::RecordSummary,
+    /// What the system's recorded run covered (resonator packages only).
+    pub system_record: Option<crate::blocks::system::SystemSummary>,
 }
 
 /// Runs the chain for `job` and builds the vectors of every registered block that has them;
@@ -235,8 +239,7 @@ pub fn run(job: &Job, roms: &RomImages) -> Result<Run> {
         })
     };
 
-    let mut builders: Vec<_> = REGISTRY
-        .iter()
+    let mut builders: Vec<_> = crate::blocks::of(job)
         .filter_map(|b| b.vectors(job, b.block(job, roms)))
         .collect();
 
@@ -338,6 +341,7 @@ pub fn run(job: &Job, roms: &RomImages) -> Result<Run> {
             report,
             samples: n,
             gyro_loop_record: results.gyro_loop_record.expect(REGISTERED),
+            system_record: results.system_record,
         })
     })
 }

@@ -66,6 +66,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
         config.seed = s;
     }
     let job = Job::new(config)?;
+    contents.check_for(&job).map_err(super::Usage)?;
     let bar = super::progress::spinner("generate", quiet);
     let provenance = source.provenance(&job, Output::Package);
     let options = Options {

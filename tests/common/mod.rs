@@ -118,35 +118,51 @@ pub fn flip_expected_bit(package: &Path, block: &str, sample: usize) -> String {
     signal
 }
 
-/// Like [`flip_expected_bit`], at the first sample from `from` whose outputs are compared:
-/// where a block has a `*_valid` strobe among its outputs, a line with it 1 (the other outputs
-/// may be gated by it). Returns the field flipped and the sample.
+/// Like [`flip_expected_bit`], at the first sample from `from` where the last output is
+/// compared: where the manifest gates it by a strobe (`only_where`), a line with the strobe 1.
+/// Returns the field flipped and the sample.
 pub fn flip_checked_bit(package: &Path, block: &str, from: usize) -> (String, usize) {
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(package.join("manifest.json")).unwrap())
+            .unwrap();
+    let fields = manifest["blocks"][block]["expected"]["fields"]
+        .as_array()
+        .expect("the block's expected fields in the manifest");
+    let strobe_name = fields.last().unwrap()["only_where"]
+        .as_str()
+        .map(|gate| gate.trim_end_matches(" = 1").to_string());
+    let strobe = strobe_name.map(|name| {
+        fields
+            .iter()
+            .position(|f| f["name"] == name.as_str())
+            .expect("the strobe among the outputs")
+    });
     let path = package.join(block).join(format!("{block}_expected.hex"));
     let content = std::fs::read_to_string(&path).unwrap();
     let lines: Vec<&str> = content.lines().collect();
-    let strobe = lines[1]
-        .trim_start_matches("// ")
-        .split(' ')
-        .position(|field| field.split(':').next().unwrap().ends_with("valid"));
     let sample = (from..lines.len() - 2)
         .find(|k| strobe.is_none_or(|i| lines[2 + k].split(' ').nth(i) == Some("1")))
         .expect("a compared sample");
     (flip_expected_bit(package, block, sample), sample)
 }
 
-/// The blocks of a package, in Makefile order.
-pub const BLOCKS: [&str; 6] = [
+/// The blocks of a resonator-plant package (the default's), in Makefile order.
+pub const BLOCKS: [&str; 7] = [
     "sequencer",
     "estimator",
     "kf",
     "top",
     "mean_filter",
     "gyro_loop",
+    "system",
 ];
 
-/// The chain's blocks (every block but the gyro loop, whose 40 000-sample closed-loop
-/// testbench takes about a minute in GHDL), as `verify --blocks` takes them: tests about the
+/// How many blocks a rate-plant package has: every block but the system (its loops' output
+/// need not be the chain's input there).
+pub const RATE_PLANT_BLOCK_COUNT: usize = BLOCKS.len() - 1;
+
+/// The chain's blocks (every block but the gyro loop and the system, whose 40 000-sample
+/// closed-loop testbenches take a minute or more in GHDL), as `verify --blocks` takes them: tests about the
 /// chain run only these.
 pub const CHAIN_BLOCKS: &str = "sequencer,estimator,kf,top,mean_filter";
 
@@ -155,3 +171,21 @@ pub const CHAIN_BLOCK_COUNT: usize = 5;
 
 /// Every simulator `gyrofx verify` runs.
 pub const SIMULATORS: [&str; 3] = ["iverilog", "verilator", "ghdl"];
+
+/// SHA-256 through `sha256sum`, independent of the code under test.
+pub fn hex_sha256(data: &[u8]) -> String {
+    use std::io::Write;
+    let mut child = std::process::Command::new("sha256sum")
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .expect("sha256sum runs");
+    child.stdin.take().unwrap().write_all(data).unwrap();
+    let out = child.wait_with_output().unwrap();
+    String::from_utf8(out.stdout)
+        .unwrap()
+        .split_whitespace()
+        .next()
+        .unwrap()
+        .to_string()
+}

@@ -112,7 +112,7 @@ fn pi_codes(prefix: &str, plan: &gyrofx_model::gyro_loop::pi::Plan, what: &str) 
 }
 
 /// Every parameter of `hdl/gyrofx_gyro_loop.v` for `plan`, in the RTL's order.
-pub fn parameters(plan: &Plan, roms: &RomImages) -> Vec<Param> {
+pub fn parameters(plan: &Plan, sine_file: &str, taps_file: &str) -> Vec<Param> {
     let mut p = Vec::new();
     p.extend(prefixed("NCO", plan.nco.rtl_parameters(), "NCO"));
     p.extend(prefixed(
@@ -234,12 +234,10 @@ pub fn parameters(plan: &Plan, roms: &RomImages) -> Vec<Param> {
         )
     }));
     p.extend(mode_params(plan.output.rounding, plan.output.overflow));
-    let sine = roms.entry(SINE_ROM);
-    let taps = roms.entry(TAPS_ROM);
-    p.push(Param::string("NCO_ROM_FILE", &sine.0, "NCO sine ROM"));
+    p.push(Param::string("NCO_ROM_FILE", sine_file, "NCO sine ROM"));
     p.push(Param::string(
         "CIC_ROM_FILE",
-        &taps.0,
+        taps_file,
         "CIC compensator ROM",
     ));
     p
@@ -274,12 +272,12 @@ impl RtlBlock for GyroLoop {
             self.title(),
             vec![
                 Signal::flag("mode"),
-                Signal::new("adc_x", plan.adc),
-                Signal::new("adc_y", plan.adc),
+                Signal::new("adc_x", plan.adc).with_unit("fs"),
+                Signal::new("adc_y", plan.adc).with_unit("fs"),
             ],
             vec![
-                Output::registered(Signal::new("dac_x", plan.dac.to)),
-                Output::registered(Signal::new("dac_y", plan.dac.to)),
+                Output::registered(Signal::new("dac_x", plan.dac.to).with_unit("")),
+                Output::registered(Signal::new("dac_y", plan.dac.to).with_unit("")),
                 Output::registered(Signal::flag("locked")),
                 Output::pulse(Signal::flag("out_valid")),
                 Output::gated(Signal::new("rate", plan.output.to), "out_valid"),
@@ -287,7 +285,7 @@ impl RtlBlock for GyroLoop {
             ],
         );
         block.settle_clocks = SETTLE_CLOCKS;
-        block.params = parameters(plan, roms);
+        block.params = parameters(plan, &roms.entry(SINE_ROM).0, &roms.entry(TAPS_ROM).0);
         block.roms.push(roms.entry(SINE_ROM));
         block.roms.push(roms.entry(TAPS_ROM));
         block

@@ -17,6 +17,7 @@ pub mod gyro_loop;
 pub mod kf;
 pub mod mean_filter;
 pub mod sequencer;
+pub mod system;
 pub mod top;
 
 use gyrofx_model::chain::{FloatSample, Sample};
@@ -38,6 +39,12 @@ pub trait RtlBlock: Sync {
 
     /// What the block is, one line.
     fn title(&self) -> &'static str;
+
+    /// Whether `job`'s package has the block (every block's but the system's, which needs
+    /// the resonator plant).
+    fn in_package(&self, _job: &Job) -> bool {
+        true
+    }
 
     /// The ROMs the block owns (the package writes each in every format under `roms/`).
     fn roms(&self, _job: &Job) -> Vec<Rom> {
@@ -73,7 +80,13 @@ pub static REGISTRY: &[&dyn RtlBlock] = &[
     &top::Top,
     &mean_filter::MeanFilter,
     &gyro_loop::GyroLoop,
+    &system::System,
 ];
+
+/// The blocks of `job`'s package, in registry order.
+pub fn of(job: &Job) -> impl Iterator<Item = &'static dyn RtlBlock> + '_ {
+    REGISTRY.iter().copied().filter(|b| b.in_package(job))
+}
 
 /// The registered block called `name`.
 ///
@@ -140,8 +153,7 @@ impl RomImages {
     /// The images of every ROM of the registry for `job`, in registry order.
     pub fn new(job: &Job, provenance: &Provenance) -> Self {
         RomImages(
-            REGISTRY
-                .iter()
+            of(job)
                 .flat_map(|b| b.roms(job))
                 .map(|rom| RomImage {
                     file: RomFormat::Mem.file_name(&rom.name),

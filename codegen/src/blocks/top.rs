@@ -15,6 +15,37 @@ use crate::vectors::{Results, Run};
 /// The top block.
 pub struct Top;
 
+/// `gyrofx_top`'s parameters for `plan`, its ROMs read from `gain_rom_file` and
+/// `kf_rom_file`: the submodules' parameters, each once — the sequencer's schedule, the
+/// estimator's formats (its W and interval width are the sequencer's) and the KF's (its input
+/// is the calibrated output) — then the rounding and overflow.
+pub fn chain_params(plan: &Plan, gain_rom_file: &str, kf_rom_file: &str) -> Vec<Param> {
+    let est = &plan.estimator;
+    let mut params = sequencer::params(&est.schedule);
+    params.extend(
+        estimator::params(est)
+            .into_iter()
+            .filter(|p| p.name != "INTERVALS" && p.name != "INTERVAL_W"),
+    );
+    params.push(Param::string(
+        "GAIN_ROM_FILE",
+        gain_rom_file,
+        "estimator gain ROM",
+    ));
+    params.extend(
+        kf::params(&plan.kf)
+            .into_iter()
+            .filter(|p| p.name != "IN_W" && p.name != "IN_F"),
+    );
+    params.push(Param::string(
+        "KF_ROM_FILE",
+        kf_rom_file,
+        "KF coefficient ROM",
+    ));
+    params.extend(mode_params(est.rounding, est.overflow));
+    params
+}
+
 impl RtlBlock for Top {
     fn name(&self) -> &'static str {
         "top"
@@ -50,33 +81,9 @@ impl RtlBlock for Top {
                 Output::registered(Signal::flag("estimated")),
             ],
         );
-        // The submodules' parameters, each once: the sequencer's schedule, the estimator's
-        // formats (its W and interval width are the sequencer's) and the KF's (its input is
-        // the calibrated output).
-        block.params = sequencer::params(&est.schedule);
-        block.params.extend(
-            estimator::params(est)
-                .into_iter()
-                .filter(|p| p.name != "INTERVALS" && p.name != "INTERVAL_W"),
-        );
         let gains = roms.entry(estimator::ROM);
-        block.params.push(Param::string(
-            "GAIN_ROM_FILE",
-            &gains.0,
-            "estimator gain ROM",
-        ));
-        block.params.extend(
-            kf::params(kf)
-                .into_iter()
-                .filter(|p| p.name != "IN_W" && p.name != "IN_F"),
-        );
         let coefficients = roms.entry(kf::ROM);
-        block.params.push(Param::string(
-            "KF_ROM_FILE",
-            &coefficients.0,
-            "KF coefficient ROM",
-        ));
-        block.params.extend(mode_params(est.rounding, est.overflow));
+        block.params = chain_params(&job.chain, &gains.0, &coefficients.0);
         block.roms.push(gains);
         block.roms.push(coefficients);
         block

@@ -1,0 +1,502 @@
+//! `system` — `gyrofx_system`, the whole gyro at the ADC rate: gyro A's and B's loops
+//! (`gyrofx_gyro_loop`) feeding the mode-reversal chain (`gyrofx_top`), whose sequencer
+//! commands the loops' modes (`gyrofx_model::system`, `docs/blocks/system.md`).
+//!
+//! It is in the package when the resonator plant feeds the chain (the loops' output format is
+//! then the chain's input format). Its vectors replay the system closed around both simulated
+//! resonators from reset: [`STARTUP_S`] with `enable` low (both loops lock in normal mode, the
+//! chain holds), then two estimator windows with `enable` high. A window of the configured
+//! schedule is 4 × 150 chain samples of 1000 ADC samples each, far too long for a testbench,
+//! so the system's chain runs a short schedule ([`schedule`]: L = [`INTERVAL_LENGTH`],
+//! M = [`BLANK`], the configured W, pattern and stagger direction) with its own estimator
+//! plan and gain ROM; the KF is the configured one. The vectors prove the wiring bit for bit
+//! — each chain period taken in the mode the sequencer describes, the loops' rates into the
+//! estimator, the KF on their calibrated combination — not the estimates' accuracy, which
+//! the blanking of so short an interval cannot give (the `top` and `gyro_loop` vectors and
+//! the report cover that).
+
+use gyrofx_model::chain;
+use gyrofx_model::estimator;
+use gyrofx_model::fx::CoefficientFormat;
+use gyrofx_model::gyro_loop::gyro::Plan as LoopPlan;
+use gyrofx_model::resonator::Mode;
+use gyrofx_model::sequencer::Schedule;
+use gyrofx_model::system::{record, GyroPhysics, RecordedSample};
+use serde_json::json;
+
+use super::{flag, gyro_loop, kf, top, ChainSample, RomImages, RtlBlock, VectorBuilder};
+use crate::block::{Block, Output, Param, Signal};
+use crate::config::GyroLoop as LoopConfig;
+use crate::error::{Error, Result};
+use crate::job::Job;
+use crate::rom::Rom;
+use crate::vectors::{Results, Run};
+
+/// The system block.
+pub struct System;
+
+/// Name of the system chain's estimator gain ROM (its schedule's, not the configured one's).
+pub const GAINS_ROM: &str = "system_estimator_gains";
+
+/// Chain samples per interval of the system vectors' schedule.
+pub const INTERVAL_LENGTH: usize = 3;
+/// Blanked chain samples at the start of each interval there.
+pub const BLANK: usize = 1;
+/// Estimator windows after the start-up.
+pub const WINDOWS: usize = 2;
+/// Seconds of start-up with `enable` low, rounded up to whole chain periods (the loops lock in
+/// about 80 ms).
+pub const STARTUP_S: f64 = 0.1;
+/// Input rate of the recorded run, °/s.
+pub const RATE_DPS: f64 = 10.0;
+
+/// Clocks from the `ce` of an ADC sample to the chain's registered outputs, less the one the
+/// testbench always allows: the loop's four stages, then the chain's register.
+const SETTLE_CLOCKS: u32 = 4;
+
+/// The system vectors' schedule: the configured one with L = [`INTERVAL_LENGTH`] and
+/// M = [`BLANK`]; B runs [`BLANK`] samples behind A when the configured schedule staggers.
+pub fn schedule(configured: &Schedule) -> Schedule {
+    Schedule {
+        interval_length: INTERVAL_LENGTH,
+        blank: BLANK,
+        stagger: if configured.stagger > 0 { BLANK } else { 0 },
+        ..configured.clone()
+    }
+}
+
+/// The system's chain: the configured estimator settings on [`schedule`] (the reciprocal's
+/// fraction bits re-derived for `1/(L − M)`, its width kept) and the configured KF.
+///
+/// # Errors
+/// [`Error::Estimator`] when the estimator cannot be planned on the short schedule.
+pub fn chain_plan(
+    configured: &estimator::Spec,
+    kf: &gyrofx_model::kf::Plan,
+) -> Result<chain::Plan> {
+    let mut spec = configured.clone();
+    spec.schedule = schedule(&configured.schedule);
+    let width = match spec.reciprocal {
+        CoefficientFormat::Auto { width } => width,
+        CoefficientFormat::Fixed(format) => format.width,
+    };
+    spec.reciprocal = CoefficientFormat::Auto { width };
+    let plan = estimator::Plan::new(&spec).map_err(Error::Estimator)?;
+    chain::Plan::new(plan, kf.clone()).map_err(|e| Error::Config {
+        field: "estimator / kf formats (system vectors)".into(),
+        value: String::new(),
+        allowed: e.to_string(),
+    })
+}
+
+/// Whether loop parameter `name` differs between the gyros (each loop gets its own, `A_` or
+/// `B_` prefixed): the per-mode values and everything designed from the gyro's physics.
+fn per_gyro(name: &str) -> bool {
+    name.ends_with("_N")
+        || name.ends_with("_R")
+        || name.starts_with("PLL_K")
+        || name.starts_with("AGC_K")
+        || name.starts_with("COEF_")
+        || matches!(
+            name,
+            "PLL_INT_MIN" | "PLL_INT_MAX" | "AGC_INT_MIN" | "AGC_INT_MAX"
+        )
+}
+
+/// The loops' parameters as `gyrofx_system` takes them: the shared ones once (the loop's
+/// `ROUNDING`, `SATURATE` and `LATENCY` as `LOOP_*`; its output format is the chain's `IN_*`),
+/// then gyro A's own, then gyro B's. Both loops read the ROM images `sine_file` and
+/// `taps_file` (gyro A's).
+///
+/// # Errors
+/// [`Error::Config`] when a parameter the RTL shares (a format, the CIC, the lock detector)
+/// or a ROM image differs between the two gyros' loop designs.
+pub fn loop_params(loops: [&LoopPlan; 2], sine_file: &str, taps_file: &str) -> Result<Vec<Param>> {
+    let [a, b] = loops.map(|plan| gyro_loop::parameters(plan, sine_file, taps_file));
+    let differs = |what: String, a: String, b: String| {
+        Error::Config {
+        field: "resonator_b (system block)".into(),
+        value: format!("{what} = {b} for gyro B, {a} for gyro A"),
+        allowed: "gyrofx_system gives both loops one value of it: resonators whose loop designs share it (the [loop] section sets it for both)".into(),
+    }
+    };
+    let codes = |plan: &LoopPlan| {
+        [
+            Rom::gyro_loop_sine(&plan.nco).codes,
+            Rom::gyro_loop_cic(&plan.cic).codes,
+        ]
+    };
+    let [rom_a, rom_b] = loops.map(codes);
+    for ((name, a), b) in ["NCO_ROM_FILE", "CIC_ROM_FILE"]
+        .iter()
+        .zip(&rom_a)
+        .zip(&rom_b)
+    {
+        if a != b {
+            return Err(differs(
+                format!("the ROM image of {name}"),
+                "one image".into(),
+                "another".into(),
+            ));
+        }
+    }
+    let mut shared = Vec::new();
+    let mut own = [Vec::new(), Vec::new()];
+    for (pa, pb) in a.into_iter().zip(b) {
+        if per_gyro(&pa.name) {
+            for (g, mut p) in [pa, pb].into_iter().enumerate() {
+                p.name = format!("{}_{}", ["A", "B"][g], p.name);
+                own[g].push(p);
+            }
+            continue;
+        }
+        if pa.value != pb.value {
+            return Err(differs(pa.name.clone(), pa.value, pb.value));
+        }
+        match pa.name.as_str() {
+            "OUT_W" | "OUT_F" => {}
+            "ROUNDING" | "SATURATE" | "LATENCY" => {
+                let mut p = pa;
+                p.name = format!("LOOP_{}", p.name);
+                shared.push(p);
+            }
+            _ => shared.push(pa),
+        }
+    }
+    shared.extend(own.into_iter().flatten());
+    Ok(shared)
+}
+
+impl RtlBlock for System {
+    fn name(&self) -> &'static str {
+        "system"
+    }
+
+    fn module(&self) -> &'static str {
+        "gyrofx_system"
+    }
+
+    fn title(&self) -> &'static str {
+        "the whole gyro: both loops feeding the chain, which commands their modes"
+    }
+
+    fn in_package(&self, job: &Job) -> bool {
+        job.system_chain.is_some()
+    }
+
+    fn roms(&self, job: &Job) -> Vec<Rom> {
+        match &job.system_chain {
+            Some(plan) => {
+                let mut rom = Rom::estimator(&plan.estimator);
+                rom.name = GAINS_ROM.into();
+                rom.description = format!(
+                    "{} (the system vectors' schedule, L = {INTERVAL_LENGTH}, M = {BLANK})",
+                    rom.description
+                );
+                vec![rom]
+            }
+            None => Vec::new(),
+        }
+    }
+
+    fn block(&self, job: &Job, roms: &RomImages) -> Block {
+        let plan = job
+            .system_chain
+            .as_ref()
+            .expect("the system block is in resonator packages only");
+        let est = &plan.estimator;
+        let kf = &plan.kf;
+        let adc = job.gyro_loops[0].plan.adc;
+        let dac = job.gyro_loops[0].plan.dac.to;
+        let mut block = Block::new(
+            self.name(),
+            self.module(),
+            self.title(),
+            vec![
+                Signal::flag("enable"),
+                Signal::index("bw_sel", kf.select_width()),
+                Signal::new("adc_a_x", adc).with_unit("fs"),
+                Signal::new("adc_a_y", adc).with_unit("fs"),
+                Signal::new("adc_b_x", adc).with_unit("fs"),
+                Signal::new("adc_b_y", adc).with_unit("fs"),
+            ],
+            vec![
+                Output::registered(Signal::new("dac_a_x", dac).with_unit("")),
+                Output::registered(Signal::new("dac_a_y", dac).with_unit("")),
+                Output::registered(Signal::new("dac_b_x", dac).with_unit("")),
+                Output::registered(Signal::new("dac_b_y", dac).with_unit("")),
+                Output::registered(Signal::flag("locked_a")),
+                Output::registered(Signal::flag("locked_b")),
+                Output::registered(Signal::flag("mode_a")),
+                Output::registered(Signal::flag("mode_b")),
+                Output::pulse(Signal::flag("out_valid")),
+                Output::gated(Signal::new("rate_out", kf.output), "out_valid"),
+                Output::registered(Signal::new("bias_a", est.bias)),
+                Output::registered(Signal::new("bias_b", est.bias)),
+                Output::registered(Signal::flag("estimated")),
+            ],
+        );
+        block.settle_clocks = SETTLE_CLOCKS;
+        let gains = roms.entry(GAINS_ROM);
+        let coefficients = roms.entry(kf::ROM);
+        block.params = top::chain_params(plan, &gains.0, &coefficients.0);
+        let sine = roms.entry(gyro_loop::SINE_ROM);
+        let taps = roms.entry(gyro_loop::TAPS_ROM);
+        block.params.extend(
+            loop_params(
+                [&job.gyro_loops[0].plan, &job.gyro_loops[1].plan],
+                &sine.0,
+                &taps.0,
+            )
+            .expect("Job::new checked that the loops share what the RTL shares"),
+        );
+        block.roms.push(gains);
+        block.roms.push(coefficients);
+        block.roms.push(sine);
+        block.roms.push(taps);
+        block
+    }
+
+    fn vectors<'a>(&self, job: &'a Job, block: Block) -> Option<Box<dyn VectorBuilder + 'a>> {
+        Some(Box::new(Vectors {
+            job,
+            plan: job.system_chain.as_ref()?,
+            block,
+        }))
+    }
+
+    fn manifest(
+        &self,
+        job: &Job,
+        _roms: &RomImages,
+        run: &Run,
+    ) -> Option<(&'static str, serde_json::Value)> {
+        let plan = job.system_chain.as_ref()?;
+        let schedule = &plan.estimator.schedule;
+        let lp = &job.gyro_loops[0].plan;
+        Some((
+            "system",
+            json!({
+                "adc_rate_hz": lp.adc_rate_hz,
+                "decimation": lp.cic.decimation,
+                "latency_clocks": SETTLE_CLOCKS + 1,
+                "min_clocks_per_sample": SETTLE_CLOCKS + 1,
+                "schedule": {
+                    "interval_length": schedule.interval_length,
+                    "intervals": schedule.intervals,
+                    "pattern": schedule.pattern.name(),
+                    "blank": schedule.blank,
+                    "stagger": schedule.stagger,
+                },
+                "stimulus": format!(
+                    "gyro A's and B's loops closed around their resonators from reset at {RATE_DPS} °/s: enable low for {STARTUP_S} s (rounded up to whole chain periods; both lock in normal mode), then high for {WINDOWS} windows of the schedule above; bw_sel 0 in the first window, then the next ROM entry"
+                ),
+                "recorded": run.system_record,
+            }),
+        ))
+    }
+}
+
+/// Builds the vectors from the recorded run at the end; the chain's samples are not used.
+struct Vectors<'a> {
+    job: &'a Job,
+    plan: &'a chain::Plan,
+    block: Block,
+}
+
+/// What the recorded system run covered (the manifest's `system.recorded`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct SystemSummary {
+    /// ADC samples.
+    pub samples: usize,
+    /// ADC samples with `enable` low.
+    pub startup_samples: usize,
+    /// Chain samples (the chain's steps).
+    pub chain_samples: usize,
+    /// The first ADC sample after which both loops were locked.
+    pub first_lock_sample: Option<usize>,
+    /// The first ADC sample with an estimate.
+    pub first_estimate_sample: Option<usize>,
+    /// KF outputs.
+    pub outputs: usize,
+    /// Mode switches of gyro A and of gyro B.
+    pub switches: [usize; 2],
+}
+
+fn mode_flag(mode: Mode) -> i128 {
+    flag(mode == Mode::Normal)
+}
+
+impl VectorBuilder for Vectors<'_> {
+    fn reset(&mut self) {}
+
+    fn sample(&mut self, _sample: &ChainSample) {}
+
+    fn finish(mut self: Box<Self>, results: &mut Results) -> Block {
+        let loops: [&LoopConfig; 2] = [&self.job.gyro_loops[0], &self.job.gyro_loops[1]];
+        let schedule = &self.plan.estimator.schedule;
+        let decimation = loops[0].plan.cic.decimation as usize;
+        let chain_rate_hz = loops[0].plan.chain_rate_hz();
+        let startup = (STARTUP_S * chain_rate_hz).ceil() as usize * decimation;
+        let window = schedule.cycle_length() * decimation;
+        let samples = startup + WINDOWS * window;
+        let entries = self.plan.kf.gains.len();
+        let seed = self.job.config.seed;
+        let physics = [0, 1].map(|g| GyroPhysics {
+            params: &loops[g].params,
+            front_end: &loops[g].front_end,
+            seed: seed.wrapping_mul(2).wrapping_add(g as u64),
+        });
+        self.block.reserve(samples);
+        let mut summary = SystemSummary {
+            samples,
+            startup_samples: startup,
+            ..SystemSummary::default()
+        };
+        let nan = f64::NAN;
+        let mut loop_rates: [Vec<f64>; 2] =
+            [Vec::with_capacity(samples), Vec::with_capacity(samples)];
+        let output_lsb = loops[0].plan.output.to.lsb();
+        let mut previous_modes = [Mode::Normal; 2];
+        let mut last_rate = 0i128;
+        let mut k = 0usize;
+        let block = &mut self.block;
+        // bw_sel: 0 in the first window, the next entry after it (the chain's ROM switch).
+        let bw_sel_of = |k: usize| usize::from(k >= startup + window).min(entries - 1);
+        record(
+            [&loops[0].plan, &loops[1].plan],
+            self.plan,
+            physics,
+            RATE_DPS,
+            samples,
+            startup,
+            bw_sel_of,
+            |s: &RecordedSample| {
+                let step = &s.step;
+                for g in 0..2 {
+                    if step.modes[g] != previous_modes[g] {
+                        summary.switches[g] += 1;
+                        previous_modes[g] = step.modes[g];
+                    }
+                    loop_rates[g].push(step.rates.map_or(nan, |r| r[g] as f64 * output_lsb));
+                }
+                if summary.first_lock_sample.is_none() && step.locked == [true; 2] {
+                    summary.first_lock_sample = Some(k);
+                }
+                let chain = step.chain;
+                if chain.is_some() {
+                    summary.chain_samples += 1;
+                }
+                if let Some(code) = chain.and_then(|c| c.rate) {
+                    last_rate = code.into();
+                    summary.outputs += 1;
+                }
+                if s.estimated && summary.first_estimate_sample.is_none() {
+                    summary.first_estimate_sample = Some(k);
+                }
+                block.push(
+                    false,
+                    &[
+                        flag(s.enable),
+                        bw_sel_of(k) as i128,
+                        s.adc[0][0].into(),
+                        s.adc[0][1].into(),
+                        s.adc[1][0].into(),
+                        s.adc[1][1].into(),
+                    ],
+                    &[
+                        step.dac[0][0].into(),
+                        step.dac[0][1].into(),
+                        step.dac[1][0].into(),
+                        step.dac[1][1].into(),
+                        flag(step.locked[0]),
+                        flag(step.locked[1]),
+                        mode_flag(s.upcoming[0]),
+                        mode_flag(s.upcoming[1]),
+                        flag(chain.is_some_and(|c| c.rate.is_some())),
+                        last_rate,
+                        s.bias[0],
+                        s.bias[1],
+                        flag(s.estimated),
+                    ],
+                );
+                k += 1;
+            },
+        )
+        .expect("the config check validated the physics");
+        let [rate_a, rate_b] = loop_rates;
+        self.block.extra = vec![("loop_rate_a_dps", rate_a), ("loop_rate_b_dps", rate_b)];
+        results.system_record = Some(summary);
+        self.block
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::{preset, Config, PRESETS};
+
+    fn resonator_jobs() -> Vec<(String, Job)> {
+        let mut jobs = vec![("default".to_string(), Job::new(Config::embedded()).unwrap())];
+        for (name, _) in PRESETS {
+            let config = Config::from_toml(preset(name).unwrap(), name).unwrap();
+            let job = Job::new(config).unwrap();
+            if job.system_chain.is_some() {
+                jobs.push((name.to_string(), job));
+            }
+        }
+        jobs
+    }
+
+    #[test]
+    fn both_gyros_get_the_same_parameter_names_and_the_shared_ones_once() {
+        for (name, job) in resonator_jobs() {
+            let loops = [&job.gyro_loops[0].plan, &job.gyro_loops[1].plan];
+            let params = loop_params(loops, "s.mem", "t.mem").unwrap();
+            let names: Vec<&str> = params.iter().map(|p| p.name.as_str()).collect();
+            let own = |prefix: &str| -> Vec<&str> {
+                names
+                    .iter()
+                    .filter_map(|n| n.strip_prefix(prefix))
+                    .collect()
+            };
+            assert!(!own("A_").is_empty(), "{name}");
+            assert_eq!(own("A_"), own("B_"), "{name}");
+            let mut unique = names.clone();
+            unique.sort_unstable();
+            unique.dedup();
+            assert_eq!(unique.len(), names.len(), "{name}: a name twice");
+            // The loop's output format is the chain's input: not a parameter of its own.
+            assert!(
+                !names.contains(&"OUT_W") && names.contains(&"LOOP_ROUNDING"),
+                "{name}"
+            );
+            // Every per-gyro name is one the loop RTL has.
+            let whole = gyro_loop::parameters(loops[0], "s.mem", "t.mem");
+            for n in own("A_") {
+                assert!(whole.iter().any(|p| p.name == n), "{name}: {n}");
+            }
+        }
+    }
+
+    #[test]
+    fn loops_that_differ_in_a_shared_parameter_are_refused_naming_it() {
+        let job = Job::new(Config::embedded()).unwrap();
+        let a = job.gyro_loops[0].plan.clone();
+        let mut b = job.gyro_loops[1].plan.clone();
+        b.lock.shift += 1;
+        let error = loop_params([&a, &b], "s.mem", "t.mem")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            error.contains("LOCK_SHIFT") && error.contains("resonator_b"),
+            "{error}"
+        );
+        let mut b = job.gyro_loops[1].plan.clone();
+        b.cic.taps[0].code += 1;
+        let error = loop_params([&a, &b], "s.mem", "t.mem")
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("CIC_ROM_FILE"), "{error}");
+    }
+}

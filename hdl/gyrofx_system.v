@@ -1,0 +1,340 @@
+// Language: Verilog 2001
+
+`resetall
+`timescale 1ns / 1ps
+`default_nettype none
+
+/*
+ * gyrofx_system — the whole mode-reversal gyro at the ADC rate: gyro A's and
+ *   B's loops (gyrofx_gyro_loop) feeding the chain (gyrofx_top), whose
+ *   sequencer commands the loops' modes.
+ *
+ * Purpose: ADC codes of both axes of both gyros in, DAC codes and the
+ *   calibrated, filtered rate out (SPEC 1.6 and 1). Bit-exact with
+ *   gyrofx_model::system::FixedSystem; docs/blocks/system.md documents it.
+ *
+ * Algorithm (per ADC sample, ce high):
+ *     mode_g = enable ? the chain's mode_g : normal      (loop g's mode input)
+ *     both loops take the sample in mode_g
+ *     when the loops output a decimated rate (A's out_valid; B's comes with it)
+ *     and enable was high at that ADC sample, the chain takes y_a = rate_a,
+ *     y_b = rate_b at the bw_sel of that sample
+ *   So every ADC sample of a chain period is taken in the mode the sequencer
+ *   describes for that period's chain sample. enable low holds the chain and
+ *   runs both loops in normal mode: raise it once the loops have locked.
+ *
+ * Timing: ce at most every 5th clock. dac_*, locked_* are valid 4 clocks
+ *   after ce and hold until the next sample's; the chain's outputs (mode_a,
+ *   mode_b: the modes of the next chain period; out_valid, a one-clock pulse;
+ *   rate_out; bias_a, bias_b, estimated) change 5 clocks after the ce of the
+ *   ADC sample that ends a chain period and hold otherwise. A clock with rst
+ *   high clears every register.
+ *
+ * Parameters: the chain's as gyrofx_top's; the loops' shared ones as
+ *   gyrofx_gyro_loop's (its ROUNDING, SATURATE, LATENCY as LOOP_*, its output
+ *   format is IN_W/IN_F); those designed per gyro with the prefix A_ or B_.
+ */
+module gyrofx_system #(
+    // chain: sequencer
+    parameter INTERVAL_LENGTH = 150,
+    parameter INTERVALS = 4,
+    parameter [INTERVALS-1:0] PATTERN = 4'h5,
+    parameter BLANK = 30,
+    parameter STAGGER = 0,
+    parameter PHASE_W = 8,
+    parameter INTERVAL_W = 2,
+    // chain: gyro samples (the loops' rate output, the KF input and the calibrated format)
+    parameter IN_W = 24,
+    parameter IN_F = 14,
+    // chain: estimator
+    parameter ACC_W = 32,
+    parameter RECIP_W = 18,
+    parameter RECIP_F = 23,
+    parameter [RECIP_W-1:0] RECIP = 18'h11111,
+    parameter MEAN_W = 28,
+    parameter MEAN_F = 18,
+    parameter GAIN_W = 18,
+    parameter GAIN_F = 18,
+    parameter DOT_W = 49,
+    parameter BIAS_W = 28,
+    parameter BIAS_F = 18,
+    parameter SMOOTH = 0,
+    parameter GAIN_ROM_FILE = "estimator_gains.mem",
+    // chain: KF
+    parameter STATE_W = 36,
+    parameter STATE_F = 26,
+    parameter OUT_W = 24,
+    parameter OUT_F = 14,
+    parameter G1_W = 18,
+    parameter G1_F = 17,
+    parameter G2_W = 18,
+    parameter G2_F = 38,
+    parameter SEL_W = 2,
+    parameter ROM_DEPTH = 3,
+    parameter KF_ROM_FILE = "kf_coefficients.mem",
+    // chain rounding: 0 floor, 1 ceil, 2 zero, 3 nearest, 4 round, 5 convergent; overflow: 0 wrap, 1 saturate
+    parameter ROUNDING = 3,
+    parameter SATURATE = 1,
+    // loops (shared by both gyros): NCOs, demodulators, PLL and AGC formats, CICs, DAC
+    parameter NCO_PHASE_W = 32,
+    parameter NCO_ADDR_W = 10,
+    parameter NCO_SIN_W = 18,
+    parameter DEMOD_ADC_W = 24,
+    parameter DEMOD_ADC_F = 23,
+    parameter DEMOD_REF_W = 18,
+    parameter DEMOD_REF_F = 17,
+    parameter DEMOD_PROD_W = 36,
+    parameter DEMOD_PROD_F = 34,
+    parameter DEMOD_STATE_W = 44,
+    parameter DEMOD_STATE_F = 42,
+    parameter DEMOD_OUT_W = 32,
+    parameter DEMOD_OUT_F = 30,
+    parameter DEMOD_SHIFT = 8,
+    parameter PLL_ERR_W = 32,
+    parameter PLL_ERR_F = 30,
+    parameter PLL_INT_W = 40,
+    parameter PLL_INT_F = 38,
+    parameter PLL_OUT_W = 32,
+    parameter PLL_OUT_F = 32,
+    parameter AGC_ERR_W = 32,
+    parameter AGC_ERR_F = 30,
+    parameter AGC_INT_W = 40,
+    parameter AGC_INT_F = 20,
+    parameter AGC_OUT_W = 24,
+    parameter AGC_OUT_F = 6,
+    parameter CIC_IN_W = 32,
+    parameter CIC_IN_F = 30,
+    parameter CIC_STAGES = 3,
+    parameter CIC_DECIMATION = 1000,
+    parameter CIC_DELAY = 1,
+    parameter CIC_SHIFT = 30,
+    parameter CIC_MID_W = 40,
+    parameter CIC_MID_F = 38,
+    parameter CIC_TAPS = 5,
+    parameter CIC_COEF_W = 18,
+    parameter CIC_COEF_F = 16,
+    parameter CIC_OUT_W = 32,
+    parameter CIC_OUT_F = 30,
+    parameter DAC_W = 18,
+    parameter DAC_F = 0,
+    // loops: ADC-to-DAC latency (samples), lock detector, rounding and overflow, ROM images
+    parameter LOOP_LATENCY = 1,
+    parameter LOCK_SHIFT = 9,
+    parameter LOCK_HOLD = 2000,
+    parameter LOOP_ROUNDING = 3,
+    parameter LOOP_SATURATE = 1,
+    parameter NCO_ROM_FILE = "nco_sine.mem",
+    parameter CIC_ROM_FILE = "cic_taps.mem",
+    // gyro A's loop: PI gains and limits, 1/SF format, per-mode values (_N normal, _R reverse)
+    parameter A_PLL_KP_W = 18,
+    parameter A_PLL_KP_F = 27,
+    parameter A_PLL_KI_W = 18,
+    parameter A_PLL_KI_F = 38,
+    parameter signed [A_PLL_KP_W-1:0] A_PLL_KP = 18'sh10625,
+    parameter signed [A_PLL_KI_W-1:0] A_PLL_KI = 18'sh17795,
+    parameter signed [PLL_INT_W-1:0] A_PLL_INT_MIN = 40'sh292cd0c7b,
+    parameter signed [PLL_INT_W-1:0] A_PLL_INT_MAX = 40'sh2a786ac8d,
+    parameter A_AGC_KP_W = 18,
+    parameter A_AGC_KP_F = 1,
+    parameter A_AGC_KI_W = 18,
+    parameter A_AGC_KI_F = 11,
+    parameter signed [A_AGC_KP_W-1:0] A_AGC_KP = 18'sh19a9a,
+    parameter signed [A_AGC_KI_W-1:0] A_AGC_KI = 18'sh12624,
+    parameter signed [AGC_INT_W-1:0] A_AGC_INT_MIN = 40'sh0,
+    parameter signed [AGC_INT_W-1:0] A_AGC_INT_MAX = 40'sh1ffff00000,
+    parameter A_COEF_W = 24,
+    parameter A_COEF_F = 6,
+    parameter signed [DEMOD_OUT_W-1:0] A_SETPOINT_N = 32'shcccc666,
+    parameter signed [DEMOD_OUT_W-1:0] A_SETPOINT_R = 32'shcccc666,
+    parameter [NCO_PHASE_W-1:0] A_FREQ_WORD_N = 32'ha7d5617,
+    parameter [NCO_PHASE_W-1:0] A_FREQ_WORD_R = 32'ha6bf8ce,
+    parameter signed [PLL_INT_W-1:0] A_PLL_PRESET_N = 40'sh29f5585a4,
+    parameter signed [PLL_INT_W-1:0] A_PLL_PRESET_R = 40'sh29afe3365,
+    parameter [NCO_PHASE_W-1:0] A_DAC_OFFSET_N = 32'hfd38ab7,
+    parameter [NCO_PHASE_W-1:0] A_DAC_OFFSET_R = 32'hfbb6e38,
+    parameter [NCO_PHASE_W-1:0] A_SENSE_OFFSET_N = 32'h4f56436e,
+    parameter [NCO_PHASE_W-1:0] A_SENSE_OFFSET_R = 32'hafd6e2bb,
+    parameter signed [A_COEF_W-1:0] A_RATE_COEF_N = 24'sh63db80,
+    parameter signed [A_COEF_W-1:0] A_RATE_COEF_R = 24'sh9aa98a,
+    parameter signed [A_COEF_W-1:0] A_QUAD_COEF_N = 24'sh9c2480,
+    parameter signed [A_COEF_W-1:0] A_QUAD_COEF_R = 24'sh9aa98a,
+    parameter signed [63:0] A_LOCK_Q_N = 64'shb70271b,
+    parameter signed [63:0] A_LOCK_Q_R = 64'shb70271b,
+    parameter signed [63:0] A_LOCK_A_N = 64'sh68db574,
+    parameter signed [63:0] A_LOCK_A_R = 64'sh68db574,
+    // gyro B's loop: the same
+    parameter B_PLL_KP_W = 18,
+    parameter B_PLL_KP_F = 27,
+    parameter B_PLL_KI_W = 18,
+    parameter B_PLL_KI_F = 38,
+    parameter signed [B_PLL_KP_W-1:0] B_PLL_KP = 18'sh10625,
+    parameter signed [B_PLL_KI_W-1:0] B_PLL_KI = 18'sh17795,
+    parameter signed [PLL_INT_W-1:0] B_PLL_INT_MIN = 40'sh292cd0c7b,
+    parameter signed [PLL_INT_W-1:0] B_PLL_INT_MAX = 40'sh2a786ac8d,
+    parameter B_AGC_KP_W = 18,
+    parameter B_AGC_KP_F = 1,
+    parameter B_AGC_KI_W = 18,
+    parameter B_AGC_KI_F = 11,
+    parameter signed [B_AGC_KP_W-1:0] B_AGC_KP = 18'sh19a9a,
+    parameter signed [B_AGC_KI_W-1:0] B_AGC_KI = 18'sh12624,
+    parameter signed [AGC_INT_W-1:0] B_AGC_INT_MIN = 40'sh0,
+    parameter signed [AGC_INT_W-1:0] B_AGC_INT_MAX = 40'sh1ffff00000,
+    parameter B_COEF_W = 24,
+    parameter B_COEF_F = 6,
+    parameter signed [DEMOD_OUT_W-1:0] B_SETPOINT_N = 32'shcccc666,
+    parameter signed [DEMOD_OUT_W-1:0] B_SETPOINT_R = 32'shcccc666,
+    parameter [NCO_PHASE_W-1:0] B_FREQ_WORD_N = 32'ha7d5617,
+    parameter [NCO_PHASE_W-1:0] B_FREQ_WORD_R = 32'ha6bf8ce,
+    parameter signed [PLL_INT_W-1:0] B_PLL_PRESET_N = 40'sh29f5585a4,
+    parameter signed [PLL_INT_W-1:0] B_PLL_PRESET_R = 40'sh29afe3365,
+    parameter [NCO_PHASE_W-1:0] B_DAC_OFFSET_N = 32'hfd38ab7,
+    parameter [NCO_PHASE_W-1:0] B_DAC_OFFSET_R = 32'hfbb6e38,
+    parameter [NCO_PHASE_W-1:0] B_SENSE_OFFSET_N = 32'h4f56436e,
+    parameter [NCO_PHASE_W-1:0] B_SENSE_OFFSET_R = 32'hafd6e2bb,
+    parameter signed [B_COEF_W-1:0] B_RATE_COEF_N = 24'sh63db80,
+    parameter signed [B_COEF_W-1:0] B_RATE_COEF_R = 24'sh9aa98a,
+    parameter signed [B_COEF_W-1:0] B_QUAD_COEF_N = 24'sh9c2480,
+    parameter signed [B_COEF_W-1:0] B_QUAD_COEF_R = 24'sh9aa98a,
+    parameter signed [63:0] B_LOCK_Q_N = 64'shb70271b,
+    parameter signed [63:0] B_LOCK_Q_R = 64'shb70271b,
+    parameter signed [63:0] B_LOCK_A_N = 64'sh68db574,
+    parameter signed [63:0] B_LOCK_A_R = 64'sh68db574
+) (
+    input  wire                           clk,
+    input  wire                           rst,
+    input  wire                           ce,
+    input  wire                           enable,
+    input  wire [SEL_W-1:0]               bw_sel,
+    input  wire signed [DEMOD_ADC_W-1:0]  adc_a_x,
+    input  wire signed [DEMOD_ADC_W-1:0]  adc_a_y,
+    input  wire signed [DEMOD_ADC_W-1:0]  adc_b_x,
+    input  wire signed [DEMOD_ADC_W-1:0]  adc_b_y,
+    output wire signed [DAC_W-1:0]        dac_a_x,
+    output wire signed [DAC_W-1:0]        dac_a_y,
+    output wire signed [DAC_W-1:0]        dac_b_x,
+    output wire signed [DAC_W-1:0]        dac_b_y,
+    output wire                           locked_a,
+    output wire                           locked_b,
+    output wire                           mode_a,
+    output wire                           mode_b,
+    output wire                           out_valid,
+    output wire signed [OUT_W-1:0]        rate_out,
+    output wire signed [BIAS_W-1:0]       bias_a,
+    output wire signed [BIAS_W-1:0]       bias_b,
+    output wire                           estimated
+);
+
+// enable and bw_sel as of the ADC sample in flight: the loops' decimated output
+// comes 4 clocks after its ce, while the inputs may already describe the next.
+reg enable_reg = 1'b0;
+reg [SEL_W-1:0] bw_sel_reg = {SEL_W{1'b0}};
+
+always @(posedge clk) begin
+    if (rst) begin
+        enable_reg <= 1'b0;
+        bw_sel_reg <= {SEL_W{1'b0}};
+    end else if (ce) begin
+        enable_reg <= enable;
+        bw_sel_reg <= bw_sel;
+    end
+end
+
+wire loop_mode_a = enable ? mode_a : 1'b1;
+wire loop_mode_b = enable ? mode_b : 1'b1;
+wire signed [IN_W-1:0] rate_a;
+wire signed [IN_W-1:0] rate_b;
+wire loop_valid;
+
+/* verilator lint_off PINCONNECTEMPTY */
+gyrofx_gyro_loop #(
+        .NCO_PHASE_W(NCO_PHASE_W), .NCO_ADDR_W(NCO_ADDR_W), .NCO_SIN_W(NCO_SIN_W),
+        .DEMOD_ADC_W(DEMOD_ADC_W), .DEMOD_ADC_F(DEMOD_ADC_F), .DEMOD_REF_W(DEMOD_REF_W),
+        .DEMOD_REF_F(DEMOD_REF_F), .DEMOD_PROD_W(DEMOD_PROD_W), .DEMOD_PROD_F(DEMOD_PROD_F),
+        .DEMOD_STATE_W(DEMOD_STATE_W), .DEMOD_STATE_F(DEMOD_STATE_F),
+        .DEMOD_OUT_W(DEMOD_OUT_W), .DEMOD_OUT_F(DEMOD_OUT_F), .DEMOD_SHIFT(DEMOD_SHIFT),
+        .PLL_ERR_W(PLL_ERR_W), .PLL_ERR_F(PLL_ERR_F), .PLL_KP_W(A_PLL_KP_W),
+        .PLL_KP_F(A_PLL_KP_F), .PLL_KI_W(A_PLL_KI_W), .PLL_KI_F(A_PLL_KI_F),
+        .PLL_INT_W(PLL_INT_W), .PLL_INT_F(PLL_INT_F), .PLL_OUT_W(PLL_OUT_W),
+        .PLL_OUT_F(PLL_OUT_F), .PLL_KP(A_PLL_KP), .PLL_KI(A_PLL_KI),
+        .PLL_INT_MIN(A_PLL_INT_MIN), .PLL_INT_MAX(A_PLL_INT_MAX), .AGC_ERR_W(AGC_ERR_W),
+        .AGC_ERR_F(AGC_ERR_F), .AGC_KP_W(A_AGC_KP_W), .AGC_KP_F(A_AGC_KP_F),
+        .AGC_KI_W(A_AGC_KI_W), .AGC_KI_F(A_AGC_KI_F), .AGC_INT_W(AGC_INT_W),
+        .AGC_INT_F(AGC_INT_F), .AGC_OUT_W(AGC_OUT_W), .AGC_OUT_F(AGC_OUT_F), .AGC_KP(A_AGC_KP),
+        .AGC_KI(A_AGC_KI), .AGC_INT_MIN(A_AGC_INT_MIN), .AGC_INT_MAX(A_AGC_INT_MAX),
+        .CIC_IN_W(CIC_IN_W), .CIC_IN_F(CIC_IN_F), .CIC_STAGES(CIC_STAGES),
+        .CIC_DECIMATION(CIC_DECIMATION), .CIC_DELAY(CIC_DELAY), .CIC_SHIFT(CIC_SHIFT),
+        .CIC_MID_W(CIC_MID_W), .CIC_MID_F(CIC_MID_F), .CIC_TAPS(CIC_TAPS),
+        .CIC_COEF_W(CIC_COEF_W), .CIC_COEF_F(CIC_COEF_F), .CIC_OUT_W(CIC_OUT_W),
+        .CIC_OUT_F(CIC_OUT_F), .DAC_W(DAC_W), .DAC_F(DAC_F), .OUT_W(IN_W), .OUT_F(IN_F),
+        .COEF_W(A_COEF_W), .COEF_F(A_COEF_F), .LATENCY(LOOP_LATENCY), .LOCK_SHIFT(LOCK_SHIFT),
+        .LOCK_HOLD(LOCK_HOLD), .SETPOINT_N(A_SETPOINT_N), .SETPOINT_R(A_SETPOINT_R),
+        .FREQ_WORD_N(A_FREQ_WORD_N), .FREQ_WORD_R(A_FREQ_WORD_R),
+        .PLL_PRESET_N(A_PLL_PRESET_N), .PLL_PRESET_R(A_PLL_PRESET_R),
+        .DAC_OFFSET_N(A_DAC_OFFSET_N), .DAC_OFFSET_R(A_DAC_OFFSET_R),
+        .SENSE_OFFSET_N(A_SENSE_OFFSET_N), .SENSE_OFFSET_R(A_SENSE_OFFSET_R),
+        .RATE_COEF_N(A_RATE_COEF_N), .RATE_COEF_R(A_RATE_COEF_R), .QUAD_COEF_N(A_QUAD_COEF_N),
+        .QUAD_COEF_R(A_QUAD_COEF_R), .LOCK_Q_N(A_LOCK_Q_N), .LOCK_Q_R(A_LOCK_Q_R),
+        .LOCK_A_N(A_LOCK_A_N), .LOCK_A_R(A_LOCK_A_R), .ROUNDING(LOOP_ROUNDING),
+        .SATURATE(LOOP_SATURATE), .NCO_ROM_FILE(NCO_ROM_FILE), .CIC_ROM_FILE(CIC_ROM_FILE)
+) loop_a (
+    .clk(clk), .rst(rst), .ce(ce), .mode(loop_mode_a), .adc_x(adc_a_x), .adc_y(adc_a_y),
+    .dac_x(dac_a_x), .dac_y(dac_a_y), .rate(rate_a), .quadrature(), .out_valid(loop_valid),
+    .locked(locked_a)
+);
+
+// B decimates by the same factor from the same reset: its out_valid is A's.
+gyrofx_gyro_loop #(
+        .NCO_PHASE_W(NCO_PHASE_W), .NCO_ADDR_W(NCO_ADDR_W), .NCO_SIN_W(NCO_SIN_W),
+        .DEMOD_ADC_W(DEMOD_ADC_W), .DEMOD_ADC_F(DEMOD_ADC_F), .DEMOD_REF_W(DEMOD_REF_W),
+        .DEMOD_REF_F(DEMOD_REF_F), .DEMOD_PROD_W(DEMOD_PROD_W), .DEMOD_PROD_F(DEMOD_PROD_F),
+        .DEMOD_STATE_W(DEMOD_STATE_W), .DEMOD_STATE_F(DEMOD_STATE_F),
+        .DEMOD_OUT_W(DEMOD_OUT_W), .DEMOD_OUT_F(DEMOD_OUT_F), .DEMOD_SHIFT(DEMOD_SHIFT),
+        .PLL_ERR_W(PLL_ERR_W), .PLL_ERR_F(PLL_ERR_F), .PLL_KP_W(B_PLL_KP_W),
+        .PLL_KP_F(B_PLL_KP_F), .PLL_KI_W(B_PLL_KI_W), .PLL_KI_F(B_PLL_KI_F),
+        .PLL_INT_W(PLL_INT_W), .PLL_INT_F(PLL_INT_F), .PLL_OUT_W(PLL_OUT_W),
+        .PLL_OUT_F(PLL_OUT_F), .PLL_KP(B_PLL_KP), .PLL_KI(B_PLL_KI),
+        .PLL_INT_MIN(B_PLL_INT_MIN), .PLL_INT_MAX(B_PLL_INT_MAX), .AGC_ERR_W(AGC_ERR_W),
+        .AGC_ERR_F(AGC_ERR_F), .AGC_KP_W(B_AGC_KP_W), .AGC_KP_F(B_AGC_KP_F),
+        .AGC_KI_W(B_AGC_KI_W), .AGC_KI_F(B_AGC_KI_F), .AGC_INT_W(AGC_INT_W),
+        .AGC_INT_F(AGC_INT_F), .AGC_OUT_W(AGC_OUT_W), .AGC_OUT_F(AGC_OUT_F), .AGC_KP(B_AGC_KP),
+        .AGC_KI(B_AGC_KI), .AGC_INT_MIN(B_AGC_INT_MIN), .AGC_INT_MAX(B_AGC_INT_MAX),
+        .CIC_IN_W(CIC_IN_W), .CIC_IN_F(CIC_IN_F), .CIC_STAGES(CIC_STAGES),
+        .CIC_DECIMATION(CIC_DECIMATION), .CIC_DELAY(CIC_DELAY), .CIC_SHIFT(CIC_SHIFT),
+        .CIC_MID_W(CIC_MID_W), .CIC_MID_F(CIC_MID_F), .CIC_TAPS(CIC_TAPS),
+        .CIC_COEF_W(CIC_COEF_W), .CIC_COEF_F(CIC_COEF_F), .CIC_OUT_W(CIC_OUT_W),
+        .CIC_OUT_F(CIC_OUT_F), .DAC_W(DAC_W), .DAC_F(DAC_F), .OUT_W(IN_W), .OUT_F(IN_F),
+        .COEF_W(B_COEF_W), .COEF_F(B_COEF_F), .LATENCY(LOOP_LATENCY), .LOCK_SHIFT(LOCK_SHIFT),
+        .LOCK_HOLD(LOCK_HOLD), .SETPOINT_N(B_SETPOINT_N), .SETPOINT_R(B_SETPOINT_R),
+        .FREQ_WORD_N(B_FREQ_WORD_N), .FREQ_WORD_R(B_FREQ_WORD_R),
+        .PLL_PRESET_N(B_PLL_PRESET_N), .PLL_PRESET_R(B_PLL_PRESET_R),
+        .DAC_OFFSET_N(B_DAC_OFFSET_N), .DAC_OFFSET_R(B_DAC_OFFSET_R),
+        .SENSE_OFFSET_N(B_SENSE_OFFSET_N), .SENSE_OFFSET_R(B_SENSE_OFFSET_R),
+        .RATE_COEF_N(B_RATE_COEF_N), .RATE_COEF_R(B_RATE_COEF_R), .QUAD_COEF_N(B_QUAD_COEF_N),
+        .QUAD_COEF_R(B_QUAD_COEF_R), .LOCK_Q_N(B_LOCK_Q_N), .LOCK_Q_R(B_LOCK_Q_R),
+        .LOCK_A_N(B_LOCK_A_N), .LOCK_A_R(B_LOCK_A_R), .ROUNDING(LOOP_ROUNDING),
+        .SATURATE(LOOP_SATURATE), .NCO_ROM_FILE(NCO_ROM_FILE), .CIC_ROM_FILE(CIC_ROM_FILE)
+) loop_b (
+    .clk(clk), .rst(rst), .ce(ce), .mode(loop_mode_b), .adc_x(adc_b_x), .adc_y(adc_b_y),
+    .dac_x(dac_b_x), .dac_y(dac_b_y), .rate(rate_b), .quadrature(), .out_valid(),
+    .locked(locked_b)
+);
+/* verilator lint_on PINCONNECTEMPTY */
+
+gyrofx_top #(
+    .INTERVAL_LENGTH(INTERVAL_LENGTH), .INTERVALS(INTERVALS), .PATTERN(PATTERN), .BLANK(BLANK),
+    .STAGGER(STAGGER), .PHASE_W(PHASE_W), .INTERVAL_W(INTERVAL_W), .IN_W(IN_W), .IN_F(IN_F),
+    .ACC_W(ACC_W), .RECIP_W(RECIP_W), .RECIP_F(RECIP_F), .RECIP(RECIP), .MEAN_W(MEAN_W),
+    .MEAN_F(MEAN_F), .GAIN_W(GAIN_W), .GAIN_F(GAIN_F), .DOT_W(DOT_W), .BIAS_W(BIAS_W),
+    .BIAS_F(BIAS_F), .SMOOTH(SMOOTH), .GAIN_ROM_FILE(GAIN_ROM_FILE), .STATE_W(STATE_W),
+    .STATE_F(STATE_F), .OUT_W(OUT_W), .OUT_F(OUT_F), .G1_W(G1_W), .G1_F(G1_F), .G2_W(G2_W),
+    .G2_F(G2_F), .SEL_W(SEL_W), .ROM_DEPTH(ROM_DEPTH), .KF_ROM_FILE(KF_ROM_FILE),
+    .ROUNDING(ROUNDING), .SATURATE(SATURATE)
+) chain (
+    .clk(clk), .rst(rst), .ce(loop_valid && enable_reg), .bw_sel(bw_sel_reg),
+    .y_a(rate_a), .y_b(rate_b), .mode_a(mode_a), .mode_b(mode_b), .rate_out(rate_out),
+    .out_valid(out_valid), .bias_a(bias_a), .bias_b(bias_b), .estimated(estimated)
+);
+
+endmodule
+
+`resetall
