@@ -166,6 +166,69 @@ fn bad_input_is_refused_clearly() {
     }
 }
 
+/// `--taus many` gives ten factors per decade; `--taus all` refuses a record too long for its
+/// N² time before any work, naming the limit and the alternatives; the Hadamard deviation
+/// leaves the rate ramp out (its third difference cancels a ramp) rather than print a number.
+#[test]
+fn tau_grids_and_the_kinds_terms() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = white_csv(dir.path(), 10_000);
+    let json = |kind: &str, taus: &str| -> serde_json::Value {
+        let out = ok(&[
+            "allan", "--input", &csv, "--rate", "1", "--taus", taus, "--kind", kind, "--json",
+        ]);
+        serde_json::from_str(&out).unwrap()
+    };
+    let many = json("overlapping", "many");
+    let taus: Vec<f64> = many["tau_s"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t.as_f64().unwrap())
+        .collect();
+    assert_eq!(taus.len(), 34, "{taus:?}"); // 1 … 3981 (max 4999): 7 distinct in the first decade
+    assert_eq!(&taus[..8], &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0]);
+    let hadamard = json("hadamard", "octave");
+    assert!(hadamard["noise"]["rate_ramp_deg_per_h2"]["value"].is_null());
+    assert!(
+        hadamard["noise"]["arw_deg_per_sqrt_h"]["value"]
+            .as_f64()
+            .unwrap()
+            > 0.0
+    );
+    let text = ok(&[
+        "allan", "--input", &csv, "--rate", "1", "--kind", "hadamard",
+    ]);
+    assert!(
+        text.contains("the Hadamard variance cancels a rate ramp"),
+        "{text}"
+    );
+    // White noise of variance 1/12 at 1 Hz: N = sqrt(1/12) °/√s for every kind.
+    for kind in ["overlapping", "nonoverlapping", "modified", "hadamard"] {
+        let n = json(kind, "octave")["noise"]["arw_deg_per_sqrt_h"]["value"]
+            .as_f64()
+            .unwrap();
+        let want = (1.0f64 / 12.0).sqrt() * 60.0;
+        assert!((n / want - 1.0).abs() < 0.05, "{kind}: N {n} vs {want}");
+    }
+
+    let long = dir.path().join("long.csv");
+    let mut text = String::with_capacity(2_100_000 * 2);
+    text.push_str("rate_dps\n");
+    for k in 0..1_000_001u32 {
+        text.push_str(if k % 2 == 0 { "1\n" } else { "0\n" });
+    }
+    std::fs::write(&long, text).unwrap();
+    let long = long.to_string_lossy().into_owned();
+    let log = fails(&["allan", "--input", &long, "--rate", "1", "--taus", "all"]);
+    assert!(
+        log.contains("1000001 samples")
+            && log.contains("at most 1000000")
+            && log.contains("--taus many"),
+        "{log}"
+    );
+}
+
 /// White noise with a ×8 burst from 90 s to 100 s at 100 Hz.
 fn burst_csv(dir: &std::path::Path) -> String {
     let mut n: u64 = 987_654_321;

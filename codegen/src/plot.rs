@@ -14,9 +14,10 @@ use std::path::{Path, PathBuf};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use gyrofx_model::analysis::allan::Kind;
 use gyrofx_model::analysis::allan::Point;
 use gyrofx_model::analysis::davar::{Coefficients, Davar};
-use gyrofx_model::analysis::noise::{Terms, FLICKER_FLOOR};
+use gyrofx_model::analysis::noise::{self, Terms};
 use gyrofx_model::gyro_loop::trace::TracePoint;
 
 use crate::error::{Error, Result};
@@ -57,17 +58,14 @@ fn plot_error(path: &Path, e: impl std::fmt::Display) -> Error {
     Error::Plot(format!("plot {}: {e}", path.display()))
 }
 
-/// `σ²(τ)` of one noise term per unit of its squared coefficient.
-type TermShape = fn(f64) -> f64;
-
 /// One series of an Allan plot.
 pub struct AllanSeries<'a> {
     /// Legend label.
     pub label: String,
     /// The curve.
     pub points: &'a [Point],
-    /// The fitted terms, drawn as lines.
-    pub terms: Option<&'a Terms>,
+    /// The fitted terms and the kind of deviation they were fitted to, drawn as lines.
+    pub terms: Option<(&'a Terms, Kind)>,
 }
 
 const COLORS: [RGBColor; 6] = [
@@ -145,21 +143,31 @@ fn draw_allan<DB: DrawingBackend>(
             .legend(move |(x, y)| {
                 PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(1))
             });
-        if let Some(t) = s.terms {
+        if let Some((t, kind)) = s.terms {
             let taus: Vec<f64> = (0..=60)
                 .map(|k| tmin * (tmax / tmin).powf(k as f64 / 60.0))
                 .collect();
-            let terms: [(f64, TermShape); 5] = [
-                (t.q.value, |tau| 3.0 / (tau * tau)),
-                (t.n.value, |tau| 1.0 / tau),
-                (t.b.value, |_| FLICKER_FLOOR * FLICKER_FLOOR),
-                (t.k.value, |tau| tau / 3.0),
-                (t.r.value, |tau| tau * tau / 2.0),
-            ];
-            for (value, shape) in terms.iter().filter(|(v, _)| *v > 0.0) {
+            // The sample interval, for the modified deviation's factor-dependent terms.
+            let tau0 = s
+                .points
+                .first()
+                .map_or(1.0, |p| p.tau_s / p.m.max(1) as f64);
+            let shape = |j: usize, tau: f64| {
+                let m = (tau / tau0).round().max(1.0) as usize;
+                noise::basis(kind, tau, m)[j]
+            };
+            let values = [t.q.value, t.n.value, t.b.value, t.k.value, t.r.value];
+            let terms: Vec<(usize, f64)> = values
+                .iter()
+                .copied()
+                .enumerate()
+                .filter(|(_, v)| *v > 0.0)
+                .collect();
+            for (j, value) in &terms {
                 chart
                     .draw_series(LineSeries::new(
-                        taus.iter().map(|tau| (*tau, value * shape(*tau).sqrt())),
+                        taus.iter()
+                            .map(|tau| (*tau, value * shape(*j, *tau).sqrt())),
                         color.mix(0.35).stroke_width(1),
                     ))
                     .map_err(|x| e(&x))?;
@@ -167,7 +175,7 @@ fn draw_allan<DB: DrawingBackend>(
             chart
                 .draw_series(LineSeries::new(
                     taus.iter().map(|tau| {
-                        let total: f64 = terms.iter().map(|(v, shape)| v * v * shape(*tau)).sum();
+                        let total: f64 = terms.iter().map(|(j, v)| v * v * shape(*j, *tau)).sum();
                         (*tau, total.sqrt())
                     }),
                     color.mix(0.6).stroke_width(1),

@@ -24,7 +24,7 @@ pub struct Args {
     column: Vec<String>,
     #[command(flatten)]
     rate: SampleRate,
-    /// Averaging times: octave, decade or all.
+    /// Averaging times: octave, decade, many (ten per decade) or all (every factor: O(N²) time).
     #[arg(long, default_value = "octave")]
     taus: String,
     /// Deviation: overlapping, nonoverlapping, modified or hadamard.
@@ -37,6 +37,10 @@ pub struct Args {
     #[arg(long)]
     plot: Option<PathBuf>,
 }
+
+/// The longest record `--taus all` takes: its time grows as N² (10⁵ samples: 1.2 s, 10⁶:
+/// about 2 minutes on two cores); memory stays O(N) at any length.
+const ALL_TAUS_MAX_SAMPLES: usize = 1_000_000;
 
 /// Prints the deviation and the noise terms of every input × column (a table, or JSON), and
 /// writes the plot if asked.
@@ -91,16 +95,25 @@ pub fn run(args: Args) -> Result<ExitCode> {
                 values.len()
             );
         }
+        if grid == allan::Grid::All && values.len() > ALL_TAUS_MAX_SAMPLES {
+            usage!(
+                "--taus all on {} ({} samples): every factor up to N/2 is a pass over the record, about N²/4 = {:.1e} terms (hours at this size); all takes at most {ALL_TAUS_MAX_SAMPLES} samples: use --taus many (ten per decade) or octave",
+                path.display(),
+                values.len(),
+                (values.len() as f64).powi(2) / 4.0
+            );
+        }
         let points = allan::curve(kind, &values, rate, grid);
-        let terms = noise::fit(&points);
-        let report = noise::report(&points, &terms);
+        let terms = noise::fit(&points, kind);
+        let report = noise::report(&points, &terms, kind);
         let label = if columns.len() > 1 {
             format!("{} [{column}]", path.display())
         } else {
             path.display().to_string()
         };
         curves.push((label, points.clone(), terms));
-        // Welch with the largest power-of-two segment up to N/8 (at most 2048).
+        // Welch with the largest power-of-two segment up to N/8, at most 2048 (half of the
+        // clamp's 4096: the power of two at or above the clamped length, halved).
         let segment = (values.len() / 8).clamp(8, 4096).next_power_of_two() / 2;
         let density = (segment >= 8)
             .then(|| gyrofx_model::analysis::spectrum::welch(&values, rate, segment.max(8)))
@@ -144,7 +157,10 @@ pub fn run(args: Args) -> Result<ExitCode> {
                     e.value, e.lo, e.hi
                 );
             };
-            println!("noise terms (weighted non-negative fit, ±1 standard error):");
+            println!(
+                "noise terms (weighted non-negative fit of the {} variance's model, ±1 standard error):",
+                format!("{kind:?}").to_lowercase()
+            );
             line("quantization Q", report.quantization_urad, "µrad");
             line("angle random walk N", report.arw_deg_per_sqrt_h, "°/√h");
             line(
@@ -157,7 +173,14 @@ pub fn run(args: Args) -> Result<ExitCode> {
                 report.rrw_deg_per_h_per_sqrt_h,
                 "°/h/√h",
             );
-            line("rate ramp R", report.rate_ramp_deg_per_h2, "°/h²");
+            if report.rate_ramp_deg_per_h2.value.is_nan() {
+                println!(
+                    "  {:<28} {:>12} (the Hadamard variance cancels a rate ramp)",
+                    "rate ramp R", "-"
+                );
+            } else {
+                line("rate ramp R", report.rate_ramp_deg_per_h2, "°/h²");
+            }
             println!(
                 "  Kalibr: noise density {:.5e} rad/s/√Hz, random walk {:.5e} rad/s²/√Hz",
                 report.kalibr_noise_density_rad_per_s_per_sqrt_hz,
@@ -169,7 +192,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
                 opt(density)
             );
             println!(
-                "  slope readings: N {} °/√h (τ = 1 s), K {} °/h/√h (τ = 3 s), B {:.5e} °/h (min/0.6643)",
+                "  slope readings: N {} °/√h (τ = 1 s), K {} °/h/√h (τ = 3 s), B {:.5e} °/h (min/0.6643), the kind's response divided out",
                 opt(report.slope_arw_deg_per_sqrt_h),
                 opt(report.slope_rrw_deg_per_h_per_sqrt_h),
                 report.slope_bias_instability_deg_per_h
@@ -182,7 +205,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
             .map(|(label, points, terms)| gyrofx_codegen::plot::AllanSeries {
                 label: label.clone(),
                 points,
-                terms: Some(terms),
+                terms: Some((terms, kind)),
             })
             .collect();
         let title = match kind {

@@ -87,8 +87,8 @@ pub(crate) fn variance(values: &[f64]) -> f64 {
 /// The five noise terms of `rate` (°/s at `rate_hz`) in Table 2's units.
 pub(crate) fn terms(rate: &[f64], rate_hz: f64) -> [f64; 5] {
     let points = allan::curve(Kind::Overlapping, rate, rate_hz, Grid::Octave);
-    let fitted = noise::fit(&points);
-    let report = noise::report(&points, &fitted);
+    let fitted = noise::fit(&points, Kind::Overlapping);
+    let report = noise::report(&points, &fitted, Kind::Overlapping);
     [
         report.quantization_urad.value,
         report.arw_deg_per_sqrt_h.value,

@@ -19,15 +19,17 @@
 //! with `N` the number of phase points (samples + 1), as in NIST SP 1065 (§5.2), whose
 //! reference values the tests reproduce.
 //!
-//! Confidence intervals: the equivalent degrees of freedom of the overlapping ADEV from the
-//! simple approximations of NIST SP 1065 Table 5 (Howe, Allan & Barnes 1981) for the noise type
-//! identified at that τ, and the χ² interval `σ² · edf / χ²(p)` (SP 1065 eq. 45), by default
+//! Confidence intervals: the equivalent degrees of freedom of the kind's estimator
+//! (Greenhall & Riley 2003, [`edf`]; [`edf_overlapping`] keeps SP 1065 Table 5's simple
+//! approximations for the overlapping ADEV) for the noise type identified at that τ, and the χ²
+//! interval `σ² · edf / χ²(p)` (SP 1065 eq. 45), by default
 //! the 68.3 % (1σ) interval. The noise type at each τ comes from the lag-1 autocorrelation of
 //! the τ-averaged rate (Riley & Greenhall 2004): `ρ = r1/(1 + r1)`, differencing while `ρ >= ¼`
 //! (at most twice), `α = −2(ρ + d)` rounded — α = 2 white PM (quantization), 0 white FM
 //! (ARW), −1 flicker FM (bias instability), −2 random-walk FM (RRW).
 
 use super::chi2::chi2_quantile;
+use super::edf;
 
 /// Which deviation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -51,6 +53,8 @@ pub enum Grid {
     Decade,
     /// Every m.
     All,
+    /// Ten log-spaced factors per decade (1, 2, 3, 4, 5, 6, 8, 10, 13, 16, 20, 25, …).
+    Many,
 }
 
 impl std::str::FromStr for Grid {
@@ -60,8 +64,9 @@ impl std::str::FromStr for Grid {
             "octave" => Ok(Grid::Octave),
             "decade" => Ok(Grid::Decade),
             "all" => Ok(Grid::All),
+            "many" => Ok(Grid::Many),
             other => Err(format!(
-                "'{other}' is not a tau grid: expected octave, decade or all"
+                "'{other}' is not a tau grid: expected octave, decade, many or all"
             )),
         }
     }
@@ -81,11 +86,12 @@ pub fn phase(rate: &[f64]) -> Vec<f64> {
     out
 }
 
-/// Largest averaging factor `kind` can use on `points` phase points (at least 2 terms for ADEV
-/// and Hadamard, 1 for the modified).
+/// Largest averaging factor `kind` can use on `points` phase points: a deviation rests on at
+/// least two terms (differences) for every kind.
 pub fn max_factor(kind: Kind, points: usize) -> usize {
     match kind {
-        Kind::Overlapping | Kind::NonOverlapping => points.saturating_sub(2) / 2,
+        Kind::Overlapping => points.saturating_sub(2) / 2,
+        Kind::NonOverlapping => points.saturating_sub(1) / 3,
         Kind::Modified => points.saturating_sub(1) / 3,
         Kind::Hadamard => points.saturating_sub(2) / 3,
     }
@@ -102,6 +108,22 @@ pub fn factors(kind: Kind, grid: Grid, points: usize) -> Vec<usize> {
             while m <= max {
                 out.push(m);
                 m *= 2;
+            }
+        }
+        Grid::Many => {
+            // round(10^(k/10)), each factor once; exact powers of ten by integer steps.
+            let mut k = 0u32;
+            loop {
+                let decade = 10usize.saturating_pow(k / 10);
+                let m =
+                    (decade as f64 * libm::pow(10.0, f64::from(k % 10) / 10.0)).round() as usize;
+                if m > max || decade == usize::MAX {
+                    break;
+                }
+                if out.last() != Some(&m) {
+                    out.push(m);
+                }
+                k += 1;
             }
         }
         Grid::Decade => {
@@ -436,9 +458,20 @@ pub fn deviations(
     })
 }
 
+impl Kind {
+    /// The estimator's structure, for its degrees of freedom.
+    pub fn estimator(self) -> edf::Estimator {
+        edf::Estimator {
+            d: if self == Kind::Hadamard { 3 } else { 2 },
+            modified: self == Kind::Modified,
+            overlapping: self != Kind::NonOverlapping,
+        }
+    }
+}
+
 /// The curve of `kind` over `grid` for a rate record at `rate_hz`, with 1σ confidence
-/// intervals (the overlapping-ADEV EDF for every kind). The noise type is identified at each
-/// octave and used for the factors up to the next one.
+/// intervals from the kind's own equivalent degrees of freedom ([`edf::edf`]). The noise type
+/// is identified at each octave and used for the factors up to the next one.
 pub fn curve(kind: Kind, rate: &[f64], rate_hz: f64, grid: Grid) -> Vec<Point> {
     let x = phase(rate);
     let factors = factors(kind, grid, x.len());
@@ -458,7 +491,7 @@ pub fn curve(kind: Kind, rate: &[f64], rate_hz: f64, grid: Grid) -> Vec<Point> {
                     a
                 }
             };
-            let edf = edf_overlapping(x.len(), *m, alpha);
+            let edf = edf::edf(kind.estimator(), alpha, *m, x.len()).unwrap_or(1.0);
             let (lo, hi) = confidence_interval(dev, edf, ONE_SIGMA);
             Some(Point {
                 tau_s: *m as f64 / rate_hz,

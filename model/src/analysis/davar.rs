@@ -26,7 +26,7 @@
 
 use serde::Serialize;
 
-use super::allan::{factors, phase, Grid, Kind};
+use super::allan::{self, factors, phase, Grid, Kind};
 use super::noise;
 
 /// How the window moves.
@@ -273,7 +273,7 @@ pub fn coefficients(d: &Davar) -> Coefficients {
             c.rrw_deg_per_h_per_sqrt_h.push(0.0);
             continue;
         }
-        let terms = noise::fit(&points);
+        let terms = noise::fit(&points, allan::Kind::Overlapping);
         // A degenerate window (e.g. all points equal) can make the fit non-finite: NaN,
         // written as null.
         let finite = |v: f64| if v.is_finite() { v } else { f64::NAN };

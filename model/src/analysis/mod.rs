@@ -8,6 +8,7 @@ pub mod ar;
 pub mod chi2;
 pub mod davar;
 pub mod denoise;
+pub mod edf;
 pub mod emd;
 pub mod noise;
 pub mod spectrum;

@@ -22,7 +22,7 @@
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
-use super::allan::Point;
+use super::allan::{Kind, Point};
 
 /// The flicker floor factor: `σ_floor = 0.6643 B` (√(2 ln 2 / π)).
 pub const FLICKER_FLOOR: f64 = 0.664_3;
@@ -89,15 +89,66 @@ pub struct Report {
     pub slope_bias_instability_deg_per_h: f64,
 }
 
-/// The basis functions of `σ²(τ)` for `[Q², N², B², K², R²]`.
-fn basis(tau: f64) -> [f64; 5] {
-    [
-        3.0 / (tau * tau),
-        1.0 / tau,
-        FLICKER_FLOOR * FLICKER_FLOOR,
-        tau / 3.0,
-        tau * tau / 2.0,
-    ]
+/// `Mod σ²/σ²` of flicker FM for large `m`: `(27/16 ln 3 − 2 ln 2)/ln 2` (Mod σ² =
+/// `2 ln(3^{27/16}/4) h₋₁` against `2 ln 2 h₋₁`; SP 1065 gives 0.67).
+pub const MODIFIED_FLICKER_RATIO: f64 = 0.674_624_219_966_951_5;
+/// `Mod σ²/σ²` of random-walk FM for large `m`: `(11/20 π²)/(2/3 π²) = 33/40` (SP 1065: 0.82).
+pub const MODIFIED_RANDOM_WALK_RATIO: f64 = 33.0 / 40.0;
+/// `σ²_H/σ²` of flicker FM: `(4 ln 2 − 3/2 ln 3)/(2 ln 2)` (from `(8/3) ∫ sin⁶u/u³ du`).
+pub const HADAMARD_FLICKER_RATIO: f64 = 0.811_278_124_459_132_8;
+
+/// `Mod σ²` of white FM at factor `m` over its Allan variance `N²/τ`, exactly: the mean of
+/// `m` second differences of a random walk weights the `3m − 1` rate samples by a
+/// triangle-like pattern `w` with `Σw² = 5 S(m) + S(m − 1) − 2m²(m + 1) + m³`
+/// (`S(n) = n(n+1)(2n+1)/6`), and `Mod σ² = N² Σw² / (2 m³ τ)`: 1 at `m = 1`, → ½.
+pub fn modified_white_fm_ratio(m: usize) -> f64 {
+    let m = m.max(1) as f64;
+    let s = |n: f64| n * (n + 1.0) * (2.0 * n + 1.0) / 6.0;
+    let sum = 5.0 * s(m) + s(m - 1.0) - 2.0 * m * m * (m + 1.0) + m * m * m;
+    sum / (2.0 * m * m * m)
+}
+
+/// The response of `kind`'s variance at `τ` (factor `m`) to each term:
+/// `σ²(τ) = Σ_j c_j basis_j` for `c = [Q², N², B², K², R²]` (IEEE 952 defines the terms on the
+/// Allan variance). The Allan variances (overlapping or not) share one model; the modified
+/// variance divides quantization by `m` and white FM by about 2 (both exact for sampled
+/// data), flicker and random-walk FM by their asymptotic ratios, and keeps the ramp; the
+/// Hadamard variance has 10/3 for quantization, half the random walk and no response to a
+/// ramp (its third difference cancels it).
+pub fn basis(kind: Kind, tau: f64, m: usize) -> [f64; 5] {
+    let floor = FLICKER_FLOOR * FLICKER_FLOOR;
+    match kind {
+        Kind::Overlapping | Kind::NonOverlapping => [
+            3.0 / (tau * tau),
+            1.0 / tau,
+            floor,
+            tau / 3.0,
+            tau * tau / 2.0,
+        ],
+        Kind::Modified => [
+            3.0 / (m.max(1) as f64 * tau * tau),
+            modified_white_fm_ratio(m) / tau,
+            MODIFIED_FLICKER_RATIO * floor,
+            MODIFIED_RANDOM_WALK_RATIO * tau / 3.0,
+            tau * tau / 2.0,
+        ],
+        Kind::Hadamard => [
+            10.0 / (3.0 * tau * tau),
+            1.0 / tau,
+            HADAMARD_FLICKER_RATIO * floor,
+            tau / 6.0,
+            0.0,
+        ],
+    }
+}
+
+/// The terms `kind` can identify: every one but the rate ramp for the Hadamard variance.
+fn identifiable(kind: Kind) -> usize {
+    if kind == Kind::Hadamard {
+        4
+    } else {
+        5
+    }
 }
 
 /// A feasible solution on one set of active terms.
@@ -112,51 +163,80 @@ struct Candidate {
     covariance: DMatrix<f64>,
 }
 
-/// Fits the five terms to an Allan curve (overlapping ADEV with EDFs).
+/// Fits the five terms to a curve of `kind` (with its EDFs), each with `kind`'s own model
+/// ([`basis`]). Memory does not grow with the number of points: the weighted normal
+/// equations are summed point by point. A term the kind cannot see (the Hadamard variance's
+/// rate ramp) comes out NaN.
 ///
 /// # Panics
 /// On an empty curve.
-pub fn fit(curve: &[Point]) -> Terms {
+pub fn fit(curve: &[Point], kind: Kind) -> Terms {
     assert!(!curve.is_empty(), "an Allan curve to fit");
     let zero = Estimate {
         value: 0.0,
         lo: 0.0,
         hi: 0.0,
     };
+    let unseen = Estimate {
+        value: f64::NAN,
+        lo: f64::NAN,
+        hi: f64::NAN,
+    };
+    let count = identifiable(kind);
+    let mut terms = [zero; 5];
+    for term in terms.iter_mut().skip(count) {
+        *term = unseen;
+    }
+    let finish = |t: [Estimate; 5]| Terms {
+        q: t[0],
+        n: t[1],
+        b: t[2],
+        k: t[3],
+        r: t[4],
+    };
     if curve.iter().all(|p| p.dev == 0.0) {
         // A constant record: no noise, and weights 1/σ⁴ that would divide by zero.
-        return Terms {
-            q: zero,
-            n: zero,
-            b: zero,
-            k: zero,
-            r: zero,
-        };
+        return finish(terms);
     }
-    let rows = curve.len();
-    let weights: Vec<f64> = curve
+    // Per point: weight, basis row, variance.
+    let rows: Vec<(f64, [f64; 5], f64)> = curve
         .iter()
-        .map(|p| p.edf / (2.0 * p.dev.powi(4)).max(f64::MIN_POSITIVE))
+        .map(|p| {
+            let w = p.edf / (2.0 * p.dev.powi(4)).max(f64::MIN_POSITIVE);
+            (w, basis(kind, p.tau_s, p.m), p.dev * p.dev)
+        })
         .collect();
     let mut best: Option<Candidate> = None;
-    for mask in 1u32..32 {
-        let active: Vec<usize> = (0..5).filter(|j| mask & (1 << j) != 0).collect();
-        if active.len() > rows {
+    for mask in 1u32..(1 << count) {
+        let active: Vec<usize> = (0..count).filter(|j| mask & (1 << j) != 0).collect();
+        let k = active.len();
+        if k > rows.len() {
             continue;
         }
-        let a = DMatrix::from_fn(rows, active.len(), |i, j| basis(curve[i].tau_s)[active[j]]);
-        let w = DMatrix::from_diagonal(&DVector::from_vec(weights.clone()));
-        let y = DVector::from_iterator(rows, curve.iter().map(|p| p.dev * p.dev));
-        let normal = a.transpose() * &w * &a;
-        let Some(covariance) = normal.clone().try_inverse() else {
+        let mut normal = DMatrix::<f64>::zeros(k, k);
+        let mut rhs = DVector::<f64>::zeros(k);
+        for (w, a, y) in &rows {
+            for (r, &jr) in active.iter().enumerate() {
+                rhs[r] += w * a[jr] * y;
+                for (c, &jc) in active.iter().enumerate() {
+                    normal[(r, c)] += w * a[jr] * a[jc];
+                }
+            }
+        }
+        let Some(covariance) = normal.try_inverse() else {
             continue;
         };
-        let c = &covariance * a.transpose() * &w * &y;
+        let c = &covariance * rhs;
         if c.iter().any(|v| *v < 0.0) {
             continue;
         }
-        let residual = &y - &a * &c;
-        let cost = (residual.transpose() * &w * &residual)[(0, 0)];
+        let cost: f64 = rows
+            .iter()
+            .map(|(w, a, y)| {
+                let model: f64 = active.iter().zip(c.iter()).map(|(j, cj)| a[*j] * cj).sum();
+                w * (y - model) * (y - model)
+            })
+            .sum();
         if best.as_ref().is_none_or(|b| cost < b.cost) {
             best = Some(Candidate {
                 cost,
@@ -166,7 +246,6 @@ pub fn fit(curve: &[Point]) -> Terms {
             });
         }
     }
-    let mut terms = [zero; 5];
     if let Some(Candidate {
         active,
         c,
@@ -183,13 +262,7 @@ pub fn fit(curve: &[Point]) -> Terms {
             };
         }
     }
-    Terms {
-        q: terms[0],
-        n: terms[1],
-        b: terms[2],
-        k: terms[3],
-        r: terms[4],
-    }
+    finish(terms)
 }
 
 /// Reads a line of log-log `slope` through the points whose local slope is within 0.15 of it
@@ -209,10 +282,20 @@ fn slope_reading(curve: &[Point], slope: f64, at_tau: f64) -> Option<f64> {
     Some((mean + slope * at_tau.ln()).exp())
 }
 
-/// The fit and the slope readings in IEEE-952 and Kalibr units.
-pub fn report(curve: &[Point], terms: &Terms) -> Report {
+/// The fit and the slope readings in IEEE-952 and Kalibr units, for a curve of `kind`: the
+/// readings divide out the kind's response to white FM (at τ = 1 s), random-walk FM and flicker
+/// FM (the asymptotic ratios of [`basis`]).
+pub fn report(curve: &[Point], terms: &Terms, kind: Kind) -> Report {
     let radians = std::f64::consts::PI / 180.0;
     let min = curve.iter().map(|p| p.dev).fold(f64::INFINITY, f64::min);
+    // The kind's variance over the Allan variance for white, flicker and random-walk FM.
+    let (white, flicker, random_walk): (f64, f64, f64) = match kind {
+        Kind::Overlapping | Kind::NonOverlapping => (1.0, 1.0, 1.0),
+        Kind::Modified => (0.5, MODIFIED_FLICKER_RATIO, MODIFIED_RANDOM_WALK_RATIO),
+        Kind::Hadamard => (1.0, HADAMARD_FLICKER_RATIO, 0.5),
+    };
+    let (white, flicker, random_walk): (f64, f64, f64) =
+        (white.sqrt(), flicker.sqrt(), random_walk.sqrt());
     Report {
         quantization_urad: terms.q.scaled(radians * 1e6),
         arw_deg_per_sqrt_h: terms.n.scaled(60.0),
@@ -221,16 +304,17 @@ pub fn report(curve: &[Point], terms: &Terms) -> Report {
         rate_ramp_deg_per_h2: terms.r.scaled(3600.0 * 3600.0),
         kalibr_noise_density_rad_per_s_per_sqrt_hz: terms.n.value * radians,
         kalibr_random_walk_rad_per_s2_per_sqrt_hz: terms.k.value * radians,
-        slope_arw_deg_per_sqrt_h: slope_reading(curve, -0.5, 1.0).map(|n| n * 60.0),
-        slope_rrw_deg_per_h_per_sqrt_h: slope_reading(curve, 0.5, 3.0).map(|k| k * 216_000.0),
-        slope_bias_instability_deg_per_h: min / FLICKER_FLOOR * 3600.0,
+        slope_arw_deg_per_sqrt_h: slope_reading(curve, -0.5, 1.0).map(|n| n / white * 60.0),
+        slope_rrw_deg_per_h_per_sqrt_h: slope_reading(curve, 0.5, 3.0)
+            .map(|k| k / random_walk * 216_000.0),
+        slope_bias_instability_deg_per_h: min / (FLICKER_FLOOR * flicker) * 3600.0,
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::analysis::allan::{curve, Grid, Kind};
+    use crate::analysis::allan::{curve, Grid};
     use crate::plant::{GyroErrors, Plant};
 
     /// A record with known N, B, K from the plant (one gyro, normal mode only).
@@ -264,8 +348,8 @@ mod tests {
         for seed in [7, 8, 9] {
             let y = record(0.5, 10.0, 100.0, 1 << 20, seed);
             let c = curve(Kind::Overlapping, &y, 100.0, Grid::Octave);
-            let terms = fit(&c);
-            let r = report(&c, &terms);
+            let terms = fit(&c, Kind::Overlapping);
+            let r = report(&c, &terms, Kind::Overlapping);
             let n = r.arw_deg_per_sqrt_h.value;
             let b = r.bias_instability_deg_per_h.value;
             let k = r.rrw_deg_per_h_per_sqrt_h.value;
@@ -282,14 +366,110 @@ mod tests {
         }
     }
 
+    /// Every kind with its own model recovers N and K of white + random-walk noise, with no
+    /// spurious bias instability (the Allan model on the modified deviation gave N 1.44 of
+    /// 3.0 °/√h and B 139 °/h; on the Hadamard deviation K/√2).
+    #[test]
+    fn every_kind_recovers_the_terms_with_its_own_model() {
+        let y = record(3.0, 0.0, 300.0, 1 << 20, 11);
+        for kind in [
+            Kind::Overlapping,
+            Kind::NonOverlapping,
+            Kind::Modified,
+            Kind::Hadamard,
+        ] {
+            let c = curve(kind, &y, 100.0, Grid::Octave);
+            let r = report(&c, &fit(&c, kind), kind);
+            let n = r.arw_deg_per_sqrt_h.value;
+            let b = r.bias_instability_deg_per_h.value;
+            let k = r.rrw_deg_per_h_per_sqrt_h.value;
+            assert!((n / 3.0 - 1.0).abs() < 0.05, "{kind:?}: N = {n}: {r:?}");
+            assert!((k / 300.0 - 1.0).abs() < 0.3, "{kind:?}: K = {k}: {r:?}");
+            assert!(b < 5.0, "{kind:?}: B = {b}: {r:?}");
+            if let Some(slope) = r.slope_arw_deg_per_sqrt_h {
+                assert!((slope / 3.0 - 1.0).abs() < 0.1, "{kind:?}: slope N {slope}");
+            }
+        }
+    }
+
     #[test]
     fn a_term_that_is_absent_comes_out_zero_or_small() {
         // White noise only: N alone, no K, no R.
         let y = record(1.0, 0.0, 0.0, 1 << 18, 3);
         let c = curve(Kind::Overlapping, &y, 100.0, Grid::Octave);
-        let r = report(&c, &fit(&c));
+        let r = report(&c, &fit(&c, Kind::Overlapping), Kind::Overlapping);
         assert!((r.arw_deg_per_sqrt_h.value - 1.0).abs() < 0.03, "{r:?}");
         assert!(r.rrw_deg_per_h_per_sqrt_h.value < 2.0, "{r:?}");
         assert!(r.rate_ramp_deg_per_h2.value < 10.0, "{r:?}");
+    }
+}
+
+#[cfg(test)]
+mod model_tests {
+    use super::*;
+
+    /// `∫_0^∞ f(u) du` by Simpson's rule on [0, 4000] (the integrands here fall as u⁻³ or
+    /// faster: the tail is below 1e-7).
+    fn integral(f: impl Fn(f64) -> f64) -> f64 {
+        let (end, steps) = (4000.0, 4_000_000);
+        let h = end / steps as f64;
+        let mut sum = 0.0;
+        for i in 0..=steps {
+            let u = i as f64 * h;
+            let w = if i == 0 || i == steps {
+                1.0
+            } else if i % 2 == 1 {
+                4.0
+            } else {
+                2.0
+            };
+            sum += w * f(u);
+        }
+        sum * h / 3.0
+    }
+
+    fn sinc_power(u: f64, sine: i32, denominator: i32) -> f64 {
+        if u == 0.0 {
+            // The limit: 1 where the powers match, 0 where the sine's is higher.
+            f64::from(u8::from(sine == denominator))
+        } else {
+            u.sin().powi(sine) / u.powi(denominator)
+        }
+    }
+
+    /// The constants against the transfer functions: σ² = 2∫S_y sin⁴(πfτ)/(πfτ)², Mod σ²
+    /// (m → ∞) = 2∫S_y sin⁶/(πfτ)⁴, σ²_H = (8/3)∫S_y sin⁶/(πfτ)², for S_y = h₋₁/f and h₋₂/f².
+    #[test]
+    fn the_kind_ratios_are_the_transfer_function_integrals() {
+        let allan_flicker = 2.0 * integral(|u| sinc_power(u, 4, 3));
+        assert!((allan_flicker - 2.0 * std::f64::consts::LN_2).abs() < 1e-5);
+        let modified_flicker = 2.0 * integral(|u| sinc_power(u, 6, 5));
+        assert!((modified_flicker / allan_flicker - MODIFIED_FLICKER_RATIO).abs() < 1e-5);
+        let hadamard_flicker = 8.0 / 3.0 * integral(|u| sinc_power(u, 6, 3));
+        assert!((hadamard_flicker / allan_flicker - HADAMARD_FLICKER_RATIO).abs() < 1e-5);
+        let allan_walk = 2.0 * integral(|u| sinc_power(u, 4, 4));
+        let modified_walk = 2.0 * integral(|u| sinc_power(u, 6, 6));
+        assert!((modified_walk / allan_walk - MODIFIED_RANDOM_WALK_RATIO).abs() < 1e-5);
+        let hadamard_walk = 8.0 / 3.0 * integral(|u| sinc_power(u, 6, 4));
+        assert!((hadamard_walk / allan_walk - 0.5).abs() < 1e-5);
+    }
+
+    /// The closed form of `Σw²` against the weights summed one by one.
+    #[test]
+    fn modified_white_fm_ratio_matches_the_weights() {
+        for m in [1usize, 2, 3, 7, 50] {
+            let mut weights = vec![0i64; 3 * m];
+            for j in 0..m {
+                for k in j..j + m {
+                    weights[k] -= 1;
+                    weights[k + m] += 1;
+                }
+            }
+            let sum: i64 = weights.iter().map(|w| w * w).sum();
+            let want = sum as f64 / (2.0 * (m * m * m) as f64);
+            assert!((modified_white_fm_ratio(m) - want).abs() < 1e-12, "m {m}");
+        }
+        assert!((modified_white_fm_ratio(1) - 1.0).abs() < 1e-12);
+        assert!((modified_white_fm_ratio(100_000) - 0.5).abs() < 1e-6);
     }
 }

@@ -112,6 +112,14 @@ fn grids() {
         vec![1, 2, 5, 10, 20, 50, 100, 200]
     );
     assert_eq!(factors(Kind::Hadamard, Grid::All, 11).len(), 3);
+    // Ten per decade, log-spaced (round(10^(k/10))), each once.
+    assert_eq!(
+        factors(Kind::Overlapping, Grid::Many, 2002),
+        vec![
+            1, 2, 3, 4, 5, 6, 8, 10, 13, 16, 20, 25, 32, 40, 50, 63, 79, 100, 126, 158, 200, 251,
+            316, 398, 501, 631, 794, 1000
+        ]
+    );
     assert!(deviation(Kind::Overlapping, &phase(&[1.0; 10]), 5, 1.0).is_none());
 }
 
@@ -152,4 +160,35 @@ fn confidence_intervals_cover_the_truth_about_68_percent_of_the_time() {
     }
     let rate = covered as f64 / trials as f64;
     assert!((0.58..=0.78).contains(&rate), "coverage {rate}");
+}
+
+/// Each kind gets its own degrees of freedom: the non-overlapping deviation averages about m
+/// times fewer terms than the overlapping one at the same τ, the modified fewer than the
+/// overlapping; and every point of every kind rests on at least two terms.
+#[test]
+fn each_kind_has_its_own_degrees_of_freedom_and_at_least_two_terms() {
+    let data: Vec<f64> = nbs14_1000().iter().cycle().take(20_000).copied().collect();
+    let at = |kind: Kind, grid: Grid| curve(kind, &data, 1.0, grid);
+    let overlapping = at(Kind::Overlapping, Grid::Octave);
+    let non_overlapping = at(Kind::NonOverlapping, Grid::Octave);
+    let modified = at(Kind::Modified, Grid::Octave);
+    for m in [8usize, 32, 128] {
+        let edf = |c: &[Point]| c.iter().find(|p| p.m == m).unwrap().edf;
+        assert!(edf(&non_overlapping) < edf(&overlapping) / 2.0, "m {m}");
+        assert!(edf(&modified) < edf(&overlapping), "m {m}");
+    }
+    for kind in [
+        Kind::Overlapping,
+        Kind::NonOverlapping,
+        Kind::Modified,
+        Kind::Hadamard,
+    ] {
+        let points = curve(kind, &data[..301], 1.0, Grid::All);
+        assert!(points.iter().all(|p| p.terms >= 2), "{kind:?}");
+        assert_eq!(
+            points.last().unwrap().m,
+            max_factor(kind, 302),
+            "{kind:?}: the grid goes to the last factor with two terms"
+        );
+    }
 }
