@@ -483,9 +483,26 @@ mod tests {
                 "kf",
                 "top",
                 "mean_filter",
-                "gyro_loop"
+                "gyro_loop",
+                "system"
             ]
         );
+        // The system's run: both loops lock during the start-up, the chain then steps once
+        // per decimated output, both gyros switch, and the estimator produces estimates.
+        let system = run
+            .system_record
+            .expect("a resonator package records the system");
+        assert_eq!(run.blocks[6].len(), system.samples);
+        let lock = system.first_lock_sample.expect("both loops lock");
+        assert!(lock < system.startup_samples, "{system:?}");
+        assert_eq!(
+            system.chain_samples,
+            (system.samples - system.startup_samples) / 1000
+        );
+        assert!(system.switches.iter().all(|s| *s >= 4), "{system:?}");
+        let estimate = system.first_estimate_sample.expect("an estimate");
+        assert!(estimate > system.startup_samples && system.outputs > 0);
+        assert!(system.outputs <= system.chain_samples);
         // The loop's recorded window covers lock acquisition in normal mode, the switch and
         // the re-lock in reverse mode, with a decimated output every 1000 samples.
         let record = run.gyro_loop_record;
