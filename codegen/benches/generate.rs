@@ -7,6 +7,7 @@ use gyrofx_codegen::config::Config;
 use gyrofx_codegen::generate::{generate, provenance, Contents, Options, Output};
 use gyrofx_codegen::job::Job;
 use gyrofx_codegen::output_folder::Replace;
+use gyrofx_codegen::progress::Progress;
 
 fn generate_million(c: &mut Criterion) {
     let mut config =
@@ -29,7 +30,7 @@ fn generate_million(c: &mut Criterion) {
                     contents: Contents::default(),
                 },
                 &provenance,
-                &mut |_| {},
+                &Progress::default(),
             )
             .unwrap()
         })

@@ -12,6 +12,7 @@ use crate::hdl;
 use crate::job::Job;
 use crate::output_folder::{self, Kind, Replace};
 use crate::package::{sha256_hex, Package, MANIFEST};
+use crate::progress::Progress;
 use crate::rom::{self, RomFormat, ROM_FOLDER};
 use crate::testbench::{verilog, vhdl};
 use crate::vectors::{self, Run};
@@ -137,7 +138,8 @@ fn block_manifest(block: &Block) -> serde_json::Value {
     })
 }
 
-/// Builds every file of the package for `job`, in memory. `progress` is told the phase.
+/// Builds every file of the package for `job`, in memory. `progress` follows the phases and
+/// the chain run's simulated samples.
 ///
 /// # Errors
 /// Stimulus errors (a bad CSV file).
@@ -145,15 +147,15 @@ pub fn build_package(
     job: &Job,
     contents: &Contents,
     provenance: &Provenance,
-    progress: &mut dyn FnMut(&str),
+    progress: &Progress,
 ) -> Result<(Package, Summary)> {
-    progress("chain run");
+    progress.set_phase("chain run");
     let roms = RomImages::new(job, provenance);
-    let mut run = vectors::run(job, &roms)?;
+    let mut run = vectors::run(job, &roms, progress)?;
     if let Some(names) = &contents.blocks {
         run.blocks.retain(|b| names.iter().any(|n| n == b.name));
     }
-    progress("files");
+    progress.set_phase("files");
     let mut package = Package::new(Kind::Generate, writers::build_outputs(&run.blocks));
     package.add("README.md", writers::package_readme(&run, provenance));
     package.add("Makefile", writers::makefile(&run.blocks, provenance));
@@ -316,7 +318,7 @@ pub fn generate(
     out: &Path,
     options: Options,
     provenance: &Provenance,
-    progress: &mut dyn FnMut(&str),
+    progress: &Progress,
 ) -> Result<Summary> {
     output_folder::check(out, Kind::Generate, options.replace)?;
     let (package, summary) = build_package(job, &options.contents, provenance, progress)?;
@@ -324,7 +326,7 @@ pub fn generate(
     if options.strict && !overflowed.is_empty() {
         return Err(crate::error::Error::Overflow(overflow_list(&overflowed)));
     }
-    progress("writing");
+    progress.set_phase("writing");
     let replace = options.replace;
     package.write_atomically(out, replace)?;
     Ok(summary)

@@ -20,6 +20,7 @@ pub mod junit;
 pub mod output_folder;
 pub mod package;
 pub mod plot;
+pub mod progress;
 pub mod report;
 pub mod reproduce;
 pub mod rom;

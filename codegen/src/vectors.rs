@@ -25,6 +25,7 @@ use crate::blocks::{ChainSample, RomImages};
 use crate::config::GyroLoop;
 use crate::error::{Error, Result};
 use crate::job::Job;
+use crate::progress::Progress;
 pub use crate::stats::ErrorStats;
 
 /// Overflow counts of every quantization point.
@@ -194,12 +195,20 @@ pub struct Run {
 ///
 /// # Errors
 /// Stimulus errors (a bad CSV file).
-pub fn run(job: &Job, roms: &RomImages) -> Result<Run> {
+pub fn run(job: &Job, roms: &RomImages, progress: &Progress) -> Result<Run> {
     let plan = &job.chain;
     let kf = job.kf();
     let est = &plan.estimator;
     let rate = job.true_rate(job.config.samples)?;
     let n = rate.len();
+    // Work units: chain samples of each closed-loop gyro simulation (two with reversal, two
+    // without, for the report), then of the chain itself.
+    let simulations = if job.settings.resonator.is_some() {
+        4
+    } else {
+        0
+    };
+    progress.plan((simulations + 1) * n as u64);
     let entries = kf.rom.len();
     let chunk = (n / (2 * entries)).max(1);
     // One reset of the whole chain, late in the run, so that the report has a long stretch of
@@ -226,7 +235,7 @@ pub fn run(job: &Job, roms: &RomImages) -> Result<Run> {
             ([ya, yb], [sat_a, sat_b])
         }
         Some(loops) => {
-            let [a, b] = resonator_record(loops, &rate, &modes, seed, est.input)?;
+            let [a, b] = resonator_record(loops, &rate, &modes, seed, est.input, progress)?;
             ([a.codes, b.codes], [a.saturations, b.saturations])
         }
     };
@@ -234,8 +243,11 @@ pub fn run(job: &Job, roms: &RomImages) -> Result<Run> {
     let raw_record = || -> Result<[Vec<f64>; 2]> {
         Ok(match &job.settings.resonator {
             None => plant.simulate(&rate, &vec![[1i8, 1i8]; n], seed).y,
-            Some(loops) => resonator_record(loops, &rate, &vec![[1i8, 1i8]; n], seed, est.input)?
-                .map(|gyro| gyro.dps),
+            Some(loops) => {
+                let normal = vec![[1i8, 1i8]; n];
+                resonator_record(loops, &rate, &normal, seed, est.input, progress)?
+                    .map(|gyro| gyro.dps)
+            }
         })
     };
 
@@ -255,6 +267,9 @@ pub fn run(job: &Job, roms: &RomImages) -> Result<Run> {
         let mut first_estimate: Option<usize> = None;
 
         for k in 0..n {
+            if k % PROGRESS_STEP == PROGRESS_STEP - 1 {
+                progress.advance(PROGRESS_STEP as u64);
+            }
             if reset_at == Some(k) {
                 fixed.reset();
                 float.reset();
@@ -363,12 +378,16 @@ const RESONATOR_STARTUP_S: f64 = 0.5;
 /// asks for (`+1` normal, `−1` reverse), at the true rate `rate` (°/s) per chain sample, after
 /// [`RESONATOR_STARTUP_S`] at the first sample's rate in normal mode. Gyro `g` takes the seed
 /// `2·seed + g`. The loops' outputs are already codes of `input` (checked by the config).
+/// Chain samples between two counts of [`Progress::advance`].
+const PROGRESS_STEP: usize = 1024;
+
 fn resonator_record(
     loops: &[GyroLoop; 2],
     rate: &[f64],
     modes: &[[i8; 2]],
     seed: u64,
     input: Format,
+    progress: &Progress,
 ) -> Result<[GyroRecord; 2]> {
     let run = |g: usize| -> Result<GyroRecord> {
         let gyro = &loops[g];
@@ -389,7 +408,10 @@ fn resonator_record(
             dps: Vec::with_capacity(rate.len()),
             saturations: 0,
         };
-        for (omega, mode) in rate.iter().zip(modes) {
+        for (k, (omega, mode)) in rate.iter().zip(modes).enumerate() {
+            if k % PROGRESS_STEP == PROGRESS_STEP - 1 {
+                progress.advance(PROGRESS_STEP as u64);
+            }
             let mode = if mode[g] > 0 {
                 Mode::Normal
             } else {
@@ -467,7 +489,10 @@ mod tests {
             command: "test".into(),
             config_sha256: "0".repeat(64),
         };
-        let run = run(&job, &RomImages::new(&job, &provenance)).unwrap();
+        let progress = Progress::default();
+        let run = run(&job, &RomImages::new(&job, &provenance), &progress).unwrap();
+        let (done, total) = progress.counts();
+        assert!(done <= total && total > 0, "{done} of {total}");
         (job, run)
     }
 

@@ -7,6 +7,7 @@ use anyhow::Result;
 
 use gyrofx_codegen::generate::{generate, overflow_list, Contents, Options, Output};
 use gyrofx_codegen::job::Job;
+use gyrofx_codegen::progress::Progress;
 
 use super::options::{ConfigSource, OutputFolder};
 
@@ -34,7 +35,7 @@ pub struct Args {
     /// Leave out the <block>_vectors.csv twins of the hex vector files.
     #[arg(long)]
     no_csv: bool,
-    /// No progress spinner (it shows only on a terminal).
+    /// No progress bar (it shows only on a terminal).
     #[arg(long)]
     quiet: bool,
 }
@@ -67,18 +68,16 @@ pub fn run(args: Args) -> Result<ExitCode> {
     }
     let job = Job::new(config)?;
     contents.check_for(&job).map_err(super::Usage)?;
-    let bar = super::progress::spinner("generate", quiet);
     let provenance = source.provenance(&job, Output::Package);
     let options = Options {
         replace: folder.replace(),
         strict,
         contents,
     };
-    let summary = generate(&job, out, options, &provenance, &mut |phase| {
-        bar.set_message(format!("generate: {phase}"));
-    });
-    bar.finish_and_clear();
-    let summary = summary?;
+    let progress = Progress::default();
+    let summary = super::progress::follow("generate", quiet, &progress, || {
+        generate(&job, out, options, &provenance, &progress)
+    })?;
     let run = &summary.run;
     let overflowed = run.overflows.in_chain_run();
     if !overflowed.is_empty() {
