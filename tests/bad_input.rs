@@ -658,3 +658,50 @@ fn allan_and_davar_refuse_what_they_cannot_analyse() {
     let text = std::fs::read_to_string(&svg).unwrap();
     assert!(text.contains("Hadamard deviation") && !text.contains(">Allan deviation<"));
 }
+
+/// `filter` on a record beyond the KF's input range: a warning with the counts and the output
+/// written; with `--strict` an error, exit 1 and no output file.
+#[test]
+fn filter_warns_of_saturation_and_strict_refuses_it() {
+    let dir = tempfile::tempdir().unwrap();
+    // s24.14 holds ±512 °/s: three samples at 1000 °/s saturate it.
+    let rows: String = (0..200)
+        .map(|k| format!("{k},{}\n", if (50..53).contains(&k) { 1000.0 } else { 1.0 }))
+        .collect();
+    let input = dir.path().join("rate.csv");
+    std::fs::write(&input, format!("t,rate_dps\n{rows}")).unwrap();
+    let output = dir.path().join("filtered.csv");
+    let args = |strict: bool| {
+        let mut a = vec![
+            "filter".to_string(),
+            "--input".into(),
+            input.to_string_lossy().into_owned(),
+            "--fs".into(),
+            "200".into(),
+            "--output".into(),
+            output.to_string_lossy().into_owned(),
+        ];
+        if strict {
+            a.push("--strict".into());
+        }
+        a
+    };
+    let strict = args(true);
+    let strict: Vec<&str> = strict.iter().map(String::as_str).collect();
+    let log = fails(&strict);
+    assert!(
+        log.contains("--strict") && log.contains("saturated the KF's input format s24.14 3 times"),
+        "{log}"
+    );
+    assert!(!output.exists());
+    let lenient = args(false);
+    let lenient: Vec<&str> = lenient.iter().map(String::as_str).collect();
+    let log = ok(&lenient);
+    assert!(log.contains("warning:") && log.contains("3 times"), "{log}");
+    let text = std::fs::read_to_string(&output).unwrap();
+    assert_eq!(text.lines().count(), 201, "header and one row per sample");
+    // The saturated input is written as the format's largest value, not as 1000.
+    let row = text.lines().nth(51).unwrap();
+    let z: f64 = row.split(',').nth(1).unwrap().parse().unwrap();
+    assert!(z < 512.0 && z > 511.99, "{row}");
+}
