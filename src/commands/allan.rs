@@ -36,6 +36,9 @@ pub struct Args {
     /// Write a log-log plot with confidence bars and fitted terms (.png or .svg).
     #[arg(long)]
     plot: Option<PathBuf>,
+    /// No progress bar (it shows only on a terminal).
+    #[arg(long)]
+    quiet: bool,
 }
 
 /// The longest record `--taus all` takes: its time grows as N² (10⁵ samples: 1.2 s, 10⁶:
@@ -53,6 +56,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
         kind,
         json,
         plot,
+        quiet,
     } = args;
     let rate = rate.hz()?;
     let grid: allan::Grid = taus
@@ -103,7 +107,12 @@ pub fn run(args: Args) -> Result<ExitCode> {
                 (values.len() as f64).powi(2) / 4.0
             );
         }
-        let points = allan::curve(kind, &values, rate, grid);
+        let bar = super::progress::bar(1, &format!("allan: {}", path.display()), quiet);
+        let points = allan::curve_reporting(kind, &values, rate, grid, &mut |done, total| {
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+        });
+        bar.finish_and_clear();
         let terms = noise::fit(&points, kind);
         let report = noise::report(&points, &terms, kind);
         let label = if columns.len() > 1 {

@@ -8,7 +8,7 @@ use anyhow::Result;
 
 use super::usage;
 
-use gyrofx_model::analysis::davar::{coefficients, davar, disturbances, Pid, Window};
+use gyrofx_model::analysis::davar::{coefficients, davar_reporting, disturbances, Pid, Window};
 
 use super::options::{CsvColumn, SampleRate};
 
@@ -50,6 +50,9 @@ pub struct Args {
     /// Write the heatmap and the coefficients over time (.png or .svg).
     #[arg(long)]
     plot: Option<PathBuf>,
+    /// No progress bar (it shows only on a terminal).
+    #[arg(long)]
+    quiet: bool,
 }
 
 /// Prints the windows' noise coefficients and the disturbances (a table, or JSON), and writes
@@ -67,6 +70,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
         step,
         json,
         plot,
+        quiet,
     } = args;
     let rate = rate.hz()?;
     for (name, gain) in [("--kp", kp), ("--ki", ki), ("--kd", kd)] {
@@ -100,7 +104,11 @@ pub fn run(args: Args) -> Result<ExitCode> {
     } else {
         Window::Fixed(window)
     };
-    let d = davar(&values, rate, mode, step);
+    let bar = super::progress::bar(values.len() as u64, "davar", quiet);
+    let d = davar_reporting(&values, rate, mode, step, &mut |done, _| {
+        bar.set_position(done as u64);
+    });
+    bar.finish_and_clear();
     let c = coefficients(&d);
     let runs = disturbances(&d, 2.0);
     if let Some(path) = &plot {

@@ -473,9 +473,29 @@ impl Kind {
 /// intervals from the kind's own equivalent degrees of freedom ([`edf::edf`]). The noise type
 /// is identified at each octave and used for the factors up to the next one.
 pub fn curve(kind: Kind, rate: &[f64], rate_hz: f64, grid: Grid) -> Vec<Point> {
+    curve_reporting(kind, rate, rate_hz, grid, &mut |_, _| {})
+}
+
+/// Factors per call of [`deviations`] in [`curve_reporting`]: a grid of more is computed in
+/// chunks, each reported done.
+const FACTORS_PER_CHUNK: usize = 256;
+
+/// [`curve`], telling `progress(done, total)` of the factors as they are computed (every
+/// factor of a long `Grid::All` is a pass over the record); the same points.
+pub fn curve_reporting(
+    kind: Kind,
+    rate: &[f64],
+    rate_hz: f64,
+    grid: Grid,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Vec<Point> {
     let x = phase(rate);
     let factors = factors(kind, grid, x.len());
-    let values = deviations(kind, &x, &factors, rate_hz);
+    let mut values = Vec::with_capacity(factors.len());
+    for chunk in factors.chunks(FACTORS_PER_CHUNK) {
+        values.extend(deviations(kind, &x, chunk, rate_hz));
+        progress(values.len(), factors.len());
+    }
     let mut alphas: Vec<(usize, i32)> = Vec::new();
     factors
         .iter()

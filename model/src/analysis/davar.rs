@@ -168,6 +168,21 @@ pub fn kurtosis(window: &[f64]) -> f64 {
 /// # Panics
 /// When a window is shorter than 4 samples or longer than the record, or `step` is 0.
 pub fn davar(rate: &[f64], rate_hz: f64, window: Window, step: usize) -> Davar {
+    davar_reporting(rate, rate_hz, window, step, &mut |_, _| {})
+}
+
+/// [`davar`], telling `progress(done, total)` in samples of the record as the windows slide
+/// (every 256 windows); the same result.
+///
+/// # Panics
+/// As [`davar`].
+pub fn davar_reporting(
+    rate: &[f64],
+    rate_hz: f64,
+    window: Window,
+    step: usize,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Davar {
     assert!(step > 0, "step must be at least 1");
     let longest = match window {
         Window::Fixed(l) => l,
@@ -216,6 +231,9 @@ pub fn davar(rate: &[f64], rate_hz: f64, window: Window, step: usize) -> Davar {
         time_s.push(centre as f64 / rate_hz);
         windows.push(length);
         adev.push(row);
+        if time_s.len() % 256 == 0 {
+            progress(centre, rate.len());
+        }
         if let Window::Adaptive(pid) = window {
             let standard_error = (24.0 / length as f64).sqrt();
             let e = (1.0 - (kurtosis(&rate[a..b]) - 3.0).abs() / (4.0 * standard_error))
@@ -449,5 +467,20 @@ mod tests {
         let y = white(200_000, 4);
         assert!((kurtosis(&y) - 3.0).abs() < 0.05);
         assert_eq!(kurtosis(&[1.0; 10]), 3.0);
+    }
+
+    #[test]
+    fn the_reported_davar_is_the_davar_and_reports_progress() {
+        let y = white(40_000, 5);
+        let mut last = (0, 0);
+        let reported = davar_reporting(&y, 100.0, Window::Fixed(1001), 10, &mut |done, total| {
+            assert!(done >= last.0 && done <= total);
+            last = (done, total);
+        });
+        let plain = davar(&y, 100.0, Window::Fixed(1001), 10);
+        assert_eq!(reported.adev, plain.adev);
+        assert_eq!(reported.time_s, plain.time_s);
+        assert_eq!(last.1, y.len());
+        assert!(last.0 > y.len() / 2, "{last:?}");
     }
 }

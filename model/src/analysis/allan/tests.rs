@@ -192,3 +192,23 @@ fn each_kind_has_its_own_degrees_of_freedom_and_at_least_two_terms() {
         );
     }
 }
+
+/// Computing a long grid in chunks, each reported, gives the points of one pass.
+#[test]
+fn the_reported_curve_is_the_curve() {
+    let data: Vec<f64> = nbs14_1000().iter().cycle().take(3000).copied().collect();
+    let mut reports = Vec::new();
+    let chunked = curve_reporting(
+        Kind::Overlapping,
+        &data,
+        1.0,
+        Grid::All,
+        &mut |done, total| {
+            reports.push((done, total));
+        },
+    );
+    assert_eq!(chunked, curve(Kind::Overlapping, &data, 1.0, Grid::All));
+    let total = max_factor(Kind::Overlapping, 3001);
+    assert_eq!(reports.len(), total.div_ceil(FACTORS_PER_CHUNK));
+    assert_eq!(reports.last(), Some(&(total, total)));
+}
