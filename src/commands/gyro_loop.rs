@@ -9,7 +9,7 @@ use serde::Serialize;
 
 use gyrofx_model::gyro_loop::closed::FixedHarness;
 use gyrofx_model::gyro_loop::figures::{
-    characterize, Characterization, Figure, ModeCharacterization, Procedure,
+    characterize_reporting, Characterization, Figure, ModeCharacterization, Procedure, AVERAGES,
 };
 
 use gyrofx_codegen::plot;
@@ -44,6 +44,9 @@ pub struct Args {
     /// frequency and rate output against time, the re-lock marked (.png or .svg).
     #[arg(long)]
     plot: Option<PathBuf>,
+    /// No progress bar (it shows only on a terminal).
+    #[arg(long)]
+    quiet: bool,
 }
 
 /// One gyro's figures.
@@ -55,6 +58,11 @@ struct GyroFigures {
 }
 
 /// Characterizes both gyros and prints the figures.
+/// Chain samples per average for `seconds` at `chain_rate_hz`.
+fn average_samples(seconds: f64, chain_rate_hz: f64) -> usize {
+    ((seconds * chain_rate_hz).round() as usize).max(1)
+}
+
 pub fn run(args: Args) -> Result<ExitCode> {
     if !(args.seconds.is_finite() && args.seconds > 0.0 && args.seconds <= 100.0) {
         usage!(
@@ -73,6 +81,11 @@ pub fn run(args: Args) -> Result<ExitCode> {
     }
     let config = args.source.load()?;
     let loops = config.gyro_loops()?;
+    let total: usize = loops
+        .iter()
+        .map(|gyro| average_samples(args.seconds, gyro.plan.chain_rate_hz()) * AVERAGES)
+        .sum();
+    let bar = super::progress::bar(total as u64, "loop", args.quiet);
     let figures: Vec<GyroFigures> = std::thread::scope(|scope| {
         let handles: Vec<_> = loops
             .iter()
@@ -80,18 +93,19 @@ pub fn run(args: Args) -> Result<ExitCode> {
             .map(|(index, gyro)| {
                 let procedure = Procedure {
                     rate_dps: args.rate_dps,
-                    average_samples: ((args.seconds * gyro.plan.chain_rate_hz()).round() as usize)
-                        .max(1),
+                    average_samples: average_samples(args.seconds, gyro.plan.chain_rate_hz()),
                     noise: args.noise,
                     seed: config.seed.wrapping_mul(2).wrapping_add(index as u64),
                     ..Procedure::default()
                 };
+                let bar = &bar;
                 scope.spawn(move || {
-                    characterize::<FixedHarness>(
+                    characterize_reporting::<FixedHarness>(
                         &gyro.plan,
                         &gyro.params,
                         &gyro.front_end,
                         &procedure,
+                        &|n| bar.inc(n as u64),
                     )
                     .map(|figures| GyroFigures {
                         gyro: gyro.name,
@@ -105,6 +119,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
             .map(|h| h.join().expect("the loop simulation does not panic"))
             .collect::<std::result::Result<_, _>>()
     })?;
+    bar.finish_and_clear();
     if args.json {
         println!("{}", serde_json::to_string_pretty(&figures)?);
     } else {

@@ -228,6 +228,25 @@ pub fn characterize<L: LoopUnderTest>(
     physics: &PhysicsSettings,
     procedure: &Procedure,
 ) -> Result<Characterization, ParamError> {
+    characterize_reporting::<L>(plan, params, physics, procedure, &|_| {})
+}
+
+/// The averages [`characterize`] takes, each of `procedure.average_samples` chain samples:
+/// most of its time when they are long.
+pub const AVERAGES: usize = 5;
+
+/// [`characterize`], telling `progress(n)` after each of its [`AVERAGES`] averages of
+/// `n = procedure.average_samples` chain samples; the same figures.
+///
+/// # Errors
+/// As [`characterize`].
+pub fn characterize_reporting<L: LoopUnderTest>(
+    plan: &Plan,
+    params: &ResonatorParams,
+    physics: &PhysicsSettings,
+    procedure: &Procedure,
+    progress: &dyn Fn(usize),
+) -> Result<Characterization, ParamError> {
     let physics = if procedure.noise {
         *physics
     } else {
@@ -239,6 +258,11 @@ pub fn characterize<L: LoopUnderTest>(
     let samples = |ms: f64| (ms / chain_ms).ceil() as usize;
     let omega = procedure.rate_dps;
     let n = procedure.average_samples;
+    let means = |closed: &mut ClosedLoop<L>, rate: f64, mode: Mode, n: usize| {
+        let m = means(closed, rate, mode, n);
+        progress(n);
+        m
+    };
     let measure = |closed: &mut ClosedLoop<L>, mode: Mode| {
         let at_zero = means(closed, 0.0, mode, n);
         for _ in 0..samples(procedure.rate_settle_ms) {

@@ -4,7 +4,9 @@
 use proptest::prelude::*;
 
 use super::*;
-use crate::gyro_loop::figures::{characterize, coupled_resonance_hz, Characterization, Procedure};
+use crate::gyro_loop::figures::{
+    characterize_reporting, coupled_resonance_hz, Characterization, Procedure, AVERAGES,
+};
 use crate::gyro_loop::gyro::Spec;
 
 fn paper_004() -> (Spec, Plan) {
@@ -13,14 +15,16 @@ fn paper_004() -> (Spec, Plan) {
     (spec, plan)
 }
 
+/// The figures, through the reporting entry point: it reports each of its averages once.
 fn characterized<L: LoopUnderTest>(spec: &Spec, plan: &Plan) -> Characterization {
-    characterize::<L>(
-        plan,
-        &spec.resonator,
-        &spec.front_end,
-        &Procedure::default(),
-    )
-    .unwrap()
+    let procedure = Procedure::default();
+    let reported = std::cell::Cell::new(0usize);
+    let c = characterize_reporting::<L>(plan, &spec.resonator, &spec.front_end, &procedure, &|n| {
+        reported.set(reported.get() + n)
+    })
+    .unwrap();
+    assert_eq!(reported.get(), AVERAGES * procedure.average_samples);
+    c
 }
 
 /// SPEC §1.6 with Table 1 and the defaults, for the fixed loop: each figure against its
