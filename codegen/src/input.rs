@@ -126,10 +126,12 @@ fn read_plain(path: &Path, column: &str, gaps: bool) -> Result<Option<(Vec<f64>,
             );
             continue;
         };
-        if text.split(',').all(|cell| cell.trim().is_empty()) {
+        let cell = text.split(',').nth(index).unwrap_or("").trim();
+        // A line of empty cells is skipped, as the CSV crate skips it (checked only when the
+        // cell read is empty: most lines are not).
+        if cell.is_empty() && text.split(',').all(|cell| cell.trim().is_empty()) {
             continue;
         }
-        let cell = text.split(',').nth(index).unwrap_or("").trim();
         match cell_value(cell, line_number, column, gaps, &bad)? {
             Some(value) => values.push(value),
             None => skipped += 1,

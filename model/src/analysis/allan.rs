@@ -310,7 +310,11 @@ pub fn noise_type(rate: &[f64], m: usize) -> Option<i32> {
             let alpha = -2.0 * (rho + d as f64);
             return Some((alpha.round() as i32).clamp(-2, 2));
         }
-        z = z.windows(2).map(|w| w[1] - w[0]).collect();
+        // Differenced in place: the same values without another record-sized allocation.
+        for i in 0..z.len() - 1 {
+            z[i] = z[i + 1] - z[i];
+        }
+        z.pop();
         d += 1;
     }
 }
