@@ -21,7 +21,8 @@ mod quantize;
 
 pub use format::{Format, MAX_DECLARED_WIDTH, MAX_INTERMEDIATE_WIDTH};
 pub use quantize::{
-    from_f64, mode, requantize, round_right, Overflow, Quantized, Quantizer, Rounding,
+    from_f64, mode, requantize, round_right, round_right_split_i64, Overflow, Quantized, Quantizer,
+    Rounding,
 };
 
 /// Errors of the fixed-point core. Each names the offending value and what is allowed.
@@ -120,6 +121,20 @@ pub fn pow2(exp: i32) -> f64 {
     } else {
         libm::ldexp(1.0, exp)
     }
+}
+
+/// `⌊x + ½⌋` of a finite `x` as `i64` (round to nearest, ties toward +∞, the ADC's rule),
+/// saturating beyond the `i64` range: the same integer as `x.floor()` plus one when
+/// `x − x.floor() ≥ ½`, without the call to the platform's `floor` that baseline x86-64 makes.
+/// Exact: below 2^52 in magnitude the truncation and the remainder are exact in f64; from 2^52
+/// on every f64 is an integer.
+///
+/// The result for NaN is 0 (callers check finiteness first).
+#[inline(always)]
+pub fn round_half_up(x: f64) -> i64 {
+    let truncated = x as i64; // toward zero, saturating
+    let floor = truncated.saturating_sub(i64::from(truncated as f64 > x));
+    floor.saturating_add(i64::from(x - floor as f64 >= 0.5))
 }
 
 /// A code together with its format: the exact-arithmetic view of a fixed-point value.

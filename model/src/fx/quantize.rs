@@ -285,6 +285,30 @@ round_right_kernel!(
     i64
 );
 
+/// `(aligned · 2^shift + term) / 2^shift` rounded with the mode `MODE`, in 64 bits, for
+/// `1 <= shift <= 63`, without forming the sum: `aligned` is already at the target fraction
+/// (its shifted bits are zeros), so the dropped bits are `term`'s and the sum's sign is the
+/// quotient's. The caller proves `aligned + (term >> shift)` fits `i64`. A property test checks
+/// it against [`round_right`] on the sum in `i128`.
+#[inline(always)]
+pub fn round_right_split_i64<const MODE: u8>(aligned: i64, term: i64, shift: u32) -> i64 {
+    let quotient = aligned + (term >> shift);
+    let dropped_mask = i64::MAX >> (63 - shift);
+    let any_dropped = i64::from(term & dropped_mask != 0);
+    let half_bit = (term >> (shift - 1)) & 1;
+    let below_half = i64::from(term & (dropped_mask >> 1) != 0);
+    let negative = i64::from(quotient < 0);
+    let increment = match MODE {
+        mode::FLOOR => 0,
+        mode::CEIL => any_dropped,
+        mode::ZERO => any_dropped & negative,
+        mode::NEAREST => half_bit,
+        mode::ROUND => half_bit & (below_half | (1 - negative)),
+        _ => half_bit & (below_half | (quotient & 1)),
+    };
+    quotient + increment
+}
+
 #[inline(always)]
 fn finish_overflow(
     rounded: i128,
@@ -478,6 +502,21 @@ impl Quantizer {
             }
         }
         self.apply_mode::<MODE>(i128::from(code)) as i64
+    }
+
+    /// [`Quantizer::apply_mode`] of `aligned · 2^shift + term`, `shift` being this point's
+    /// dropped bits (1..=63), for a sum wider than 64 bits whose wide part is already aligned
+    /// (an integrator plus a product): [`round_right_split_i64`], and the general path for an
+    /// overflow. The caller proves `aligned + (term >> shift)` fits `i64`.
+    #[inline(always)]
+    pub fn apply_mode_split_i64<const MODE: u8>(&mut self, aligned: i64, term: i64) -> i64 {
+        debug_assert!((1..=63).contains(&self.shift));
+        let rounded = round_right_split_i64::<MODE>(aligned, term, self.shift as u32);
+        if i128::from(rounded) >= self.min && i128::from(rounded) <= self.max {
+            return rounded;
+        }
+        let sum = (i128::from(aligned) << self.shift) + i128::from(term);
+        self.apply_mode::<MODE>(sum) as i64
     }
 
     /// Whether the dropped bits of `code` are exactly half an LSB of the target: the case

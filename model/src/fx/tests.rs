@@ -331,6 +331,74 @@ fn quantizer_i64_path_equals_requantize() {
     check::<{ mode::CONVERGENT }>(Rounding::Convergent);
 }
 
+/// The split 64-bit kernel (an aligned part plus a term) against [`requantize`] on the sum in
+/// `i128`: exhaustively on small aligned parts and terms, every shift up to 12, every mode,
+/// both overflow modes, overflowing targets; then at wide values and the largest shifts.
+#[test]
+fn quantizer_split_path_equals_requantize_of_the_sum() {
+    fn check<const M: u8>(rounding: Rounding) {
+        for overflow in Overflow::ALL {
+            for shift in 1..=12i32 {
+                for to in [fmt("s4.0"), fmt("s9.2"), fmt("u3.1"), fmt("s40.3")] {
+                    let from_frac = to.frac + shift;
+                    let mut q = Quantizer::new(from_frac, to, rounding, overflow);
+                    let mut overflows = 0;
+                    for aligned in -40i64..=40 {
+                        for term in -300i64..=300 {
+                            let sum = (i128::from(aligned) << shift) + i128::from(term);
+                            let want = requantize(sum, from_frac, to, rounding, overflow);
+                            overflows += u64::from(want.overflowed);
+                            assert_eq!(
+                                i128::from(q.apply_mode_split_i64::<M>(aligned, term)),
+                                want.code,
+                                "({aligned} << {shift}) + {term} into {to} {rounding} {overflow}"
+                            );
+                        }
+                    }
+                    assert_eq!(q.overflow_count, overflows);
+                }
+            }
+        }
+        // Wide parts: the sum exceeds 64 bits.
+        for shift in [1u32, 30, 62, 63] {
+            for aligned in [
+                -(1i64 << 61),
+                -(1 << 40) - 1,
+                -1,
+                0,
+                1,
+                (1 << 40) + 3,
+                1 << 61,
+            ] {
+                for term in [
+                    i64::MIN >> 1,
+                    -(1i64 << 50) - 7,
+                    -(1 << (shift - 1)),
+                    -1,
+                    0,
+                    1 << (shift - 1),
+                    (1 << 50) + 9,
+                    i64::MAX >> 1,
+                ] {
+                    let sum = (i128::from(aligned) << shift) + i128::from(term);
+                    let want = round_right::<M>(sum, shift);
+                    assert_eq!(
+                        i128::from(round_right_split_i64::<M>(aligned, term, shift)),
+                        want,
+                        "({aligned} << {shift}) + {term} {rounding}"
+                    );
+                }
+            }
+        }
+    }
+    check::<{ mode::FLOOR }>(Rounding::Floor);
+    check::<{ mode::CEIL }>(Rounding::Ceil);
+    check::<{ mode::ZERO }>(Rounding::Zero);
+    check::<{ mode::NEAREST }>(Rounding::Nearest);
+    check::<{ mode::ROUND }>(Rounding::Round);
+    check::<{ mode::CONVERGENT }>(Rounding::Convergent);
+}
+
 #[test]
 fn extreme_shifts_round_correctly() {
     let to = fmt("s8.0");
@@ -419,6 +487,26 @@ proptest! {
         prop_assert_eq!(got, want);
     }
 
+    /// The inline ADC rounding equals `floor` plus the half-LSB test done with std's `floor`,
+    /// on arbitrary finite f64 bit patterns and on dyadic values near ties.
+    #[test]
+    fn round_half_up_equals_floor_based_rounding(
+        bits in any::<u64>(),
+        mantissa in -(1i64 << 53)..(1i64 << 53),
+        exp in -4i32..14,
+    ) {
+        let reference = |x: f64| {
+            let floor = x.floor();
+            (floor as i64).saturating_add(i64::from(x - floor >= 0.5))
+        };
+        let dyadic = mantissa as f64 * pow2(exp);
+        for x in [f64::from_bits(bits), dyadic, -dyadic, dyadic + 0.5, dyadic - 0.5] {
+            if x.is_finite() {
+                prop_assert_eq!(round_half_up(x), reference(x), "x = {:e}", x);
+            }
+        }
+    }
+
     #[test]
     fn bits_round_trip(code in any::<i64>(), width in 1u32..=64, signed in any::<bool>()) {
         let f = Format::new(signed, width, 0).unwrap();
@@ -499,4 +587,46 @@ mod against_fixed_crate {
             prop_assert_eq!(i16f16().to_f64(a.into()), I16F16::from_bits(a).to_num::<f64>());
         }
     }
+}
+
+#[test]
+fn round_half_up_at_the_edges_of_exactness_and_of_i64() {
+    let reference = |x: f64| {
+        let floor = x.floor();
+        (floor as i64).saturating_add(i64::from(x - floor >= 0.5))
+    };
+    let p52 = pow2(52);
+    let p63 = pow2(63);
+    for x in [
+        0.0,
+        -0.0,
+        0.5,
+        -0.5,
+        0.49999999999999994,
+        -0.49999999999999994,
+        1.5,
+        -1.5,
+        2.5,
+        -2.5,
+        f64::MIN_POSITIVE,
+        -f64::MIN_POSITIVE,
+        p52 - 0.5,
+        -p52 + 0.5,
+        p52,
+        -p52,
+        p52 + 1.0,
+        p63,
+        -p63,
+        p63 * 2.0,
+        -p63 * 2.0,
+        f64::from_bits((-p63).to_bits() + 1), // the next f64 below −2^63
+        f64::MAX,
+        f64::MIN,
+    ] {
+        assert_eq!(round_half_up(x), reference(x), "x = {x:e}");
+    }
+    assert_eq!(round_half_up(-0.5), 0);
+    assert_eq!(round_half_up(-1.5), -1);
+    assert_eq!(round_half_up(p63), i64::MAX);
+    assert_eq!(round_half_up(-p63 * 2.0), i64::MIN);
 }

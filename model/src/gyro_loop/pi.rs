@@ -293,12 +293,26 @@ pub struct OverflowCounts {
     pub output: u64,
 }
 
+/// Which 64-bit path [`FixedPi::step`] takes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Path {
+    /// Every exact intermediate fits `i64`.
+    Narrow,
+    /// The integrator update is wider; it is rounded as integrator plus aligned product.
+    SplitUpdate,
+}
+
 /// The bit-accurate PI controller.
 ///
-/// Two paths compute the same bits: [`FixedPi::step_reference`] follows the definition in
+/// The paths compute the same bits: [`FixedPi::step_reference`] follows the definition in
 /// `i128` with each point's own mode; [`FixedPi::step`] is monomorphized per rounding mode
-/// and runs in `i64` when both points share one mode and every exact intermediate fits 64
-/// bits (the defaults do). A property test checks them against each other.
+/// when both points share one mode, and runs in `i64` when every exact intermediate fits 64
+/// bits (the AGC's defaults do), or when only the integrator update is wider and its wide
+/// part is the integrator itself, aligned (the PLL's defaults: `v · 2^30` beside a 50-bit
+/// `ki · e`), rounding the update split into the two ([`round_right_split_i64`]). Property
+/// tests check them against each other.
+///
+/// [`round_right_split_i64`]: crate::fx::round_right_split_i64
 #[derive(Clone, Debug)]
 pub struct FixedPi {
     kp: i64,
@@ -312,8 +326,8 @@ pub struct FixedPi {
     integrator: Quantizer,
     output: Quantizer,
     limits: [i64; 2],
-    /// The shared rounding mode, when the 64-bit path applies.
-    fast: Option<Rounding>,
+    /// The shared rounding mode, when a 64-bit path applies, and which.
+    fast: Option<(Rounding, Path)>,
     clamped: u64,
     v: i64,
 }
@@ -326,19 +340,37 @@ impl FixedPi {
         let ki_e_frac = plan.ki.format.frac + plan.input.frac;
         let kp_e_frac = plan.kp.format.frac + plan.input.frac;
         let shared = plan.integrator_point.rounding == plan.output.rounding;
+        let v_to_update = (update.frac - plan.integrator.frac) as u32;
+        let ki_e_to_update = (update.frac - ki_e_frac) as u32;
         // The products are no wider than the sums they enter.
         let narrow = update.width <= 64 && sum.width <= 64;
+        // The split update: `ki·e` aligned fits 63 bits and the integrator 62, so
+        // `v + (ki·e >> v_to_update)` cannot overflow i64.
+        let product_bits = plan.ki.format.width + plan.input.width + ki_e_to_update;
+        let split = sum.width <= 64
+            && (1..=62).contains(&v_to_update)
+            && plan.integrator.width <= 62
+            && product_bits <= 63;
+        let path = if narrow {
+            Some(Path::Narrow)
+        } else if split {
+            Some(Path::SplitUpdate)
+        } else {
+            None
+        };
         FixedPi {
             kp: plan.kp.code as i64,
             ki: plan.ki.code as i64,
-            v_to_update: (update.frac - plan.integrator.frac) as u32,
-            ki_e_to_update: (update.frac - ki_e_frac) as u32,
+            v_to_update,
+            ki_e_to_update,
             kp_e_to_sum: (sum.frac - kp_e_frac) as u32,
             v_to_sum: (sum.frac - plan.integrator.frac) as u32,
             integrator: plan.integrator_point.quantizer(),
             output: plan.output.quantizer(),
             limits: plan.limits.map(|c| c as i64),
-            fast: (shared && narrow).then_some(plan.output.rounding),
+            fast: path
+                .filter(|_| shared)
+                .map(|path| (plan.output.rounding, path)),
             clamped: 0,
             v: 0,
         }
@@ -362,21 +394,39 @@ impl FixedPi {
     /// One sample: error code `e`; returns the output code.
     #[inline]
     pub fn step(&mut self, e: i64) -> i64 {
-        match self.fast {
-            Some(Rounding::Floor) => self.step_mode::<{ mode::FLOOR }>(e),
-            Some(Rounding::Ceil) => self.step_mode::<{ mode::CEIL }>(e),
-            Some(Rounding::Zero) => self.step_mode::<{ mode::ZERO }>(e),
-            Some(Rounding::Nearest) => self.step_mode::<{ mode::NEAREST }>(e),
-            Some(Rounding::Round) => self.step_mode::<{ mode::ROUND }>(e),
-            Some(Rounding::Convergent) => self.step_mode::<{ mode::CONVERGENT }>(e),
-            None => self.step_reference(e),
+        let Some((rounding, path)) = self.fast else {
+            return self.step_reference(e);
+        };
+        match (rounding, path) {
+            (Rounding::Floor, Path::Narrow) => self.step_mode::<{ mode::FLOOR }, false>(e),
+            (Rounding::Ceil, Path::Narrow) => self.step_mode::<{ mode::CEIL }, false>(e),
+            (Rounding::Zero, Path::Narrow) => self.step_mode::<{ mode::ZERO }, false>(e),
+            (Rounding::Nearest, Path::Narrow) => self.step_mode::<{ mode::NEAREST }, false>(e),
+            (Rounding::Round, Path::Narrow) => self.step_mode::<{ mode::ROUND }, false>(e),
+            (Rounding::Convergent, Path::Narrow) => {
+                self.step_mode::<{ mode::CONVERGENT }, false>(e)
+            }
+            (Rounding::Floor, Path::SplitUpdate) => self.step_mode::<{ mode::FLOOR }, true>(e),
+            (Rounding::Ceil, Path::SplitUpdate) => self.step_mode::<{ mode::CEIL }, true>(e),
+            (Rounding::Zero, Path::SplitUpdate) => self.step_mode::<{ mode::ZERO }, true>(e),
+            (Rounding::Nearest, Path::SplitUpdate) => self.step_mode::<{ mode::NEAREST }, true>(e),
+            (Rounding::Round, Path::SplitUpdate) => self.step_mode::<{ mode::ROUND }, true>(e),
+            (Rounding::Convergent, Path::SplitUpdate) => {
+                self.step_mode::<{ mode::CONVERGENT }, true>(e)
+            }
         }
     }
 
     #[inline(always)]
-    fn step_mode<const MODE: u8>(&mut self, e: i64) -> i64 {
-        let update = (self.v << self.v_to_update) + ((self.ki * e) << self.ki_e_to_update);
-        let rounded = self.integrator.apply_mode_i64::<MODE>(update);
+    fn step_mode<const MODE: u8, const SPLIT: bool>(&mut self, e: i64) -> i64 {
+        let product = (self.ki * e) << self.ki_e_to_update;
+        let rounded = if SPLIT {
+            self.integrator
+                .apply_mode_split_i64::<MODE>(self.v, product)
+        } else {
+            self.integrator
+                .apply_mode_i64::<MODE>((self.v << self.v_to_update) + product)
+        };
         let v = rounded.clamp(self.limits[0], self.limits[1]);
         self.clamped += u64::from(v != rounded);
         self.v = v;

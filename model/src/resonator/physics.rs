@@ -284,6 +284,7 @@ impl Resonator {
 
     /// Forces from DAC codes: `code · dac_newton_per_lsb`, N (the DAC holds them over a
     /// sample).
+    #[inline]
     pub fn force_from_dac(&self, codes: [i64; 2]) -> [f64; 2] {
         codes.map(|c| c as f64 * self.settings.dac_newton_per_lsb)
     }
@@ -294,18 +295,19 @@ impl Resonator {
     ///
     /// # Panics
     /// On a non-finite voltage.
+    #[inline]
     pub fn adc(&mut self, volts: [f64; 2]) -> [i64; 2] {
-        volts.map(|v| {
+        let mut codes = [0; 2];
+        for (code, v) in codes.iter_mut().zip(volts) {
             assert!(v.is_finite(), "the ADC input must be finite, got {v}");
             let scaled = v * self.adc_codes_per_volt;
-            let floor = scaled.floor();
-            let code = (floor as i64).saturating_add(i64::from(scaled - floor >= 0.5));
-            let clamped = code.clamp(self.adc_range.0, self.adc_range.1);
-            // Beyond ±2^63 the cast has saturated already.
+            let rounded = crate::fx::round_half_up(scaled);
+            *code = rounded.clamp(self.adc_range.0, self.adc_range.1);
+            // Beyond ±2^63 the rounding has saturated already.
             let beyond_i64 = !(-I64_LIMIT..I64_LIMIT).contains(&scaled);
-            self.adc_saturations += u64::from(clamped != code || beyond_i64);
-            clamped
-        })
+            self.adc_saturations += u64::from(*code != rounded || beyond_i64);
+        }
+        codes
     }
 
     /// ADC samples that saturated since construction or reset.
@@ -315,6 +317,7 @@ impl Resonator {
 
     /// One sample from DAC codes to ADC codes: [`Self::force_from_dac`], [`Self::step`],
     /// [`Self::adc`].
+    #[inline]
     pub fn step_codes(&mut self, dac_codes: [i64; 2]) -> [i64; 2] {
         let force = self.force_from_dac(dac_codes);
         let volts = self.step(force);

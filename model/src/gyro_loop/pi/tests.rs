@@ -331,3 +331,106 @@ proptest! {
         prop_assert_eq!(block, stepped);
     }
 }
+
+/// A PLL-like family whose integrator update is wider than 64 bits (`v` aligned to `ki·e`'s
+/// many fraction bits), so that [`FixedPi::step`] takes the split path.
+fn wide_update_case() -> impl Strategy<Value = Case> {
+    (
+        (16u32..=32, 0.0f64..1.0),    // input width, frac as a fraction of it
+        (8u32..=24, 28i32..=44),      // ki width, frac
+        (30u32..=62, 16i32..=40),     // integrator width, frac
+        (-0.9f64..0.9, 0.05f64..0.9), // limits: centre and half-width, fractions of range
+        (any::<bool>(), 0.0f64..1.0), // ki sign, magnitude as a fraction of its format's range
+        any_rounding(),
+        any::<bool>(), // wrap
+    )
+        .prop_flat_map(
+            |((ew, ef), (wk, fk), (wv, fv), (centre, half), (ski, mki), rounding, wrap)| {
+                let input = Format::signed(ew, (ef * f64::from(ew)) as i32).unwrap();
+                let ki_format = Format::signed(wk, fk).unwrap();
+                let integrator = Format::signed(wv, fv.min(wv as i32 - 2)).unwrap();
+                let range = integrator.max_value();
+                let ki = if ski { -1.0 } else { 1.0 } * ki_format.max_value() * (0.02 + 0.9 * mki);
+                let spec = Spec {
+                    input,
+                    kp: 0.25,
+                    ki,
+                    kp_format: CoefficientFormat::Fixed(fmt("s12.8")),
+                    ki_format: CoefficientFormat::Fixed(ki_format),
+                    integrator,
+                    integrator_limits: [
+                        range * (centre - half).max(-0.95),
+                        range * (centre + half).min(0.95),
+                    ],
+                    output: Format::signed(
+                        (integrator.int_bits() + 4 + integrator.frac).clamp(2, 64) as u32,
+                        integrator.frac,
+                    )
+                    .unwrap(),
+                    rounding,
+                    overflow: if wrap {
+                        Overflow::Wrap
+                    } else {
+                        Overflow::Saturate
+                    },
+                };
+                let (lo, hi) = (input.min_code() as i64, input.max_code() as i64);
+                let event = prop_oneof![
+                    40 => Just(Event::None),
+                    1 => any::<i64>().prop_map(|c| Event::Preset(c >> 20)),
+                    1 => Just(Event::Reset),
+                ];
+                let samples = prop::collection::vec((lo..=hi, event), 1..2000);
+                (Just(spec), samples).prop_map(|(spec, samples)| Case { spec, samples })
+            },
+        )
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+    /// The split 64-bit path against the literal i128 reference, for every mode, wrap and
+    /// saturate, presets and resets: the same bits, integrator and counts.
+    #[test]
+    fn split_update_path_equals_the_reference(case in wide_update_case()) {
+        let Ok(plan) = Plan::new(&case.spec) else { return Ok(()) };
+        let mut fast = FixedPi::new(&plan);
+        prop_assume!(matches!(fast.fast, Some((_, Path::SplitUpdate))));
+        let mut reference = FixedPi::new(&plan);
+        for (k, (e, event)) in case.samples.iter().enumerate() {
+            match event {
+                Event::Preset(code) => {
+                    fast.preset(*code);
+                    reference.preset(*code);
+                }
+                Event::Reset => {
+                    fast.reset();
+                    reference.reset();
+                }
+                Event::None => {}
+            }
+            prop_assert_eq!(fast.step(*e), reference.step_reference(*e), "sample {}", k);
+            prop_assert_eq!(fast.integrator(), reference.integrator());
+        }
+        prop_assert_eq!(fast.overflow_counts(), reference.overflow_counts());
+    }
+}
+
+/// The default PLL (and the resonator loop's) update is wider than 64 bits: it takes the split
+/// path, the AGC the narrow one.
+#[test]
+fn the_default_pll_takes_the_split_path_and_the_agc_the_narrow_one() {
+    let plan =
+        crate::gyro_loop::gyro::Plan::new(&crate::gyro_loop::gyro::Spec::paper_004()).unwrap();
+    assert!(matches!(
+        FixedPi::new(&plan.pll).fast,
+        Some((_, Path::SplitUpdate))
+    ));
+    assert!(matches!(
+        FixedPi::new(&plan.agc).fast,
+        Some((_, Path::Narrow))
+    ));
+    assert!(matches!(
+        FixedPi::new(&Plan::new(&Spec::default()).unwrap()).fast,
+        Some((_, Path::SplitUpdate)) | Some((_, Path::Narrow))
+    ));
+}
