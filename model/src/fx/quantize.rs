@@ -491,6 +491,21 @@ impl Quantizer {
         }
     }
 
+    /// [`Quantizer::apply`] on a 64-bit value: the mode dispatched at run time to
+    /// [`Quantizer::apply_mode_i64`], for points that run once per sample in a loop whose other
+    /// points are not monomorphized.
+    #[inline]
+    pub fn apply_i64(&mut self, code: i64) -> i64 {
+        match self.rounding {
+            Rounding::Floor => self.apply_mode_i64::<{ mode::FLOOR }>(code),
+            Rounding::Ceil => self.apply_mode_i64::<{ mode::CEIL }>(code),
+            Rounding::Zero => self.apply_mode_i64::<{ mode::ZERO }>(code),
+            Rounding::Nearest => self.apply_mode_i64::<{ mode::NEAREST }>(code),
+            Rounding::Round => self.apply_mode_i64::<{ mode::ROUND }>(code),
+            Rounding::Convergent => self.apply_mode_i64::<{ mode::CONVERGENT }>(code),
+        }
+    }
+
     /// [`Quantizer::apply_mode`] on a 64-bit value (shifts of 1..=63 take the 64-bit kernel;
     /// anything else, and every overflow, the general path).
     #[inline(always)]

@@ -300,6 +300,7 @@ fn quantizer_i64_path_equals_requantize() {
                 ] {
                     let from_frac = to.frac + shift;
                     let mut q = Quantizer::new(from_frac, to, rounding, overflow);
+                    let mut dispatched = q.clone();
                     let mut overflows = 0;
                     let extremes = [
                         i64::MIN,
@@ -317,8 +318,10 @@ fn quantizer_i64_path_equals_requantize() {
                             want.code,
                             "{code} >> {shift} into {to} {rounding} {overflow}"
                         );
+                        assert_eq!(i128::from(dispatched.apply_i64(code)), want.code);
                     }
                     assert_eq!(q.overflow_count, overflows);
+                    assert_eq!(dispatched.overflow_count, overflows);
                 }
             }
         }

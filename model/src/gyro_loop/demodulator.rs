@@ -300,19 +300,21 @@ impl FixedDemodulator {
 
     #[inline(always)]
     fn step_mode<const MODE: u8>(&mut self, x: i64, reference: Reference) -> Iq {
-        let references = [reference.sin, reference.cos];
-        let mut out = [0i64; 2];
-        for c in 0..2 {
-            let p = self.product[c].apply_mode_i64::<MODE>(x * references[c]);
-            let y = self.y[c];
-            let y = self.state[c].apply_mode_i64::<MODE>((y << self.k) + ((p << self.align) - y));
-            self.y[c] = y;
-            out[c] = self.output[c].apply_mode_i64::<MODE>(y);
-        }
         Iq {
-            i: out[0],
-            q: out[1],
+            i: self.channel::<MODE, 0>(x, reference.sin),
+            q: self.channel::<MODE, 1>(x, reference.cos),
         }
+    }
+
+    /// Channel `C` (0: I, 1: Q) of [`Self::step_mode`], one call per channel so that both
+    /// unroll into straight-line code.
+    #[inline(always)]
+    fn channel<const MODE: u8, const C: usize>(&mut self, x: i64, reference: i64) -> i64 {
+        let p = self.product[C].apply_mode_i64::<MODE>(x * reference);
+        let y = self.y[C];
+        let y = self.state[C].apply_mode_i64::<MODE>((y << self.k) + ((p << self.align) - y));
+        self.y[C] = y;
+        self.output[C].apply_mode_i64::<MODE>(y)
     }
 
     /// One sample computed literally from the definition in `i128`, each point with its own

@@ -66,7 +66,7 @@
 use std::f64::consts::PI;
 
 use super::{field_error, PlanError, Point, RtlParameter};
-use crate::fx::{from_f64, mode, Format, Overflow, Quantizer, Rounding};
+use crate::fx::{from_f64, Format, Overflow, Rounding};
 
 /// What an NCO is asked to be.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -266,7 +266,8 @@ pub struct Reference {
 #[derive(Clone, Debug)]
 pub struct FixedNco {
     rom: Vec<i64>,
-    truncation: Quantizer,
+    /// `P − A − 2`: the truncation is a floor by this shift, and cannot overflow.
+    truncation_shift: u32,
     mask: u64,
     address_bits: u32,
     acc: u64,
@@ -277,7 +278,7 @@ impl FixedNco {
     pub fn new(plan: &Plan) -> Self {
         FixedNco {
             rom: plan.rom.iter().map(|c| *c as i64).collect(),
-            truncation: plan.truncation.quantizer(),
+            truncation_shift: plan.phase.width - (plan.address_bits + 2),
             mask: u64::MAX >> (64 - plan.phase.width),
             address_bits: plan.address_bits,
             acc: 0,
@@ -301,10 +302,8 @@ impl FixedNco {
     pub fn step(&mut self, freq: u64, offset: u64) -> Reference {
         let phase = self.acc.wrapping_add(offset) & self.mask;
         self.acc = self.acc.wrapping_add(freq) & self.mask;
-        // Below 2^63 by the plan; floor into A + 2 bits never overflows.
-        let t = self
-            .truncation
-            .apply_mode_i64::<{ mode::FLOOR }>(phase as i64) as u32;
+        // The plan's truncation point: floor of the unsigned phase into A + 2 bits.
+        let t = (phase >> self.truncation_shift) as u32;
         let quarter = 1u32 << self.address_bits;
         Reference {
             sin: self.lookup(t),

@@ -90,6 +90,9 @@ pub struct FixedGyroLoop {
     agc: FixedPi,
     agc_error: Quantizer,
     dac: Quantizer,
+    /// Whether `setpoint − I` and `amplitude · cos` fit 64 bits (they do unless formats near
+    /// 64 bits are declared): then their points round in `i64`.
+    narrow_drive: bool,
     cic_i: FixedCic,
     cic_q: FixedCic,
     output: [Quantizer; 2],
@@ -124,6 +127,7 @@ impl FixedGyroLoop {
             agc: FixedPi::new(&plan.agc),
             agc_error: plan.agc_error.quantizer(),
             dac: plan.dac.quantizer(),
+            narrow_drive: plan.agc_error.from.width <= 64 && plan.dac.from.width <= 64,
             cic_i: FixedCic::new(&plan.cic),
             cic_q: FixedCic::new(&plan.cic),
             output: [plan.output.quantizer(), plan.output.quantizer()],
@@ -203,16 +207,26 @@ impl FixedGyroLoop {
         let sense = self.demod_sense.step(adc[sensed], sense_reference);
 
         self.freq = (self.pll.step(q) as u64) & self.phase_mask;
-        let error = self.agc_error.apply(i128::from(m.setpoint) - i128::from(i)) as i64;
+        let error = if self.narrow_drive {
+            self.agc_error.apply_i64(m.setpoint - i)
+        } else {
+            self.agc_error.apply(i128::from(m.setpoint) - i128::from(i)) as i64
+        };
         let amplitude = self.agc.step(error);
-        let drive = self
-            .dac
-            .apply(i128::from(amplitude) * i128::from(transmit.cos)) as i64;
+        let drive = if self.narrow_drive {
+            self.dac.apply_i64(amplitude * transmit.cos)
+        } else {
+            self.dac
+                .apply(i128::from(amplitude) * i128::from(transmit.cos)) as i64
+        };
 
         // Delay line: write this sample's code, read the one L samples old.
-        let len = self.latency + 1;
         self.delay[self.delay_head] = drive;
-        let oldest = (self.delay_head + 1) % len;
+        let oldest = if self.delay_head == self.latency {
+            0
+        } else {
+            self.delay_head + 1
+        };
         let out = self.delay[oldest];
         self.delay_head = oldest;
         let mut dac = [0i64; 2];
