@@ -4,7 +4,7 @@
 
 use super::expm::Matrix;
 use super::settings::GaussMarkov;
-use crate::stimulus::{Gaussian, ResonatorSource, Stream};
+use crate::stimulus::{FastStream, Gaussian, ResonatorSource, Stream};
 
 /// One drifting quantity: its process and its own random stream.
 #[derive(Clone, Debug)]
@@ -14,7 +14,7 @@ pub(super) struct Drift {
     /// Per-update decay `e^{−N T / τ}` and innovation `std · sqrt(1 − decay²)`.
     pub(super) decay: f64,
     pub(super) innovation: f64,
-    pub(super) source: Gaussian,
+    pub(super) source: Gaussian<FastStream>,
 }
 
 impl Drift {
@@ -28,7 +28,7 @@ impl Drift {
         if process.std == 0.0 {
             return None;
         }
-        let mut source = Gaussian::new(seed, Stream::Resonator(source));
+        let mut source = Gaussian::on(seed, Stream::Resonator(source));
         let decay = libm::exp(-update_period_s / process.correlation_time_s);
         Some(Drift {
             value: process.std * source.sample(),
@@ -48,9 +48,9 @@ impl Drift {
 pub(super) struct Sources {
     /// Thermomechanical force (four standard normals per sample, mixed by the Cholesky
     /// factor of the discrete process-noise covariance).
-    pub(super) thermomechanical: Option<Gaussian>,
+    pub(super) thermomechanical: Option<Gaussian<FastStream>>,
     /// Electronic noise of the x and y pick-offs, and its per-sample σ (V).
-    pub(super) pickoff: Option<([Gaussian; 2], f64)>,
+    pub(super) pickoff: Option<([Gaussian<FastStream>; 2], f64)>,
     /// Damping-split drift (fraction of the mean damping).
     pub(super) damping_split: Option<Drift>,
     /// Damping-angle drift (rad).

@@ -78,12 +78,12 @@ impl Resonator {
             let [d1, d2] = params.principal_damping();
             Sources {
                 thermomechanical: (settings.temperature_k > 0.0 && d1 + d2 > 0.0).then(|| {
-                    Gaussian::new(seed, Stream::Resonator(ResonatorSource::Thermomechanical))
+                    Gaussian::on(seed, Stream::Resonator(ResonatorSource::Thermomechanical))
                 }),
                 pickoff: (settings.pickoff_noise_v_per_sqrt_hz > 0.0).then(|| {
                     (
                         [0, 1].map(|axis| {
-                            Gaussian::new(seed, Stream::Resonator(ResonatorSource::Pickoff(axis)))
+                            Gaussian::on(seed, Stream::Resonator(ResonatorSource::Pickoff(axis)))
                         }),
                         settings.pickoff_noise_v_per_sqrt_hz
                             * (settings.sample_rate_hz / 2.0).sqrt(),
