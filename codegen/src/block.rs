@@ -195,8 +195,30 @@ impl Param {
     }
 }
 
+/// Most codes in a row (`rst`, inputs, outputs) of any block.
+pub const MAX_STRIDE: usize = 64;
+
+/// Where a streamed block's rows go, one at a time, in order.
+pub trait RowSink: Send + Sync + std::fmt::Debug {
+    /// One row: its codes (`rst`, inputs, outputs) and its extra-column values.
+    fn row(&mut self, codes: &[i64], extra: &[f64]);
+    /// After the last row: the files written, with their SHA-256s.
+    ///
+    /// # Errors
+    /// Write errors.
+    fn finish(self: Box<Self>) -> crate::error::Result<Vec<crate::package::FileEntry>>;
+}
+
+/// A block's rows: kept, or streamed to a sink.
+#[derive(Debug)]
+enum Rows {
+    Memory { codes: Vec<i64>, extra: Vec<f64> },
+    Streamed(Box<dyn RowSink>),
+    Finished,
+}
+
 /// One block's vectors.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Debug)]
 pub struct Block {
     /// Folder and file prefix, e.g. `kf`.
     pub name: &'static str,
@@ -212,11 +234,13 @@ pub struct Block {
     pub inputs: Vec<Signal>,
     /// Outputs and how they are checked.
     pub outputs: Vec<Output>,
-    /// Row-major codes: per row `rst`, the inputs, the outputs (every declared format is at
-    /// most 64 bits wide).
-    codes: Vec<i64>,
-    /// Extra real-valued CSV columns (name, one value per row; NaN prints empty).
-    pub extra: Vec<(&'static str, Vec<f64>)>,
+    /// Names of the extra real-valued CSV columns, one value each per row (NaN prints empty);
+    /// declared before the first row.
+    pub extra: Vec<&'static str>,
+    /// Where the rows go.
+    rows: Rows,
+    /// Rows pushed.
+    count: usize,
     /// Clocks the testbench waits after the one that follows `ce` before it compares the
     /// registered outputs (0: they are valid 1 clock after `ce`): a pipelined block's extra
     /// latency. `ce` stays low meanwhile, so samples come every `2 + settle_clocks` clocks at
@@ -241,15 +265,66 @@ impl Block {
             roms: Vec::new(),
             inputs,
             outputs,
-            codes: Vec::new(),
             extra: Vec::new(),
+            rows: Rows::Memory {
+                codes: Vec::new(),
+                extra: Vec::new(),
+            },
+            count: 0,
             settle_clocks: 0,
         }
     }
 
-    /// Reserves room for `rows` more rows.
+    /// Sends every row from now on to `sink` instead of keeping it ([`Block::row`] then
+    /// panics): the rows of a long run are written as they come, in bounded memory.
+    ///
+    /// # Panics
+    /// When rows were pushed already.
+    pub fn stream_to(&mut self, sink: Box<dyn RowSink>) {
+        assert_eq!(self.count, 0, "{}: rows before the sink", self.name);
+        self.rows = Rows::Streamed(sink);
+    }
+
+    /// Ends the rows: the files a sink wrote (none when the rows are kept).
+    ///
+    /// # Errors
+    /// The sink's write errors.
+    pub fn finish_rows(&mut self) -> crate::error::Result<Vec<crate::package::FileEntry>> {
+        match std::mem::replace(
+            &mut self.rows,
+            Rows::Memory {
+                codes: Vec::new(),
+                extra: Vec::new(),
+            },
+        ) {
+            Rows::Memory { codes, extra } => {
+                self.rows = Rows::Memory { codes, extra };
+                Ok(Vec::new())
+            }
+            Rows::Streamed(sink) => {
+                self.rows = Rows::Finished;
+                sink.finish()
+            }
+            Rows::Finished => {
+                self.rows = Rows::Finished;
+                Ok(Vec::new())
+            }
+        }
+    }
+
+    /// Whether the rows are kept ([`Block::row`] works).
+    pub fn is_in_memory(&self) -> bool {
+        matches!(self.rows, Rows::Memory { .. })
+    }
+
+    /// Reserves room for `rows` more rows (kept rows only).
     pub fn reserve(&mut self, rows: usize) {
-        self.codes.reserve(rows * self.stride());
+        let stride = self.stride();
+        let extra = self.extra.len();
+        if let Rows::Memory { codes, extra: e } = &mut self.rows {
+            codes.reserve(rows * stride);
+            e.reserve(rows * extra);
+        }
     }
 
     /// Codes per row.
@@ -263,42 +338,96 @@ impl Block {
     /// # Panics
     /// When the counts do not match the declared signals.
     pub fn push(&mut self, rst: bool, inputs: &[i128], outputs: &[i128]) {
+        self.push_with_extra(rst, inputs, outputs, &[]);
+    }
+
+    /// [`Block::push`] with the row's values of the [extra](Block::extra) CSV columns.
+    ///
+    /// # Panics
+    /// When the counts do not match the declared signals and columns.
+    pub fn push_with_extra(&mut self, rst: bool, inputs: &[i128], outputs: &[i128], extra: &[f64]) {
         assert_eq!(inputs.len(), self.inputs.len(), "{}: inputs", self.name);
         assert_eq!(outputs.len(), self.outputs.len(), "{}: outputs", self.name);
-        self.codes.push(i64::from(rst));
-        for (code, s) in inputs.iter().zip(&self.inputs) {
+        assert_eq!(
+            extra.len(),
+            self.extra.len(),
+            "{}: extra columns",
+            self.name
+        );
+        let mut row = [0i64; MAX_STRIDE];
+        assert!(
+            self.stride() <= MAX_STRIDE,
+            "{}: too many signals",
+            self.name
+        );
+        row[0] = i64::from(rst);
+        for ((slot, code), s) in row[1..].iter_mut().zip(inputs).zip(&self.inputs) {
             debug_assert!(
                 s.format.contains(*code),
                 "{} {} = {code}",
                 self.name,
                 s.name
             );
-            self.codes.push(*code as i64);
+            *slot = *code as i64;
         }
-        for (code, o) in outputs.iter().zip(&self.outputs) {
+        let first_output = 1 + self.inputs.len();
+        for ((slot, code), o) in row[first_output..]
+            .iter_mut()
+            .zip(outputs)
+            .zip(&self.outputs)
+        {
             debug_assert!(
                 o.signal.format.contains(*code),
                 "{} {} = {code}",
                 self.name,
                 o.signal.name
             );
-            self.codes.push(*code as i64);
+            *slot = *code as i64;
         }
+        let row = &row[..self.stride()];
+        match &mut self.rows {
+            Rows::Memory { codes, extra: e } => {
+                codes.extend_from_slice(row);
+                e.extend_from_slice(extra);
+            }
+            Rows::Streamed(sink) => sink.row(row, extra),
+            Rows::Finished => panic!("{}: a row after finish_rows", self.name),
+        }
+        self.count += 1;
     }
 
     /// Number of rows.
     pub fn len(&self) -> usize {
-        self.codes.len() / self.stride()
+        self.count
     }
 
     /// Whether there are no rows.
     pub fn is_empty(&self) -> bool {
-        self.codes.is_empty()
+        self.count == 0
     }
 
     /// Row `k`: `rst`, inputs, outputs.
+    ///
+    /// # Panics
+    /// When the rows were streamed ([`Block::stream_to`]).
     pub fn row(&self, k: usize) -> &[i64] {
-        &self.codes[k * self.stride()..(k + 1) * self.stride()]
+        let stride = self.stride();
+        match &self.rows {
+            Rows::Memory { codes, .. } => &codes[k * stride..(k + 1) * stride],
+            _ => panic!("{}: rows were streamed, not kept", self.name),
+        }
+    }
+
+    /// Row `k`'s extra-column values.
+    ///
+    /// # Panics
+    /// When the rows were streamed.
+    pub fn extra_row(&self, k: usize) -> &[f64] {
+        let width = self.extra.len();
+        match &self.rows {
+            Rows::Memory { extra, .. } => &extra[k * width..(k + 1) * width],
+            _ => panic!("{}: rows were streamed, not kept", self.name),
+        }
     }
 
     /// File names inside the block's folder.

@@ -19,7 +19,7 @@ use crate::vectors::{self, Run};
 use crate::writers::{self, Provenance};
 
 /// What `generate` reports back.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub struct Summary {
     /// The run.
     pub run: Run,

@@ -28,6 +28,7 @@ pub mod simulate;
 pub mod stats;
 pub mod synth;
 pub mod testbench;
+pub mod vector_rows;
 pub mod vectors;
 pub mod writers;
 

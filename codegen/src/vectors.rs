@@ -163,7 +163,7 @@ pub struct Results {
 }
 
 /// Everything the run produced.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub struct Run {
     /// The blocks' vectors: sequencer, estimator, kf, top, mean_filter.
     pub blocks: Vec<Block>,

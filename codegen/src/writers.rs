@@ -9,7 +9,7 @@ use gyrofx_model::fx::Format;
 
 use crate::block::Block;
 use crate::hdl::{RTL_SOURCES, VHDL_SOURCES};
-use crate::testbench::header;
+use crate::vector_rows::RowLayout;
 use crate::vectors::Run;
 
 /// Where generated files come from: printed at the top of each.
@@ -51,14 +51,6 @@ pub fn push_hex(out: &mut String, code: i128, format: Format) {
     }
 }
 
-/// Appends `value` in the shortest form that reads back exactly (ryu: the same digits on
-/// every platform); NaN as an empty cell.
-fn push_real(out: &mut String, buffer: &mut ryu::Buffer, value: f64) {
-    if !value.is_nan() {
-        out.push_str(buffer.format(value));
-    }
-}
-
 /// The block's parameter include: the DUT's parameters as `P_<NAME>` localparams, the vector
 /// count and the vector file names.
 pub fn params_vh(block: &Block, provenance: &Provenance) -> String {
@@ -94,107 +86,38 @@ pub fn params_vh(block: &Block, provenance: &Provenance) -> String {
     out
 }
 
-/// The block's stimulus and expected vector files (hex, one line per clock-enable).
+/// The block's stimulus and expected vector files (hex, one line per clock-enable), from its
+/// kept rows.
+///
+/// # Panics
+/// When the block's rows were streamed.
 pub fn vector_hex(block: &Block, provenance: &Provenance) -> (String, String) {
-    let bit = Format::new(false, 1, 0).expect("1 bit");
+    let layout = RowLayout::of(block);
     let n = block.len();
-    let mut stimulus = String::with_capacity(n * (2 + 8 * block.inputs.len()) + 256);
-    let mut expected = String::with_capacity(n * (2 + 8 * block.outputs.len()) + 256);
-    let inputs: Vec<_> = block.inputs.iter().collect();
-    let outputs: Vec<_> = block.outputs.iter().map(|o| &o.signal).collect();
-    for (text, fields, rst) in [
-        (&mut stimulus, &inputs, true),
-        (&mut expected, &outputs, false),
-    ] {
-        text.push_str(&provenance.line("//"));
-        text.push('\n');
-        text.push_str(&header(fields, rst));
-        text.push('\n');
-    }
-    let ni = block.inputs.len();
+    let mut stimulus = layout.stimulus_header(provenance);
+    let mut expected = layout.expected_header(provenance);
+    stimulus.reserve(n * (2 + 8 * block.inputs.len()));
+    expected.reserve(n * (2 + 8 * block.outputs.len()));
     for k in 0..n {
         let row = block.row(k);
-        push_hex(&mut stimulus, i128::from(row[0]), bit);
-        for (code, s) in row[1..=ni].iter().zip(&block.inputs) {
-            stimulus.push(' ');
-            push_hex(&mut stimulus, i128::from(*code), s.format);
-        }
-        stimulus.push('\n');
-        for (i, (code, o)) in row[1 + ni..].iter().zip(&block.outputs).enumerate() {
-            if i > 0 {
-                expected.push(' ');
-            }
-            push_hex(&mut expected, i128::from(*code), o.signal.format);
-        }
-        expected.push('\n');
+        layout.stimulus_line(row, &mut stimulus);
+        layout.expected_line(row, &mut expected);
     }
     (stimulus, expected)
 }
 
-/// The block's vectors as CSV: sample, rst, then per signal its code (and for signed signals
-/// its real value, the column named with the unit: `_dps` °/s, `_fs` full-scale units; none
-/// for DAC codes), then the block's extra columns. A gated output's cells are empty
-/// where its gate is 0.
+/// The block's vectors as CSV ([`RowLayout::csv_header`]), from its kept rows.
+///
+/// # Panics
+/// When the block's rows were streamed.
 pub fn vector_csv(block: &Block, provenance: &Provenance) -> String {
+    let layout = RowLayout::of(block);
     let n = block.len();
-    let mut csv = String::with_capacity(n * 16 * block.stride() + 256);
-    csv.push_str(&provenance.line("#"));
-    csv.push_str("\nsample,rst");
-    let signals: Vec<_> = block
-        .inputs
-        .iter()
-        .chain(block.outputs.iter().map(|o| &o.signal))
-        .collect();
-    for s in &signals {
-        let _ = write!(csv, ",{}", s.name);
-        if let Some(unit) = s.csv_unit() {
-            let _ = write!(csv, ",{}_{unit}", s.name);
-        }
-    }
-    for (name, _) in &block.extra {
-        let _ = write!(csv, ",{name}");
-    }
-    csv.push('\n');
-    // For each signal (inputs, then outputs), the row index of its gate, if it has one.
-    let gate_of: Vec<Option<usize>> = block
-        .inputs
-        .iter()
-        .map(|_| None)
-        .chain(block.outputs.iter().map(|o| {
-            o.gate.and_then(|gate| {
-                block
-                    .outputs
-                    .iter()
-                    .position(|other| other.signal.name == gate)
-                    .map(|p| block.inputs.len() + p)
-            })
-        }))
-        .collect();
-    let (mut real, mut int) = (ryu::Buffer::new(), itoa::Buffer::new());
+    let mut csv = layout.csv_header(provenance);
+    csv.reserve(n * 16 * block.stride());
+    let mut buffers = (itoa::Buffer::new(), ryu::Buffer::new());
     for k in 0..n {
-        let row = block.row(k);
-        csv.push_str(int.format(k));
-        csv.push(',');
-        csv.push_str(int.format(row[0]));
-        for ((index, code), s) in row[1..].iter().enumerate().zip(&signals) {
-            // A gated output means nothing where its gate is 0: an empty cell, not a 0.
-            let shown = gate_of[index].is_none_or(|g| row[1 + g] == 1);
-            csv.push(',');
-            if shown {
-                csv.push_str(int.format(*code));
-            }
-            if s.csv_unit().is_some() {
-                csv.push(',');
-                if shown {
-                    push_real(&mut csv, &mut real, s.format.to_f64(i128::from(*code)));
-                }
-            }
-        }
-        for (_, values) in &block.extra {
-            csv.push(',');
-            push_real(&mut csv, &mut real, values[k]);
-        }
-        csv.push('\n');
+        layout.csv_line(k, block.row(k), block.extra_row(k), &mut csv, &mut buffers);
     }
     csv
 }

@@ -121,14 +121,9 @@ impl Plant {
     pub fn simulate(&self, rate: &[f64], modes: &[[i8; 2]], seed: u64) -> TwoGyroRecord {
         assert_eq!(rate.len(), modes.len(), "one mode pair per rate sample");
         let n = rate.len();
-        let t = 1.0 / self.fs_hz;
-        let bi_times = self.bias_instability_times();
         let records = std::thread::scope(|scope| {
             let handles: Vec<_> = (0..2u8)
-                .map(|g| {
-                    let bi_times = &bi_times;
-                    scope.spawn(move || self.simulate_gyro(g, rate, modes, seed, t, bi_times))
-                })
+                .map(|g| scope.spawn(move || self.simulate_gyro(g, rate, modes, seed)))
                 .collect();
             handles
                 .into_iter()
@@ -144,86 +139,138 @@ impl Plant {
         }
     }
 
-    fn simulate_gyro(
-        &self,
-        g: u8,
-        rate: &[f64],
-        modes: &[[i8; 2]],
-        seed: u64,
-        t: f64,
-        bi_times: &[f64],
-    ) -> (Vec<f64>, Vec<f64>) {
+    /// Gyro `g`'s sample-by-sample simulator from `seed`: what [`Plant::simulate`] runs, for
+    /// callers that stream records of any length in bounded memory.
+    pub fn gyro_stream(&self, g: u8, seed: u64) -> GyroStream {
         let e = self.gyros[usize::from(g)];
-        let white_sigma = e.arw_deg_per_sqrt_h / 60.0 / t.sqrt();
-        let walk_sigma = e.rrw_deg_per_h_per_sqrt_h / 216_000.0 * t.sqrt();
-        let ramp_per_sample = e.rate_ramp_deg_per_h2 / (3600.0 * 3600.0) * t;
-        let sf_normal = 1.0 + e.sf_ppm * 1e-6;
-        let sf_reverse = sf_normal + e.sf_mode_mismatch_ppm * 1e-6;
-        let settle = if e.settle_tau_s > 0.0 {
-            libm::exp(-t / e.settle_tau_s)
-        } else {
-            0.0
-        };
-
-        // Each noise source over the whole record in its own loop: one RNG state at a time.
-        let n = rate.len();
+        let t = 1.0 / self.fs_hz;
         let b_dps = e.bias_instability_deg_per_h / 3600.0;
         let q = if b_dps > 0.0 {
             self.bias_instability_variance(b_dps)
         } else {
             0.0
         };
-        // Slow part of the bias: instability, random walk, ramp.
-        let mut drift = vec![e.bias_dps; n];
-        if q > 0.0 {
-            for (j, tc) in bi_times.iter().enumerate() {
-                let mut source = Gaussian::new(seed, Stream::BiasInstability(g, j as u8));
-                let a = libm::exp(-t / tc);
-                let drive = (q * (1.0 - a * a)).sqrt();
-                let mut x = q.sqrt() * source.sample(); // stationary from the first sample
-                for d in &mut drift {
-                    *d += x;
-                    x = a * x + drive * source.sample();
-                }
-            }
-        }
-        if walk_sigma > 0.0 {
-            let mut walk = Gaussian::new(seed, Stream::RateRandomWalk(g));
-            let mut random_walk = 0.0;
-            for d in &mut drift {
-                *d += random_walk;
-                random_walk += walk_sigma * walk.sample();
-            }
-        }
-        if ramp_per_sample != 0.0 {
-            for (k, d) in drift.iter_mut().enumerate() {
-                *d += ramp_per_sample * k as f64;
-            }
-        }
-
-        let mut white = Gaussian::new(seed, Stream::AngleRandomWalk(g));
-        let mut y = Vec::with_capacity(n);
-        let mut transient = 0.0;
-        let mut previous: Option<(i8, f64)> = None;
-        for k in 0..n {
-            let b = drift[k];
-            let p = modes[k][usize::from(g)];
-            let (sf, offset) = if p > 0 {
-                (sf_normal, 0.0)
+        let instability = if q > 0.0 {
+            self.bias_instability_times()
+                .iter()
+                .enumerate()
+                .map(|(j, tc)| {
+                    let mut source = Gaussian::new(seed, Stream::BiasInstability(g, j as u8));
+                    let decay = libm::exp(-t / tc);
+                    GaussMarkov {
+                        // Stationary from the first sample.
+                        x: q.sqrt() * source.sample(),
+                        decay,
+                        drive: (q * (1.0 - decay * decay)).sqrt(),
+                        source,
+                    }
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let walk_sigma = e.rrw_deg_per_h_per_sqrt_h / 216_000.0 * t.sqrt();
+        let sf_normal = 1.0 + e.sf_ppm * 1e-6;
+        GyroStream {
+            errors: e,
+            white_sigma: e.arw_deg_per_sqrt_h / 60.0 / t.sqrt(),
+            walk_sigma,
+            ramp_per_sample: e.rate_ramp_deg_per_h2 / (3600.0 * 3600.0) * t,
+            sf_normal,
+            sf_reverse: sf_normal + e.sf_mode_mismatch_ppm * 1e-6,
+            settle: if e.settle_tau_s > 0.0 {
+                libm::exp(-t / e.settle_tau_s)
             } else {
-                (sf_reverse, e.bias_mode_mismatch_dps)
-            };
-            let term = f64::from(p) * (b + offset);
-            transient *= settle;
-            if let Some((previous_mode, previous_term)) = previous {
-                if p != previous_mode {
-                    transient += previous_term - term;
-                }
-            }
-            y.push(sf * rate[k] + term + transient + white_sigma * white.sample());
-            previous = Some((p, term));
+                0.0
+            },
+            instability,
+            walk: (walk_sigma > 0.0).then(|| Gaussian::new(seed, Stream::RateRandomWalk(g))),
+            random_walk: 0.0,
+            white: Gaussian::new(seed, Stream::AngleRandomWalk(g)),
+            transient: 0.0,
+            previous: None,
+            k: 0,
         }
-        (y, drift)
+    }
+
+    fn simulate_gyro(
+        &self,
+        g: u8,
+        rate: &[f64],
+        modes: &[[i8; 2]],
+        seed: u64,
+    ) -> (Vec<f64>, Vec<f64>) {
+        let mut stream = self.gyro_stream(g, seed);
+        rate.iter()
+            .zip(modes)
+            .map(|(omega, p)| stream.step(*omega, p[usize::from(g)]))
+            .unzip()
+    }
+}
+
+/// One first-order Gauss–Markov process of the bias instability, on its own stream.
+#[derive(Clone, Debug)]
+struct GaussMarkov {
+    x: f64,
+    decay: f64,
+    drive: f64,
+    source: Gaussian,
+}
+
+/// One gyro of a [`Plant`], sample by sample ([`Plant::gyro_stream`]): the same record as
+/// [`Plant::simulate`] gives, in constant memory.
+#[derive(Clone, Debug)]
+pub struct GyroStream {
+    errors: GyroErrors,
+    white_sigma: f64,
+    walk_sigma: f64,
+    ramp_per_sample: f64,
+    sf_normal: f64,
+    sf_reverse: f64,
+    settle: f64,
+    instability: Vec<GaussMarkov>,
+    walk: Option<Gaussian>,
+    random_walk: f64,
+    white: Gaussian,
+    transient: f64,
+    previous: Option<(i8, f64)>,
+    k: u64,
+}
+
+impl GyroStream {
+    /// The next sample at true rate `omega` (°/s) in mode `p` (±1): the output and the slowly
+    /// varying bias `b(k)` (normal-mode value), both °/s.
+    pub fn step(&mut self, omega: f64, p: i8) -> (f64, f64) {
+        let e = &self.errors;
+        // Slow part of the bias: instability, random walk, ramp (summed in that order).
+        let mut b = e.bias_dps;
+        for process in &mut self.instability {
+            b += process.x;
+            process.x = process.decay * process.x + process.drive * process.source.sample();
+        }
+        if let Some(walk) = self.walk.as_mut() {
+            b += self.random_walk;
+            self.random_walk += self.walk_sigma * walk.sample();
+        }
+        if self.ramp_per_sample != 0.0 {
+            b += self.ramp_per_sample * self.k as f64;
+        }
+        self.k += 1;
+        let (sf, offset) = if p > 0 {
+            (self.sf_normal, 0.0)
+        } else {
+            (self.sf_reverse, e.bias_mode_mismatch_dps)
+        };
+        let term = f64::from(p) * (b + offset);
+        self.transient *= self.settle;
+        if let Some((previous_mode, previous_term)) = self.previous {
+            if p != previous_mode {
+                self.transient += previous_term - term;
+            }
+        }
+        self.previous = Some((p, term));
+        let y = sf * omega + term + self.transient + self.white_sigma * self.white.sample();
+        (y, b)
     }
 }
 

@@ -240,6 +240,7 @@ impl RtlBlock for System {
         let gains = roms.entry(GAINS_ROM);
         let coefficients = roms.entry(kf::ROM);
         block.params = top::chain_params(plan, &gains.0, &coefficients.0);
+        block.extra = vec!["loop_rate_a_dps", "loop_rate_b_dps"];
         let sine = roms.entry(gyro_loop::SINE_ROM);
         let taps = roms.entry(gyro_loop::TAPS_ROM);
         block.params.extend(
@@ -354,8 +355,6 @@ impl VectorBuilder for Vectors<'_> {
             ..SystemSummary::default()
         };
         let nan = f64::NAN;
-        let mut loop_rates: [Vec<f64>; 2] =
-            [Vec::with_capacity(samples), Vec::with_capacity(samples)];
         let output_lsb = loops[0].plan.output.to.lsb();
         let mut previous_modes = [Mode::Normal; 2];
         let mut last_rate = 0i128;
@@ -373,12 +372,13 @@ impl VectorBuilder for Vectors<'_> {
             bw_sel_of,
             |s: &RecordedSample| {
                 let step = &s.step;
+                let mut loop_rates = [nan; 2];
                 for g in 0..2 {
                     if step.modes[g] != previous_modes[g] {
                         summary.switches[g] += 1;
                         previous_modes[g] = step.modes[g];
                     }
-                    loop_rates[g].push(step.rates.map_or(nan, |r| r[g] as f64 * output_lsb));
+                    loop_rates[g] = step.rates.map_or(nan, |r| r[g] as f64 * output_lsb);
                 }
                 if summary.first_lock_sample.is_none() && step.locked == [true; 2] {
                     summary.first_lock_sample = Some(k);
@@ -394,7 +394,7 @@ impl VectorBuilder for Vectors<'_> {
                 if s.estimated && summary.first_estimate_sample.is_none() {
                     summary.first_estimate_sample = Some(k);
                 }
-                block.push(
+                block.push_with_extra(
                     false,
                     &[
                         flag(s.enable),
@@ -419,13 +419,12 @@ impl VectorBuilder for Vectors<'_> {
                         s.bias[1],
                         flag(s.estimated),
                     ],
+                    &loop_rates,
                 );
                 k += 1;
             },
         )
         .expect("the config check validated the physics");
-        let [rate_a, rate_b] = loop_rates;
-        self.block.extra = vec![("loop_rate_a_dps", rate_a), ("loop_rate_b_dps", rate_b)];
         results.system_record = Some(summary);
         self.block
     }

@@ -84,6 +84,7 @@ impl RtlBlock for Top {
         let gains = roms.entry(estimator::ROM);
         let coefficients = roms.entry(kf::ROM);
         block.params = chain_params(&job.chain, &gains.0, &coefficients.0);
+        block.extra = vec!["float_rate_dps", "ideal_rate_dps", "true_rate_dps"];
         block.roms.push(gains);
         block.roms.push(coefficients);
         block
@@ -98,9 +99,6 @@ impl RtlBlock for Top {
             errors: Accumulator::default(),
             switches: 0,
             previous_sel: None,
-            float: Vec::with_capacity(rows),
-            ideal: Vec::with_capacity(rows),
-            truth: Vec::with_capacity(rows),
         }))
     }
 
@@ -131,23 +129,18 @@ struct Vectors<'a> {
     /// Changes of `bw_sel` between KF steps (each may add to the error bound).
     switches: u64,
     previous_sel: Option<usize>,
-    float: Vec<f64>,
-    ideal: Vec<f64>,
-    truth: Vec<f64>,
 }
 
 impl VectorBuilder for Vectors<'_> {
     fn reset(&mut self) {
-        self.block.push(true, &[0, 0, 0], &[0; 7]);
-        for extra in [&mut self.float, &mut self.ideal, &mut self.truth] {
-            extra.push(f64::NAN);
-        }
+        self.block
+            .push_with_extra(true, &[0, 0, 0], &[0; 7], &[f64::NAN; 3]);
     }
 
     fn sample(&mut self, sample: &ChainSample) {
         let fixed = sample.fixed;
         let s = &fixed.slot;
-        self.block.push(
+        self.block.push_with_extra(
             false,
             &[
                 sample.bw_sel as i128,
@@ -163,10 +156,12 @@ impl VectorBuilder for Vectors<'_> {
                 sample.bias_after[1],
                 flag(sample.estimated),
             ],
+            &[
+                sample.float.rate.unwrap_or(f64::NAN),
+                sample.ideal.rate.unwrap_or(f64::NAN),
+                sample.true_rate_dps,
+            ],
         );
-        self.float.push(sample.float.rate.unwrap_or(f64::NAN));
-        self.ideal.push(sample.ideal.rate.unwrap_or(f64::NAN));
-        self.truth.push(sample.true_rate_dps);
         if let Some(code) = fixed.rate {
             if self.previous_sel.is_some_and(|p| p != sample.bw_sel) {
                 self.switches += 1;
@@ -187,11 +182,6 @@ impl VectorBuilder for Vectors<'_> {
             .plan
             .rate_error_bound_lsb(self.errors.count(), self.switches);
         results.chain_stats = Some(std::mem::take(&mut self.errors).finish(bound));
-        self.block.extra = vec![
-            ("float_rate_dps", std::mem::take(&mut self.float)),
-            ("ideal_rate_dps", std::mem::take(&mut self.ideal)),
-            ("true_rate_dps", std::mem::take(&mut self.truth)),
-        ];
         self.block
     }
 }

@@ -31,6 +31,9 @@
 use super::chi2::chi2_quantile;
 use super::edf;
 
+mod stream;
+pub use stream::OverlappingStream;
+
 /// Which deviation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kind {
