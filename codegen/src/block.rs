@@ -241,6 +241,8 @@ pub struct Block {
     rows: Rows,
     /// Rows pushed.
     count: usize,
+    /// The files the rows were streamed to, after [`Block::finish_rows`].
+    written: Vec<crate::package::FileEntry>,
     /// Clocks the testbench waits after the one that follows `ce` before it compares the
     /// registered outputs (0: they are valid 1 clock after `ce`): a pipelined block's extra
     /// latency. `ce` stays low meanwhile, so samples come every `2 + settle_clocks` clocks at
@@ -271,6 +273,7 @@ impl Block {
                 extra: Vec::new(),
             },
             count: 0,
+            written: Vec::new(),
             settle_clocks: 0,
         }
     }
@@ -285,11 +288,23 @@ impl Block {
         self.rows = Rows::Streamed(sink);
     }
 
-    /// Ends the rows: the files a sink wrote (none when the rows are kept).
+    /// Ends the rows; a sink's files are then listed by [`Block::written`].
     ///
     /// # Errors
     /// The sink's write errors.
-    pub fn finish_rows(&mut self) -> crate::error::Result<Vec<crate::package::FileEntry>> {
+    pub fn finish_rows(&mut self) -> crate::error::Result<()> {
+        let entries = self.end_rows()?;
+        self.written.extend(entries);
+        Ok(())
+    }
+
+    /// The files the rows were streamed to (none when they were kept), after
+    /// [`Block::finish_rows`].
+    pub fn written(&self) -> &[crate::package::FileEntry] {
+        &self.written
+    }
+
+    fn end_rows(&mut self) -> crate::error::Result<Vec<crate::package::FileEntry>> {
         match std::mem::replace(
             &mut self.rows,
             Rows::Memory {

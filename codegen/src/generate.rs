@@ -10,8 +10,8 @@ use crate::blocks::{RomImages, REGISTRY};
 use crate::error::Result;
 use crate::hdl;
 use crate::job::Job;
-use crate::output_folder::{self, Kind, Replace};
-use crate::package::{sha256_hex, Package, MANIFEST};
+use crate::output_folder::{Kind, Replace};
+use crate::package::{sha256_hex, FileEntry, Package, Staging, MANIFEST};
 use crate::progress::Progress;
 use crate::rom::{self, RomFormat, ROM_FOLDER};
 use crate::testbench::{verilog, vhdl};
@@ -69,37 +69,37 @@ pub fn provenance(
     }
 }
 
-/// Every file of one block's folder.
-fn block_files(block: &Block, csv: bool, provenance: &Provenance) -> Vec<(String, String)> {
-    let (stimulus, expected) = writers::vector_hex(block, provenance);
-    let mut files = vec![
-        (
-            block.file("params.vh"),
-            writers::params_vh(block, provenance),
-        ),
-        (block.file("stimulus.hex"), stimulus),
-        (block.file("expected.hex"), expected),
-    ];
-    if csv {
-        files.push((
-            block.file("vectors.csv"),
-            writers::vector_csv(block, provenance),
-        ));
-    }
-    files.extend([
-        (block.file("tb"), verilog::testbench(block, provenance)),
-        (block.file("tb.vhd"), vhdl::testbench(block, provenance)),
-    ]);
+/// One file of a block's folder: its text, or the entry of a file its rows were streamed to.
+enum BlockFile {
+    Text(String, String),
+    Written(FileEntry),
+}
+
+/// Every file of one block's folder, in the package's order: the parameter include, the
+/// vector files (streamed already: their entries), the testbenches and the ROM images.
+fn block_files(block: &Block, provenance: &Provenance) -> Vec<BlockFile> {
+    let text =
+        |name: String, content: String| BlockFile::Text(format!("{}/{name}", block.name), content);
+    let mut files = vec![text(
+        block.file("params.vh"),
+        writers::params_vh(block, provenance),
+    )];
+    files.extend(block.written().iter().cloned().map(BlockFile::Written));
+    files.push(text(
+        block.file("tb"),
+        verilog::testbench(block, provenance),
+    ));
+    files.push(text(
+        block.file("tb.vhd"),
+        vhdl::testbench(block, provenance),
+    ));
     files.extend(
         block
             .roms
             .iter()
-            .map(|(name, text)| (name.to_string(), text.clone())),
+            .map(|(name, content)| text(name.to_string(), content.clone())),
     );
     files
-        .into_iter()
-        .map(|(name, text)| (format!("{}/{name}", block.name), text))
-        .collect()
 }
 
 fn block_manifest(block: &Block) -> serde_json::Value {
@@ -138,20 +138,29 @@ fn block_manifest(block: &Block) -> serde_json::Value {
     })
 }
 
-/// Builds every file of the package for `job`, in memory. `progress` follows the phases and
-/// the chain run's simulated samples.
+/// Builds the package for `job`: the blocks' vector files are streamed into `staging` as the
+/// chain runs (memory does not grow with the samples), every other file is built in memory
+/// for [`Package::write_staged`]. `progress` follows the phases and the chain run's simulated
+/// samples.
 ///
 /// # Errors
-/// Stimulus errors (a bad CSV file).
+/// Stimulus errors (a bad CSV file); write errors.
 pub fn build_package(
     job: &Job,
     contents: &Contents,
     provenance: &Provenance,
     progress: &Progress,
+    staging: &Staging,
 ) -> Result<(Package, Summary)> {
     progress.set_phase("chain run");
     let roms = RomImages::new(job, provenance);
-    let mut run = vectors::run(job, &roms, progress)?;
+    let streaming = vectors::Streaming {
+        root: staging.path(),
+        csv: contents.csv,
+        blocks: contents.blocks.as_deref(),
+        provenance,
+    };
+    let mut run = vectors::run_streamed(job, &roms, progress, streaming)?;
     if let Some(names) = &contents.blocks {
         run.blocks.retain(|b| names.iter().any(|n| n == b.name));
     }
@@ -171,20 +180,12 @@ pub fn build_package(
             );
         }
     }
-    let per_block: Vec<Vec<(String, String)>> = std::thread::scope(|scope| {
-        let handles: Vec<_> = run
-            .blocks
-            .iter()
-            .map(|b| scope.spawn(move || block_files(b, contents.csv, provenance)))
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| h.join().expect("writers do not panic"))
-            .collect()
-    });
-    for files in per_block {
-        for (path, text) in files {
-            package.add(path, text);
+    for block in &run.blocks {
+        for file in block_files(block, provenance) {
+            match file {
+                BlockFile::Text(path, text) => package.add(path, text),
+                BlockFile::Written(entry) => package.add_written(entry),
+            }
         }
     }
 
@@ -320,14 +321,14 @@ pub fn generate(
     provenance: &Provenance,
     progress: &Progress,
 ) -> Result<Summary> {
-    output_folder::check(out, Kind::Generate, options.replace)?;
-    let (package, summary) = build_package(job, &options.contents, provenance, progress)?;
+    let staging = Staging::create(out, Kind::Generate, options.replace)?;
+    let (package, summary) = build_package(job, &options.contents, provenance, progress, &staging)?;
     let overflowed = summary.run.overflows.in_chain_run();
     if options.strict && !overflowed.is_empty() {
+        // The staging folder goes with `staging`: nothing is written.
         return Err(crate::error::Error::Overflow(overflow_list(&overflowed)));
     }
     progress.set_phase("writing");
-    let replace = options.replace;
-    package.write_atomically(out, replace)?;
+    package.write_staged(staging)?;
     Ok(summary)
 }

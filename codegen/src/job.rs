@@ -146,30 +146,67 @@ impl Job {
     /// [`Error::Input`] / [`Error::Io`] for a bad CSV file, or one with fewer than `samples`
     /// values (silently running a shorter record would leave the report nothing to analyse).
     pub fn true_rate(&self, samples: usize) -> Result<Vec<f64>> {
+        let source = self.rate_source(samples)?;
+        Ok((0..samples).map(|k| source.at(k)).collect())
+    }
+
+    /// The true rate sample by sample: computed from the scenario, or the CSV column's first
+    /// `samples` values (which are read whole).
+    ///
+    /// # Errors
+    /// As [`Job::true_rate`].
+    pub fn rate_source(&self, samples: usize) -> Result<RateSource> {
         Ok(match &self.settings.source {
-            Source::Synthetic(scenario) => {
-                let t = 1.0 / self.config.stimulus.fs_hz;
-                (0..samples)
-                    .map(|k| scenario.rate_at(k as f64 * t))
-                    .collect()
-            }
+            Source::Synthetic(scenario) => RateSource::Synthetic {
+                scenario: *scenario,
+                period_s: 1.0 / self.config.stimulus.fs_hz,
+            },
             Source::Csv { path, column } => {
-                let mut values = read_column(path, column)?;
-                if values.len() < samples {
-                    return Err(crate::error::Error::Input {
-                        path: path.clone(),
-                        message: format!(
-                            "column {column} has {} values but samples = {samples}: give \
-                             samples <= {} (in the config or with --samples), or a longer record",
-                            values.len(),
-                            values.len()
-                        ),
-                    });
-                }
-                values.truncate(samples);
-                values
+                RateSource::Recorded(recorded_rate(path, column, samples)?)
             }
         })
+    }
+}
+
+/// The first `samples` values of `column` in the CSV file at `path`.
+fn recorded_rate(path: &std::path::Path, column: &str, samples: usize) -> Result<Vec<f64>> {
+    let mut values = read_column(path, column)?;
+    if values.len() < samples {
+        return Err(crate::error::Error::Input {
+            path: path.to_path_buf(),
+            message: format!(
+                "column {column} has {} values but samples = {samples}: give \
+                 samples <= {} (in the config or with --samples), or a longer record",
+                values.len(),
+                values.len()
+            ),
+        });
+    }
+    values.truncate(samples);
+    Ok(values)
+}
+
+/// The true rate of a run, sample by sample ([`Job::rate_source`]).
+#[derive(Clone, Debug)]
+pub enum RateSource {
+    /// The scenario at `k · period_s`.
+    Synthetic {
+        /// The scenario.
+        scenario: gyrofx_model::stimulus::Scenario,
+        /// Sample period, s.
+        period_s: f64,
+    },
+    /// A recorded column.
+    Recorded(Vec<f64>),
+}
+
+impl RateSource {
+    /// The true rate at sample `k`, °/s (0 beyond a recorded column's end).
+    pub fn at(&self, k: usize) -> f64 {
+        match self {
+            RateSource::Synthetic { scenario, period_s } => scenario.rate_at(k as f64 * period_s),
+            RateSource::Recorded(values) => values.get(k).copied().unwrap_or(0.0),
+        }
     }
 }
 

@@ -11,11 +11,21 @@ use crate::output_folder::{self, Kind, Marker, Replace, MARKER, OLD_PREFIX};
 /// gyrofx output that may be replaced: [`output_folder::check`]).
 pub const MANIFEST: &str = "manifest.json";
 
-/// Files of an output folder, by relative path.
+/// Files of an output folder, by relative path: built in memory, or already written into the
+/// staging folder (streamed vector files) with their entries.
 #[derive(Clone, Debug)]
 pub struct Package {
     kind: Kind,
-    files: Vec<(PathBuf, Vec<u8>)>,
+    files: Vec<(PathBuf, Content)>,
+}
+
+/// A file of a [`Package`].
+#[derive(Clone, Debug)]
+enum Content {
+    /// To be written.
+    Data(Vec<u8>),
+    /// Written already, into the staging folder the package goes to.
+    Written(FileEntry),
 }
 
 /// A file's entry in the manifest.
@@ -45,14 +55,22 @@ impl Package {
             kind,
             files: vec![(
                 PathBuf::from(MARKER),
-                Marker::new(kind, build_outputs).text().into_bytes(),
+                Content::Data(Marker::new(kind, build_outputs).text().into_bytes()),
             )],
         }
     }
 
     /// Adds a file at the relative `path`.
     pub fn add(&mut self, path: impl Into<PathBuf>, content: impl Into<Vec<u8>>) {
-        self.files.push((path.into(), content.into()));
+        self.files
+            .push((path.into(), Content::Data(content.into())));
+    }
+
+    /// Lists a file already written into the staging folder the package will be written to
+    /// ([`Package::write_staged`]).
+    pub fn add_written(&mut self, entry: FileEntry) {
+        self.files
+            .push((PathBuf::from(entry.path.clone()), Content::Written(entry)));
     }
 
     /// Relative paths of every file so far, `/`-separated, in the order added.
@@ -69,77 +87,66 @@ impl Package {
             let hashes: Vec<_> = self
                 .files
                 .iter()
-                .map(|(_, data)| scope.spawn(move || sha256_hex(data)))
+                .map(|(_, content)| {
+                    scope.spawn(move || match content {
+                        Content::Data(data) => (sha256_hex(data), data.len()),
+                        Content::Written(entry) => (entry.sha256.clone(), entry.bytes),
+                    })
+                })
                 .collect();
             self.paths()
                 .into_iter()
                 .zip(hashes)
-                .zip(&self.files)
-                .map(|((path, hash), (_, data))| FileEntry {
-                    path,
-                    sha256: hash.join().expect("hashing does not panic"),
-                    bytes: data.len(),
+                .map(|(path, hash)| {
+                    let (sha256, bytes) = hash.join().expect("hashing does not panic");
+                    FileEntry {
+                        path,
+                        sha256,
+                        bytes,
+                    }
                 })
                 .collect()
         })
     }
 
-    /// Writes the package to `out`, all or nothing: into a staging folder beside `out`, then
-    /// renamed into place. An existing `out` is replaced only as [`output_folder::check`]
-    /// allows; anything else is refused untouched. The staging folder is removed on an error
-    /// and, through [`output_folder::remove_registered`], on a signal; ones a killed run left
-    /// in the same parent folder are removed first ([`output_folder::clean_stale`]).
+    /// Writes the package to `out`, all or nothing: into a staging folder beside `out`
+    /// ([`Staging`]), then renamed into place. An existing `out` is replaced only as
+    /// [`output_folder::check`] allows; anything else is refused untouched.
     ///
     /// # Errors
     /// [`Error::Output`] when `out` cannot be used, [`Error::Io`] when writing fails (the
     /// staging folder is removed).
     pub fn write_atomically(&self, out: &Path, replace: Replace) -> Result<()> {
-        let refuse = |message: String| Error::Output {
-            path: out.to_path_buf(),
-            message,
-        };
-        output_folder::check(out, self.kind, replace)?;
-        let parent = match out.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
-        std::fs::create_dir_all(&parent)
-            .map_err(|e| refuse(format!("cannot create its parent folder: {e}")))?;
-        output_folder::clean_stale(&parent);
-        let staged = output_folder::create_staging(&parent).map_err(|e| {
-            refuse(format!(
-                "cannot create a temporary folder in {}: {e}",
-                parent.display()
-            ))
-        })?;
-        let written = self.write_files(&staged);
-        if let Some(hold) = std::env::var("GYROFX_TEST_HOLD_STAGING_MS")
-            .ok()
-            .and_then(|ms| ms.parse::<u64>().ok())
-        {
-            // Test hook: lets a test signal the process while the staging folder exists.
-            std::thread::sleep(std::time::Duration::from_millis(hold));
-        }
-        let result = written.and_then(|()| self.move_into_place(&staged, out, &parent));
-        if result.is_err() {
-            let _ = std::fs::remove_dir_all(&staged);
-        }
-        output_folder::unregister(&staged);
-        result
+        let staging = Staging::create(out, self.kind, replace)?;
+        self.write_staged(staging)
+    }
+
+    /// Writes the files not written yet into `staging` and moves it into place.
+    ///
+    /// # Errors
+    /// As [`Package::write_atomically`].
+    pub fn write_staged(&self, staging: Staging) -> Result<()> {
+        self.write_files(&staging.path)?;
+        staging.commit()
     }
 
     /// Writes every file under `root`, one thread per file: the large vector files are
     /// written side by side.
     fn write_files(&self, root: &Path) -> Result<()> {
-        for (path, _) in &self.files {
+        let pending = self
+            .files
+            .iter()
+            .filter_map(|(path, content)| match content {
+                Content::Data(data) => Some((path, data)),
+                Content::Written(_) => None,
+            });
+        for (path, _) in pending.clone() {
             if let Some(folder) = root.join(path).parent() {
                 std::fs::create_dir_all(folder).map_err(|e| Error::io(folder, e))?;
             }
         }
         std::thread::scope(|scope| {
-            let writers: Vec<_> = self
-                .files
-                .iter()
+            let writers: Vec<_> = pending
                 .map(|(path, data)| {
                     let target = root.join(path);
                     scope.spawn(move || {
@@ -158,9 +165,84 @@ impl Package {
                 .try_for_each(|w| w.join().expect("writing does not panic"))
         })
     }
+}
+
+/// A staging folder beside an output folder: where a package is written before it is renamed
+/// into place. Creating it checks the output folder ([`output_folder::check`]) and removes
+/// staging folders a killed run left there ([`output_folder::clean_stale`]); it is registered
+/// for removal on a signal ([`output_folder::remove_registered`]) and removed when dropped
+/// without [`Staging::commit`] (any error on the way).
+#[derive(Debug)]
+pub struct Staging {
+    path: PathBuf,
+    out: PathBuf,
+    parent: PathBuf,
+    committed: bool,
+}
+
+impl Staging {
+    /// A staging folder for `out`, a package of `kind`.
+    ///
+    /// # Errors
+    /// [`Error::Output`] when `out` may not be replaced or the folder cannot be created.
+    pub fn create(out: &Path, kind: Kind, replace: Replace) -> Result<Self> {
+        let refuse = |message: String| Error::Output {
+            path: out.to_path_buf(),
+            message,
+        };
+        output_folder::check(out, kind, replace)?;
+        let parent = match out.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        std::fs::create_dir_all(&parent)
+            .map_err(|e| refuse(format!("cannot create its parent folder: {e}")))?;
+        output_folder::clean_stale(&parent);
+        let path = output_folder::create_staging(&parent).map_err(|e| {
+            refuse(format!(
+                "cannot create a temporary folder in {}: {e}",
+                parent.display()
+            ))
+        })?;
+        Ok(Staging {
+            path,
+            out: out.to_path_buf(),
+            parent,
+            committed: false,
+        })
+    }
+
+    /// The staging folder.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Renames the staging folder to the output folder (a previous one moved aside first and
+    /// removed after).
+    ///
+    /// # Errors
+    /// [`Error::Output`] when the rename fails (the staging folder is removed).
+    pub fn commit(mut self) -> Result<()> {
+        if let Some(hold) = std::env::var("GYROFX_TEST_HOLD_STAGING_MS")
+            .ok()
+            .and_then(|ms| ms.parse::<u64>().ok())
+        {
+            // Test hook: lets a test signal the process while the staging folder exists.
+            std::thread::sleep(std::time::Duration::from_millis(hold));
+        }
+        if output_folder::interrupted() {
+            return Err(Error::io(
+                &self.path,
+                std::io::Error::from(std::io::ErrorKind::Interrupted),
+            ));
+        }
+        let result = Self::move_into_place(&self.path, &self.out, &self.parent);
+        self.committed = result.is_ok();
+        result
+    }
 
     /// Renames `staged` to `out`, moving a previous `out` aside first and removing it after.
-    fn move_into_place(&self, staged: &Path, out: &Path, parent: &Path) -> Result<()> {
+    fn move_into_place(staged: &Path, out: &Path, parent: &Path) -> Result<()> {
         let refuse = |message: String| Error::Output {
             path: out.to_path_buf(),
             message,
@@ -194,5 +276,14 @@ impl Package {
             let _ = std::fs::remove_dir_all(&old);
         }
         Ok(())
+    }
+}
+
+impl Drop for Staging {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = std::fs::remove_dir_all(&self.path);
+        }
+        output_folder::unregister(&self.path);
     }
 }

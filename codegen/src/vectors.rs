@@ -8,12 +8,13 @@
 //! late in the run. The gyros are simulated in the modes the sequencer asks for, resets
 //! included.
 
-use gyrofx_model::analysis::allan::{self, Kind};
+use gyrofx_model::analysis::allan::OverlappingStream;
 use gyrofx_model::chain::{FixedChain, FloatChain};
 use gyrofx_model::estimator::OverflowCounts as EstimatorOverflows;
 use gyrofx_model::fx::Format;
 use gyrofx_model::gyro_loop::closed::FixedClosedLoop;
 use gyrofx_model::kf::OverflowCounts;
+use gyrofx_model::plant::GyroStream;
 use gyrofx_model::resonator::Mode;
 use gyrofx_model::sequencer::Sequencer;
 use gyrofx_model::stimulus::adc;
@@ -22,11 +23,12 @@ use serde::Serialize;
 use crate::block::Block;
 use crate::blocks::kf::TieCases;
 use crate::blocks::{ChainSample, RomImages};
-use crate::config::GyroLoop;
 use crate::error::{Error, Result};
 use crate::job::Job;
 use crate::progress::Progress;
 pub use crate::stats::ErrorStats;
+use crate::vector_rows::StagedRows;
+use crate::writers::Provenance;
 
 /// Overflow counts of every quantization point.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -190,17 +192,57 @@ pub struct Run {
     pub system_record: Option<crate::blocks::system::SystemSummary>,
 }
 
-/// Runs the chain for `job` and builds the vectors of every registered block that has them;
-/// `roms` are the images their DUTs read.
+/// Where a streamed run writes its blocks' vector files ([`run_streamed`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Streaming<'a> {
+    /// The staging folder.
+    pub root: &'a std::path::Path,
+    /// Whether the CSV twins are written.
+    pub csv: bool,
+    /// Only these blocks' files (all when `None`); the others' rows are only counted.
+    pub blocks: Option<&'a [String]>,
+    /// The generated-by line's source.
+    pub provenance: &'a Provenance,
+}
+
+/// Runs the chain for `job` and builds the vectors of every registered block that has them,
+/// kept in memory; `roms` are the images their DUTs read.
 ///
 /// # Errors
 /// Stimulus errors (a bad CSV file).
 pub fn run(job: &Job, roms: &RomImages, progress: &Progress) -> Result<Run> {
+    run_with(job, roms, progress, None)
+}
+
+/// [`run`], each block's rows written as they come into its files under `streaming.root`
+/// ([`StagedRows`]): memory does not grow with the samples. Each block then holds the
+/// entries of the files it wrote ([`Block::finish_rows`]).
+///
+/// # Errors
+/// Stimulus errors; write errors.
+pub fn run_streamed(
+    job: &Job,
+    roms: &RomImages,
+    progress: &Progress,
+    streaming: Streaming,
+) -> Result<Run> {
+    run_with(job, roms, progress, Some(streaming))
+}
+
+/// Chain samples the gyros are simulated ahead of the chain, a batch at a time.
+const GYRO_BATCH: usize = 2048;
+
+fn run_with(
+    job: &Job,
+    roms: &RomImages,
+    progress: &Progress,
+    streaming: Option<Streaming>,
+) -> Result<Run> {
     let plan = &job.chain;
     let kf = job.kf();
     let est = &plan.estimator;
-    let rate = job.true_rate(job.config.samples)?;
-    let n = rate.len();
+    let rate = job.rate_source(job.config.samples)?;
+    let n = job.config.samples;
     // Work units: chain samples of each closed-loop gyro simulation (two with reversal, two
     // without, for the report), then of the chain itself.
     let simulations = if job.settings.resonator.is_some() {
@@ -215,58 +257,52 @@ pub fn run(job: &Job, roms: &RomImages, progress: &Progress) -> Result<Run> {
     // calibrated output before it.
     let reset_at = if n >= 20 { Some(n - n / 10) } else { None };
 
-    // The modes the sequencer asks for, resets included: the plant runs in them.
-    let mut sequencer = Sequencer::new(&est.schedule);
-    let mut modes = Vec::with_capacity(n);
-    for k in 0..n {
-        if reset_at == Some(k) {
-            sequencer.reset();
+    let mut builders: Vec<_> = Vec::new();
+    for registered in crate::blocks::of(job).filter(|b| b.has_vectors()) {
+        let mut block = registered.block(job, roms);
+        if let Some(streaming) = &streaming {
+            let wanted = streaming
+                .blocks
+                .is_none_or(|names| names.iter().any(|n| n == block.name));
+            let sink = if wanted {
+                StagedRows::open(&block, streaming.root, streaming.csv, streaming.provenance)?
+            } else {
+                StagedRows::discard(&block)
+            };
+            block.stream_to(Box::new(sink));
         }
-        let slot = sequencer.advance();
-        modes.push([slot.mode_a, slot.mode_b]);
+        if let Some(builder) = registered.vectors(job, block) {
+            builders.push(builder);
+        }
     }
-    let plant = &job.settings.plant;
-    let seed = job.config.seed;
-    let ([ya, yb], [sat_a, sat_b]) = match &job.settings.resonator {
-        None => {
-            let record = plant.simulate(&rate, &modes, seed);
-            let (ya, sat_a) = adc(&record.y[0], est.input);
-            let (yb, sat_b) = adc(&record.y[1], est.input);
-            ([ya, yb], [sat_a, sat_b])
-        }
-        Some(loops) => {
-            let [a, b] = resonator_record(loops, &rate, &modes, seed, est.input, progress)?;
-            ([a.codes, b.codes], [a.saturations, b.saturations])
-        }
-    };
-    // The same gyros without reversal, °/s, for the report.
-    let raw_record = || -> Result<[Vec<f64>; 2]> {
-        Ok(match &job.settings.resonator {
-            None => plant.simulate(&rate, &vec![[1i8, 1i8]; n], seed).y,
-            Some(loops) => {
-                let normal = vec![[1i8, 1i8]; n];
-                resonator_record(loops, &rate, &normal, seed, est.input, progress)?
-                    .map(|gyro| gyro.dps)
+
+    // The gyros as the sequencer drives them, and the same gyros without reversal (same
+    // noise streams) for the report, simulated a batch ahead of the chain.
+    let mut gyros = Gyros::new(job, rate.at(0))?;
+    let mut sequencer = Sequencer::new(&est.schedule);
+    let mut fixed = FixedChain::new(plan);
+    let mut float = FloatChain::quantized(plan);
+    let mut ideal = FloatChain::ideal(plan);
+    let mut first_estimate: Option<usize> = None;
+    let fs = job.config.stimulus.fs_hz;
+    let mut report = ReportStream::new(fs);
+    let (mut last_combined, mut last_filtered) = (0.0, 0.0);
+    let mut batch = GyroBatch::default();
+
+    for first in (0..n).step_by(GYRO_BATCH) {
+        let last = (first + GYRO_BATCH).min(n);
+        batch.rates.clear();
+        batch.modes.clear();
+        for k in first..last {
+            if reset_at == Some(k) {
+                sequencer.reset();
             }
-        })
-    };
-
-    let mut builders: Vec<_> = crate::blocks::of(job)
-        .filter_map(|b| b.vectors(job, b.block(job, roms)))
-        .collect();
-
-    // Report: the same gyros run without reversal (same noise streams), simulated on the other
-    // core while the chain runs.
-    std::thread::scope(|scope| -> Result<Run> {
-        let raw_record = scope.spawn(raw_record);
-        let mut fixed = FixedChain::new(plan);
-        let mut float = FloatChain::quantized(plan);
-        let mut ideal = FloatChain::ideal(plan);
-        let (mut combined_series, mut filtered_series) =
-            (Vec::with_capacity(n), Vec::with_capacity(n));
-        let mut first_estimate: Option<usize> = None;
-
-        for k in 0..n {
+            let slot = sequencer.advance();
+            batch.modes.push([slot.mode_a, slot.mode_b]);
+            batch.rates.push(rate.at(k));
+        }
+        gyros.simulate(&mut batch, progress)?;
+        for (i, k) in (first..last).enumerate() {
             if k % PROGRESS_STEP == PROGRESS_STEP - 1 {
                 progress.advance(PROGRESS_STEP as u64);
             }
@@ -279,7 +315,7 @@ pub fn run(job: &Job, roms: &RomImages, progress: &Progress) -> Result<Run> {
                 }
             }
             let bw_sel = (k / chunk) % entries;
-            let y = [ya[k], yb[k]];
+            let y = batch.codes[i];
             let y_real = [
                 est.input.to_f64(i128::from(y[0])),
                 est.input.to_f64(i128::from(y[1])),
@@ -296,177 +332,308 @@ pub fn run(job: &Job, roms: &RomImages, progress: &Progress) -> Result<Run> {
                 ideal: &c,
                 bias_after: fixed.estimator().bias(),
                 estimated: fixed.estimator().estimated(),
-                true_rate_dps: rate[k],
+                true_rate_dps: batch.rates[i],
             };
             for builder in &mut builders {
                 builder.sample(&sample);
             }
-            match a.rate {
-                Some(code) => filtered_series.push(kf.output.to_f64(i128::from(code))),
-                None => filtered_series.push(*filtered_series.last().unwrap_or(&0.0)),
+            if let Some(code) = a.rate {
+                last_filtered = kf.output.to_f64(i128::from(code));
             }
-            let combined = if a.estimator.combined_valid {
-                est.calibrated.to_f64(i128::from(a.estimator.combined))
-            } else {
-                *combined_series.last().unwrap_or(&0.0)
-            };
-            combined_series.push(combined);
+            if a.estimator.combined_valid {
+                last_combined = est.calibrated.to_f64(i128::from(a.estimator.combined));
+            }
             if first_estimate.is_none() && a.estimator.estimated {
                 first_estimate = Some(k);
             }
+            // Only calibrated samples: from the first estimate to the reset.
+            if first_estimate.is_some() && reset_at.is_none_or(|r| k < r) {
+                let [raw_a, raw_b] = batch.raw[i];
+                report.push(batch.rates[i], [raw_a, raw_b, last_combined, last_filtered]);
+            }
         }
-        let mut results = Results::default();
-        let blocks: Vec<Block> = builders
-            .into_iter()
-            .map(|builder| builder.finish(&mut results))
-            .collect();
+    }
+    let mut results = Results::default();
+    let mut blocks: Vec<Block> = builders
+        .into_iter()
+        .map(|builder| builder.finish(&mut results))
+        .collect();
+    for block in &mut blocks {
+        block.finish_rows()?;
+    }
 
-        let raw = raw_record
-            .join()
-            .expect("the plant simulation does not panic")?;
-        let fs = job.config.stimulus.fs_hz;
-        // Only calibrated samples: from the first estimate to the reset.
-        let start = first_estimate.unwrap_or(n).min(n);
-        let end = reset_at.unwrap_or(n).max(start);
-        let report = report(
-            fs,
-            &rate[start..end],
-            [
-                &raw[0][start..end],
-                &raw[1][start..end],
-                &combined_series[start..end],
-                &filtered_series[start..end],
-            ],
-        );
-        const REGISTERED: &str = "a registered block reports it";
-        Ok(Run {
-            blocks,
-            kf_stats: results.kf_stats.expect(REGISTERED),
-            chain_stats: results.chain_stats.expect(REGISTERED),
-            bias_stats: results.bias_stats.expect(REGISTERED),
-            mean_filter_stats: results.mean_filter_stats.expect(REGISTERED),
-            overflows: Overflows {
-                adc: [sat_a, sat_b],
-                estimator: fixed.estimator().overflow_counts().into(),
-                kf_chain: fixed.kf().overflow_counts().into(),
-                kf_directed: results.kf_directed.expect(REGISTERED),
-                mean_filter: results.mean_filter_overflows.expect(REGISTERED),
-            },
-            ties: results.ties.expect(REGISTERED),
-            report,
-            samples: n,
-            gyro_loop_record: results.gyro_loop_record.expect(REGISTERED),
-            system_record: results.system_record,
-        })
+    const REGISTERED: &str = "a registered block reports it";
+    Ok(Run {
+        blocks,
+        kf_stats: results.kf_stats.expect(REGISTERED),
+        chain_stats: results.chain_stats.expect(REGISTERED),
+        bias_stats: results.bias_stats.expect(REGISTERED),
+        mean_filter_stats: results.mean_filter_stats.expect(REGISTERED),
+        overflows: Overflows {
+            adc: gyros.saturations(),
+            estimator: fixed.estimator().overflow_counts().into(),
+            kf_chain: fixed.kf().overflow_counts().into(),
+            kf_directed: results.kf_directed.expect(REGISTERED),
+            mean_filter: results.mean_filter_overflows.expect(REGISTERED),
+        },
+        ties: results.ties.expect(REGISTERED),
+        report: report.finish(),
+        samples: n,
+        gyro_loop_record: results.gyro_loop_record.expect(REGISTERED),
+        system_record: results.system_record,
     })
 }
 
-/// One resonator-level gyro's output at the chain rate.
-struct GyroRecord {
-    /// Codes in the chain's input format.
-    codes: Vec<i64>,
-    /// The same, °/s.
-    dps: Vec<f64>,
-    /// Pick-off ADC saturations.
-    saturations: u64,
+/// One batch of chain samples: the true rates and the sequencer's modes in, the gyros'
+/// ADC codes (chain input format) and the unreversed gyros' outputs (°/s) out.
+#[derive(Default)]
+struct GyroBatch {
+    rates: Vec<f64>,
+    modes: Vec<[i8; 2]>,
+    codes: Vec<[i64; 2]>,
+    raw: Vec<[f64; 2]>,
+}
+
+/// The four simulated gyros of a run: A and B in the sequencer's modes, and A and B always in
+/// normal mode (same seeds, so the same noise) for the report.
+enum Gyros {
+    Rate {
+        reversed: Box<[GyroStream; 2]>,
+        normal: Box<[GyroStream; 2]>,
+        input: Format,
+        saturations: [u64; 2],
+    },
+    Resonator {
+        reversed: Box<[FixedClosedLoop; 2]>,
+        normal: Box<[FixedClosedLoop; 2]>,
+        scale: f64,
+        saturations: [u64; 2],
+    },
 }
 
 /// Start-up before the record: the loops lock from rest (about 80 ms for paper 004's gyro).
 const RESONATOR_STARTUP_S: f64 = 0.5;
 
-/// Both resonator-level gyros closed by their fixed-point loops, each in the modes `modes`
-/// asks for (`+1` normal, `−1` reverse), at the true rate `rate` (°/s) per chain sample, after
-/// [`RESONATOR_STARTUP_S`] at the first sample's rate in normal mode. Gyro `g` takes the seed
-/// `2·seed + g`. The loops' outputs are already codes of `input` (checked by the config).
 /// Chain samples between two counts of [`Progress::advance`].
 const PROGRESS_STEP: usize = 1024;
 
-fn resonator_record(
-    loops: &[GyroLoop; 2],
-    rate: &[f64],
-    modes: &[[i8; 2]],
-    seed: u64,
-    input: Format,
-    progress: &Progress,
-) -> Result<[GyroRecord; 2]> {
-    let run = |g: usize| -> Result<GyroRecord> {
-        let gyro = &loops[g];
-        let mut closed = FixedClosedLoop::new(
-            &gyro.plan,
-            &gyro.params,
-            &gyro.front_end,
-            seed.wrapping_mul(2).wrapping_add(g as u64),
-        )
-        .map_err(|e| Error::config(format!("resonator_{}", gyro.name), e, "see gyrofx init"))?;
-        let startup = (RESONATOR_STARTUP_S * gyro.plan.chain_rate_hz()).ceil() as usize;
-        for _ in 0..startup {
-            closed.step_chain(rate.first().copied().unwrap_or(0.0), Mode::Normal);
-        }
-        let scale = libm::ldexp(1.0, input.frac);
-        let mut record = GyroRecord {
-            codes: Vec::with_capacity(rate.len()),
-            dps: Vec::with_capacity(rate.len()),
-            saturations: 0,
-        };
-        for (k, (omega, mode)) in rate.iter().zip(modes).enumerate() {
-            if k % PROGRESS_STEP == PROGRESS_STEP - 1 {
-                progress.advance(PROGRESS_STEP as u64);
+impl Gyros {
+    /// The gyros of `job`. Resonator-level gyro `g` takes the seed `2·seed + g` and runs
+    /// [`RESONATOR_STARTUP_S`] at the first sample's rate `rate0` (°/s) in normal mode before
+    /// the record; its outputs are already codes of the chain's input format (checked by the
+    /// config).
+    fn new(job: &Job, rate0: f64) -> Result<Self> {
+        let seed = job.config.seed;
+        let input = job.chain.estimator.input;
+        Ok(match &job.settings.resonator {
+            None => {
+                let plant = &job.settings.plant;
+                let streams = || Box::new([0, 1].map(|g| plant.gyro_stream(g, seed)));
+                Gyros::Rate {
+                    reversed: streams(),
+                    normal: streams(),
+                    input,
+                    saturations: [0; 2],
+                }
             }
-            let mode = if mode[g] > 0 {
-                Mode::Normal
-            } else {
-                Mode::Reverse
-            };
-            let output = closed.step_chain(*omega, mode).output.rate_dps;
-            record.codes.push((output * scale).round() as i64);
-            record.dps.push(output);
-        }
-        record.saturations = closed.resonator.adc_saturations();
-        Ok(record)
-    };
-    std::thread::scope(|scope| {
-        let b = scope.spawn(|| run(1));
-        let a = run(0)?;
-        Ok([a, b.join().expect("the loop simulation does not panic")?])
-    })
-}
-
-fn report(fs: f64, rate: &[f64], signals: [&[f64]; 4]) -> Report {
-    let names = [
-        "raw gyro A (no reversal)",
-        "raw gyro B (no reversal)",
-        "calibrated, combined",
-        "filtered (KF output)",
-    ];
-    let tau_s: Vec<f64> = [0.1, 1.0, 10.0, 100.0, 1000.0]
-        .into_iter()
-        .filter(|tau| ((tau * fs).round() as usize) * 3 <= rate.len() && tau * fs >= 1.0)
-        .collect();
-    let lines = names
-        .iter()
-        .zip(signals)
-        .map(|(name, signal)| {
-            let errors: Vec<f64> = signal.iter().zip(rate).map(|(s, r)| s - r).collect();
-            ReportLine {
-                signal: name.to_string(),
-                bias_error_dps: errors.iter().sum::<f64>() / errors.len().max(1) as f64,
-                adev_dps: {
-                    let x = allan::phase(&errors);
-                    tau_s
-                        .iter()
-                        .map(|tau| {
-                            allan::deviation(Kind::Overlapping, &x, (tau * fs).round() as usize, fs)
-                                .map(|(dev, _)| dev)
-                        })
-                        .collect()
-                },
+            Some(loops) => {
+                let closed = |g: usize| -> Result<FixedClosedLoop> {
+                    let gyro = &loops[g];
+                    let mut closed = FixedClosedLoop::new(
+                        &gyro.plan,
+                        &gyro.params,
+                        &gyro.front_end,
+                        seed.wrapping_mul(2).wrapping_add(g as u64),
+                    )
+                    .map_err(|e| {
+                        Error::config(format!("resonator_{}", gyro.name), e, "see gyrofx init")
+                    })?;
+                    let startup = (RESONATOR_STARTUP_S * gyro.plan.chain_rate_hz()).ceil() as usize;
+                    for _ in 0..startup {
+                        closed.step_chain(rate0, Mode::Normal);
+                    }
+                    Ok(closed)
+                };
+                let reversed = Box::new([closed(0)?, closed(1)?]);
+                let normal = reversed.clone();
+                Gyros::Resonator {
+                    reversed,
+                    normal,
+                    scale: libm::ldexp(1.0, input.frac),
+                    saturations: [0; 2],
+                }
             }
         })
-        .collect();
-    Report {
-        samples: rate.len(),
-        tau_s,
-        lines,
+    }
+
+    /// Fills `batch.codes` and `batch.raw` for its rates and modes.
+    fn simulate(&mut self, batch: &mut GyroBatch, progress: &Progress) -> Result<()> {
+        let len = batch.rates.len();
+        batch.codes.clear();
+        batch.raw.clear();
+        match self {
+            Gyros::Rate {
+                reversed,
+                normal,
+                input,
+                saturations,
+            } => {
+                let mut values: [Vec<f64>; 2] = [Vec::with_capacity(len), Vec::with_capacity(len)];
+                for (omega, modes) in batch.rates.iter().zip(&batch.modes) {
+                    for g in 0..2 {
+                        values[g].push(reversed[g].step(*omega, modes[g]).0);
+                    }
+                    batch.raw.push([0, 1].map(|g| normal[g].step(*omega, 1).0));
+                }
+                let [(a, sat_a), (b, sat_b)] = values.map(|v| adc(&v, *input));
+                saturations[0] += sat_a;
+                saturations[1] += sat_b;
+                batch
+                    .codes
+                    .extend(a.into_iter().zip(b).map(|(a, b)| [a, b]));
+            }
+            Gyros::Resonator {
+                reversed,
+                normal,
+                scale,
+                saturations,
+            } => {
+                let scale = *scale;
+                let (rates, modes) = (&batch.rates, &batch.modes);
+                let run =
+                    |g: usize, reversed: &mut FixedClosedLoop, normal: &mut FixedClosedLoop| {
+                        let mut out = Vec::with_capacity(len);
+                        for (k, (omega, mode)) in rates.iter().zip(modes).enumerate() {
+                            if k % PROGRESS_STEP == PROGRESS_STEP - 1 {
+                                progress.advance(2 * PROGRESS_STEP as u64);
+                            }
+                            let mode = if mode[g] > 0 {
+                                Mode::Normal
+                            } else {
+                                Mode::Reverse
+                            };
+                            let output = reversed.step_chain(*omega, mode).output.rate_dps;
+                            let raw = normal.step_chain(*omega, Mode::Normal).output.rate_dps;
+                            out.push(((output * scale).round() as i64, raw));
+                        }
+                        out
+                    };
+                let [reversed_a, reversed_b] = &mut **reversed;
+                let [normal_a, normal_b] = &mut **normal;
+                let (a, b) = std::thread::scope(|scope| {
+                    let b = scope.spawn(|| run(1, reversed_b, normal_b));
+                    let a = run(0, reversed_a, normal_a);
+                    (a, b.join().expect("the loop simulation does not panic"))
+                });
+                for ((code_a, raw_a), (code_b, raw_b)) in a.into_iter().zip(b) {
+                    batch.codes.push([code_a, code_b]);
+                    batch.raw.push([raw_a, raw_b]);
+                }
+                *saturations = [
+                    reversed[0].resonator.adc_saturations(),
+                    reversed[1].resonator.adc_saturations(),
+                ];
+            }
+        }
+        Ok(())
+    }
+
+    /// ADC saturations of gyro A and B so far (the pick-offs' for resonator-level gyros).
+    fn saturations(&self) -> [u64; 2] {
+        match self {
+            Gyros::Rate { saturations, .. } | Gyros::Resonator { saturations, .. } => *saturations,
+        }
+    }
+}
+
+/// The signals of the report, in its order.
+const REPORT_SIGNALS: [&str; 4] = [
+    "raw gyro A (no reversal)",
+    "raw gyro B (no reversal)",
+    "calibrated, combined",
+    "filtered (KF output)",
+];
+
+/// Averaging times the report considers, s (those with at least three averages are shown).
+const REPORT_TAUS_S: [f64; 5] = [0.1, 1.0, 10.0, 100.0, 1000.0];
+
+/// The report accumulated sample by sample: per signal the sum of its error against the true
+/// rate and its overlapping ADEV at the report's averaging times.
+struct ReportStream {
+    fs: f64,
+    factors: Vec<(f64, usize)>,
+    errors: [f64; 4],
+    deviations: [OverlappingStream; 4],
+    samples: usize,
+}
+
+impl ReportStream {
+    fn new(fs: f64) -> Self {
+        let factors: Vec<(f64, usize)> = REPORT_TAUS_S
+            .iter()
+            .map(|tau| (*tau, (tau * fs).round() as usize))
+            .filter(|(tau, m)| *m >= 1 && tau * fs >= 1.0)
+            .collect();
+        let ms: Vec<usize> = factors.iter().map(|(_, m)| *m).collect();
+        ReportStream {
+            fs,
+            deviations: std::array::from_fn(|_| OverlappingStream::new(&ms, fs)),
+            factors,
+            errors: [0.0; 4],
+            samples: 0,
+        }
+    }
+
+    /// One sample: the true rate and the four signals, °/s.
+    fn push(&mut self, rate: f64, signals: [f64; 4]) {
+        for ((sum, deviation), signal) in self
+            .errors
+            .iter_mut()
+            .zip(&mut self.deviations)
+            .zip(signals)
+        {
+            let error = signal - rate;
+            *sum += error;
+            deviation.push(error);
+        }
+        self.samples += 1;
+    }
+
+    fn finish(self) -> Report {
+        let shown: Vec<bool> = self
+            .factors
+            .iter()
+            .map(|(_, m)| m * 3 <= self.samples)
+            .collect();
+        let tau_s = self
+            .factors
+            .iter()
+            .zip(&shown)
+            .filter(|(_, s)| **s)
+            .map(|((tau, _), _)| *tau)
+            .collect();
+        let lines = REPORT_SIGNALS
+            .iter()
+            .zip(self.errors)
+            .zip(&self.deviations)
+            .map(|((name, sum), deviation)| ReportLine {
+                signal: name.to_string(),
+                bias_error_dps: sum / self.samples.max(1) as f64,
+                adev_dps: deviation
+                    .deviations()
+                    .into_iter()
+                    .zip(&shown)
+                    .filter(|(_, s)| **s)
+                    .map(|(d, _)| d.map(|(dev, _)| dev))
+                    .collect(),
+            })
+            .collect();
+        let _ = self.fs;
+        Report {
+            samples: self.samples,
+            tau_s,
+            lines,
+        }
     }
 }
 
@@ -494,6 +661,55 @@ mod tests {
         let (done, total) = progress.counts();
         assert!(done <= total && total > 0, "{done} of {total}");
         (job, run)
+    }
+
+    /// Streamed rows give the bytes the kept rows give (one formatter), the entries name
+    /// the files' real SHA-256 and size, a left-out block writes nothing, and without the CSV
+    /// only the hex files are written.
+    #[test]
+    fn streamed_vector_files_equal_the_kept_rows() {
+        let (job, kept) = run_embedded(|config| config.plant.model = "rate".into());
+        let provenance = Provenance {
+            version: "test".into(),
+            command: "test".into(),
+            config_sha256: "0".repeat(64),
+        };
+        let roms = RomImages::new(&job, &provenance);
+        for (csv, selected) in [(true, None), (false, Some(vec!["kf".to_string()]))] {
+            let root = tempfile::tempdir().unwrap();
+            let streaming = Streaming {
+                root: root.path(),
+                csv,
+                blocks: selected.as_deref(),
+                provenance: &provenance,
+            };
+            let streamed = run_streamed(&job, &roms, &Progress::default(), streaming).unwrap();
+            assert_eq!(streamed.samples, kept.samples);
+            for (s, k) in streamed.blocks.iter().zip(&kept.blocks) {
+                assert_eq!((s.name, s.len()), (k.name, k.len()));
+                let wanted = selected
+                    .as_ref()
+                    .is_none_or(|names| names.iter().any(|n| n == s.name));
+                if !wanted {
+                    assert!(s.written().is_empty());
+                    assert!(!root.path().join(s.name).exists(), "{}", s.name);
+                    continue;
+                }
+                let (stimulus, expected) = crate::writers::vector_hex(k, &provenance);
+                let mut want = vec![stimulus, expected];
+                if csv {
+                    want.push(crate::writers::vector_csv(k, &provenance));
+                }
+                assert_eq!(s.written().len(), want.len(), "{}", s.name);
+                for (entry, text) in s.written().iter().zip(&want) {
+                    let bytes = std::fs::read(root.path().join(&entry.path)).unwrap();
+                    assert!(bytes == text.as_bytes(), "{} differs", entry.path);
+                    assert_eq!(entry.bytes, bytes.len());
+                    assert_eq!(entry.sha256, crate::package::sha256_hex(&bytes));
+                }
+            }
+            assert_eq!(streamed.report, kept.report.clone());
+        }
     }
 
     #[test]

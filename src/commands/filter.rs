@@ -40,6 +40,40 @@ pub struct Args {
     strict: bool,
 }
 
+/// Samples the KF runs between two formatting rounds.
+const FILTER_BATCH: usize = 1 << 18;
+
+/// One output row's codes and float reference.
+struct Row {
+    z: i64,
+    rate: i64,
+    reference: f64,
+}
+
+/// The CSV text of `rows`, the first being sample `first`.
+fn format_rows(rows: &[Row], first: usize, plan: &gyrofx_model::kf::Plan) -> Vec<u8> {
+    let (mut integer, mut real) = (itoa::Buffer::new(), ryu::Buffer::new());
+    let mut text = Vec::with_capacity(rows.len() * 80);
+    for (k, row) in rows.iter().enumerate() {
+        text.extend_from_slice(integer.format(first + k).as_bytes());
+        text.push(b',');
+        text.extend_from_slice(real.format(plan.input.to_f64(i128::from(row.z))).as_bytes());
+        text.push(b',');
+        text.extend_from_slice(integer.format(row.z).as_bytes());
+        text.push(b',');
+        text.extend_from_slice(integer.format(row.rate).as_bytes());
+        text.push(b',');
+        text.extend_from_slice(
+            real.format(plan.output.to_f64(i128::from(row.rate)))
+                .as_bytes(),
+        );
+        text.push(b',');
+        text.extend_from_slice(real.format(row.reference).as_bytes());
+        text.push(b'\n');
+    }
+    text
+}
+
 /// Writes the CSV atomically (one row per sample: the input, its code, the fixed-point and the
 /// float rate) and prints a summary with the saturation and overflow counts.
 pub fn run(args: Args) -> Result<ExitCode> {
@@ -99,39 +133,64 @@ pub fn run(args: Args) -> Result<ExitCode> {
     let values = csv.read()?;
     let mut fixed = FixedKf::new(&plan);
     let mut float = FloatKf::new(plan.gains.clone());
-    // Rows are formatted with itoa/ryu (shortest round-trip reals) into a buffered writer:
-    // formatting was half of filter's time with format!.
-    let mut writer = std::io::BufWriter::with_capacity(1 << 20, staged.as_file_mut());
     let write_error = |e: std::io::Error| anyhow::anyhow!("output {}: {e}", output.display());
-    writer
-        .write_all(b"sample,z_dps,z_code,rate_code,rate_dps,float_rate_dps\n")
-        .map_err(write_error)?;
+    // The KF runs in batches; each batch's rows are formatted (itoa/ryu, shortest round-trip
+    // reals: formatting is most of filter's time) on every core, and a writer thread writes
+    // the formatted parts in order while the next batch runs.
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get().min(8));
     let mut saturated = 0u64;
-    let (mut integer, mut real) = (itoa::Buffer::new(), ryu::Buffer::new());
-    let mut row = String::with_capacity(128);
-    for (k, value) in values.iter().enumerate() {
-        let q = from_f64(*value, plan.input, Rounding::Nearest, Overflow::Saturate)?;
-        saturated += u64::from(q.overflowed);
-        let z = q.code as i64;
-        let rate = fixed.step(z, 0);
-        let reference = float.step(*value, 0);
-        row.clear();
-        row.push_str(integer.format(k));
-        row.push(',');
-        row.push_str(real.format(plan.input.to_f64(q.code)));
-        row.push(',');
-        row.push_str(integer.format(z));
-        row.push(',');
-        row.push_str(integer.format(rate));
-        row.push(',');
-        row.push_str(real.format(plan.output.to_f64(i128::from(rate))));
-        row.push(',');
-        row.push_str(real.format(reference));
-        row.push('\n');
-        writer.write_all(row.as_bytes()).map_err(write_error)?;
-    }
-    writer.flush().map_err(write_error)?;
-    drop(writer);
+    let file = staged.as_file_mut();
+    std::thread::scope(|scope| -> Result<()> {
+        let (send, receive) = std::sync::mpsc::sync_channel::<Vec<u8>>(2 * cores);
+        // The parts are large: written as they are, not copied through a buffer.
+        let writer = scope.spawn(move || -> std::io::Result<()> {
+            file.write_all(b"sample,z_dps,z_code,rate_code,rate_dps,float_rate_dps\n")?;
+            for part in receive {
+                file.write_all(&part)?;
+            }
+            file.flush()
+        });
+        let mut rows = Vec::with_capacity(FILTER_BATCH.min(values.len()));
+        for (batch, chunk) in values.chunks(FILTER_BATCH).enumerate() {
+            rows.clear();
+            for value in chunk {
+                let q = from_f64(*value, plan.input, Rounding::Nearest, Overflow::Saturate)?;
+                saturated += u64::from(q.overflowed);
+                let z = q.code as i64;
+                rows.push(Row {
+                    z,
+                    rate: fixed.step(z, 0),
+                    reference: float.step(*value, 0),
+                });
+            }
+            let first = batch * FILTER_BATCH;
+            let part_rows = rows.len().div_ceil(cores).max(1);
+            let parts: Vec<Vec<u8>> = std::thread::scope(|formatters| {
+                let handles: Vec<_> = rows
+                    .chunks(part_rows)
+                    .enumerate()
+                    .map(|(p, part)| {
+                        let plan = &plan;
+                        formatters.spawn(move || format_rows(part, first + p * part_rows, plan))
+                    })
+                    .collect();
+                handles
+                    .into_iter()
+                    .map(|h| h.join().expect("formatting does not panic"))
+                    .collect()
+            });
+            for part in parts {
+                if send.send(part).is_err() {
+                    break; // the writer failed: its error is reported below
+                }
+            }
+        }
+        drop(send);
+        writer
+            .join()
+            .expect("the writer does not panic")
+            .map_err(write_error)
+    })?;
     let o = fixed.overflow_counts();
     let overflows = o.x1 + o.x2 + o.rate_hat;
     if saturated + overflows > 0 {

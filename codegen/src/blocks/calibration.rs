@@ -62,6 +62,10 @@ impl RtlBlock for Calibration {
         block
     }
 
+    fn has_vectors(&self) -> bool {
+        false
+    }
+
     fn vectors<'a>(&self, _job: &'a Job, _block: Block) -> Option<Box<dyn VectorBuilder + 'a>> {
         None
     }

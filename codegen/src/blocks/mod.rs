@@ -55,6 +55,12 @@ pub trait RtlBlock: Sync {
     /// formats, its parameters and the ROM images its DUT reads.
     fn block(&self, job: &Job, roms: &RomImages) -> Block;
 
+    /// Whether the block has vectors and a testbench of its own ([`RtlBlock::vectors`] gives
+    /// a builder): not so for a block tested inside its parent.
+    fn has_vectors(&self) -> bool {
+        true
+    }
+
     /// The builder of its vectors from the chain run, or `None` for a block that has no
     /// testbench of its own (its vectors are its parent's).
     fn vectors<'a>(&self, job: &'a Job, block: Block) -> Option<Box<dyn VectorBuilder + 'a>>;
