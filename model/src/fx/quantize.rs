@@ -246,6 +246,22 @@ pub mod mode {
     pub const CONVERGENT: u8 = 5;
 }
 
+/// The increment of a floor quotient under rounding mode `MODE`, from the dropped bits (any
+/// set; the half bit; any set below it), the sign of the value and the quotient (for its
+/// parity), all 0/1 words.
+macro_rules! mode_increment {
+    ($mode:ident, $any_dropped:expr, $half_bit:expr, $below_half:expr, $negative:expr, $quotient:expr) => {
+        match $mode {
+            mode::FLOOR => 0,
+            mode::CEIL => $any_dropped,
+            mode::ZERO => $any_dropped & $negative,
+            mode::NEAREST => $half_bit,
+            mode::ROUND => $half_bit & ($below_half | (1 - $negative)),
+            _ => $half_bit & ($below_half | ($quotient & 1)),
+        }
+    };
+}
+
 /// One branch-free rounding kernel per word type: `value / 2^shift` rounded with `MODE`.
 macro_rules! round_right_kernel {
     ($(#[$doc:meta])* $name:ident, $word:ty) => {
@@ -258,15 +274,7 @@ macro_rules! round_right_kernel {
             let half_bit = (value >> (shift - 1)) & 1;
             let below_half = <$word>::from(value & (dropped_mask >> 1) != 0);
             let negative = <$word>::from(value < 0);
-            let increment = match MODE {
-                mode::FLOOR => 0,
-                mode::CEIL => any_dropped,
-                mode::ZERO => any_dropped & negative,
-                mode::NEAREST => half_bit,
-                mode::ROUND => half_bit & (below_half | (1 - negative)),
-                _ => half_bit & (below_half | (quotient & 1)),
-            };
-            quotient + increment
+            quotient + mode_increment!(MODE, any_dropped, half_bit, below_half, negative, quotient)
         }
     };
 }
@@ -298,15 +306,7 @@ pub fn round_right_split_i64<const MODE: u8>(aligned: i64, term: i64, shift: u32
     let half_bit = (term >> (shift - 1)) & 1;
     let below_half = i64::from(term & (dropped_mask >> 1) != 0);
     let negative = i64::from(quotient < 0);
-    let increment = match MODE {
-        mode::FLOOR => 0,
-        mode::CEIL => any_dropped,
-        mode::ZERO => any_dropped & negative,
-        mode::NEAREST => half_bit,
-        mode::ROUND => half_bit & (below_half | (1 - negative)),
-        _ => half_bit & (below_half | (quotient & 1)),
-    };
-    quotient + increment
+    quotient + mode_increment!(MODE, any_dropped, half_bit, below_half, negative, quotient)
 }
 
 #[inline(always)]

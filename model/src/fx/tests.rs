@@ -285,6 +285,18 @@ fn quantizer_fast_path_equals_requantize() {
     }
 }
 
+/// Calls `$check::<MODE>(rounding)` for every rounding mode.
+macro_rules! every_mode {
+    ($check:ident) => {
+        $check::<{ mode::FLOOR }>(Rounding::Floor);
+        $check::<{ mode::CEIL }>(Rounding::Ceil);
+        $check::<{ mode::ZERO }>(Rounding::Zero);
+        $check::<{ mode::NEAREST }>(Rounding::Nearest);
+        $check::<{ mode::ROUND }>(Rounding::Round);
+        $check::<{ mode::CONVERGENT }>(Rounding::Convergent);
+    };
+}
+
 /// The 64-bit kernel against [`requantize`]: exhaustively on small values, and on the extremes.
 #[test]
 fn quantizer_i64_path_equals_requantize() {
@@ -326,12 +338,7 @@ fn quantizer_i64_path_equals_requantize() {
             }
         }
     }
-    check::<{ mode::FLOOR }>(Rounding::Floor);
-    check::<{ mode::CEIL }>(Rounding::Ceil);
-    check::<{ mode::ZERO }>(Rounding::Zero);
-    check::<{ mode::NEAREST }>(Rounding::Nearest);
-    check::<{ mode::ROUND }>(Rounding::Round);
-    check::<{ mode::CONVERGENT }>(Rounding::Convergent);
+    every_mode!(check);
 }
 
 /// The split 64-bit kernel (an aligned part plus a term) against [`requantize`] on the sum in
@@ -394,12 +401,7 @@ fn quantizer_split_path_equals_requantize_of_the_sum() {
             }
         }
     }
-    check::<{ mode::FLOOR }>(Rounding::Floor);
-    check::<{ mode::CEIL }>(Rounding::Ceil);
-    check::<{ mode::ZERO }>(Rounding::Zero);
-    check::<{ mode::NEAREST }>(Rounding::Nearest);
-    check::<{ mode::ROUND }>(Rounding::Round);
-    check::<{ mode::CONVERGENT }>(Rounding::Convergent);
+    every_mode!(check);
 }
 
 #[test]

@@ -204,6 +204,45 @@ struct Case {
     samples: Vec<(i64, Event)>,
 }
 
+/// `spec` with up to 2000 error codes over its input range, now and then a preset or a reset
+/// before one.
+fn with_samples(spec: Spec) -> impl Strategy<Value = Case> {
+    let (lo, hi) = (spec.input.min_code() as i64, spec.input.max_code() as i64);
+    let event = prop_oneof![
+        40 => Just(Event::None),
+        1 => any::<i64>().prop_map(|c| Event::Preset(c >> 20)),
+        1 => Just(Event::Reset),
+    ];
+    let samples = prop::collection::vec((lo..=hi, event), 1..2000);
+    (Just(spec), samples).prop_map(|(spec, samples)| Case { spec, samples })
+}
+
+/// `fast.step` against `reference.step_reference` over `samples` (presets and resets applied
+/// to both): the same outputs, integrators and counts.
+fn paths_agree(
+    fast: &mut FixedPi,
+    reference: &mut FixedPi,
+    samples: &[(i64, Event)],
+) -> Result<(), TestCaseError> {
+    for (k, (e, event)) in samples.iter().enumerate() {
+        match event {
+            Event::Preset(code) => {
+                fast.preset(*code);
+                reference.preset(*code);
+            }
+            Event::Reset => {
+                fast.reset();
+                reference.reset();
+            }
+            Event::None => {}
+        }
+        prop_assert_eq!(fast.step(*e), reference.step_reference(*e), "sample {}", k);
+        prop_assert_eq!(fast.integrator(), reference.integrator());
+    }
+    prop_assert_eq!(fast.overflow_counts(), reference.overflow_counts());
+    Ok(())
+}
+
 fn any_case() -> impl Strategy<Value = Case> {
     (
         (6u32..=28, 0i32..=28),         // input width, frac
@@ -252,14 +291,7 @@ fn any_case() -> impl Strategy<Value = Case> {
                     rounding,
                     overflow: Overflow::Saturate,
                 };
-                let (lo, hi) = (input.min_code() as i64, input.max_code() as i64);
-                let event = prop_oneof![
-                    40 => Just(Event::None),
-                    1 => any::<i64>().prop_map(|c| Event::Preset(c >> 20)),
-                    1 => Just(Event::Reset),
-                ];
-                let samples = prop::collection::vec((lo..=hi, event), 1..2000);
-                (Just(spec), samples).prop_map(|(spec, samples)| Case { spec, samples })
+                with_samples(spec)
             },
         )
 }
@@ -306,23 +338,7 @@ proptest! {
         }
         let Ok(plan) = Plan::new(&spec) else { return Ok(()) };
         let mut fast = FixedPi::new(&plan);
-        let mut reference = FixedPi::new(&plan);
-        for (k, (e, event)) in case.samples.iter().enumerate() {
-            match event {
-                Event::Preset(code) => {
-                    fast.preset(*code);
-                    reference.preset(*code);
-                }
-                Event::Reset => {
-                    fast.reset();
-                    reference.reset();
-                }
-                Event::None => {}
-            }
-            prop_assert_eq!(fast.step(*e), reference.step_reference(*e), "sample {}", k);
-            prop_assert_eq!(fast.integrator(), reference.integrator());
-        }
-        prop_assert_eq!(fast.overflow_counts(), reference.overflow_counts());
+        paths_agree(&mut fast, &mut FixedPi::new(&plan), &case.samples)?;
         let e: Vec<i64> = case.samples.iter().map(|s| s.0).collect();
         let mut block = vec![0; e.len()];
         FixedPi::new(&plan).process(&e, &mut block);
@@ -374,14 +390,7 @@ fn wide_update_case() -> impl Strategy<Value = Case> {
                         Overflow::Saturate
                     },
                 };
-                let (lo, hi) = (input.min_code() as i64, input.max_code() as i64);
-                let event = prop_oneof![
-                    40 => Just(Event::None),
-                    1 => any::<i64>().prop_map(|c| Event::Preset(c >> 20)),
-                    1 => Just(Event::Reset),
-                ];
-                let samples = prop::collection::vec((lo..=hi, event), 1..2000);
-                (Just(spec), samples).prop_map(|(spec, samples)| Case { spec, samples })
+                with_samples(spec)
             },
         )
 }
@@ -395,23 +404,7 @@ proptest! {
         let Ok(plan) = Plan::new(&case.spec) else { return Ok(()) };
         let mut fast = FixedPi::new(&plan);
         prop_assume!(matches!(fast.fast, Some((_, Path::SplitUpdate))));
-        let mut reference = FixedPi::new(&plan);
-        for (k, (e, event)) in case.samples.iter().enumerate() {
-            match event {
-                Event::Preset(code) => {
-                    fast.preset(*code);
-                    reference.preset(*code);
-                }
-                Event::Reset => {
-                    fast.reset();
-                    reference.reset();
-                }
-                Event::None => {}
-            }
-            prop_assert_eq!(fast.step(*e), reference.step_reference(*e), "sample {}", k);
-            prop_assert_eq!(fast.integrator(), reference.integrator());
-        }
-        prop_assert_eq!(fast.overflow_counts(), reference.overflow_counts());
+        paths_agree(&mut fast, &mut FixedPi::new(&plan), &case.samples)?;
     }
 }
 
