@@ -322,6 +322,30 @@ pub fn noise_type(rate: &[f64], m: usize) -> Option<i32> {
     }
 }
 
+/// [`noise_type`] at each of `octaves` (0 where it has too few averages), the octaves shared
+/// out over the cores (each is a pass over the record): `(octave, α)` in their order.
+fn noise_types(rate: &[f64], octaves: &[usize]) -> Vec<(usize, i32)> {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get().min(8));
+    let alpha = |m: usize| (m, noise_type(rate, m).unwrap_or(0));
+    if cores == 1 || octaves.len() < 2 {
+        return octaves.iter().map(|m| alpha(*m)).collect();
+    }
+    let mut found: Vec<(usize, i32)> = std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..cores)
+            .map(|c| {
+                let mine: Vec<usize> = octaves.iter().copied().skip(c).step_by(cores).collect();
+                scope.spawn(move || mine.into_iter().map(alpha).collect::<Vec<_>>())
+            })
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().expect("noise typing does not panic"))
+            .collect()
+    });
+    found.sort_unstable_by_key(|(m, _)| octaves.iter().position(|o| o == m));
+    found
+}
+
 /// Equivalent degrees of freedom of the overlapping ADEV with `points` phase points at
 /// averaging factor `m` for noise type `alpha` (NIST SP 1065 Table 5).
 pub fn edf_overlapping(points: usize, m: usize, alpha: i32) -> f64 {
@@ -503,21 +527,25 @@ pub fn curve_reporting(
         values.extend(deviations(kind, &x, chunk, rate_hz));
         progress(values.len(), factors.len());
     }
-    let mut alphas: Vec<(usize, i32)> = Vec::new();
+    let octave_of = |m: usize| 1usize << (usize::BITS - 1 - m.leading_zeros());
+    let mut octaves: Vec<usize> = factors
+        .iter()
+        .zip(&values)
+        .filter(|(_, value)| value.is_some())
+        .map(|(m, _)| octave_of(*m))
+        .collect();
+    octaves.dedup();
+    let alphas = noise_types(rate, &octaves);
     factors
         .iter()
         .zip(values)
         .filter_map(|(m, value)| {
             let (dev, terms) = value?;
-            let octave = 1usize << (usize::BITS - 1 - m.leading_zeros());
-            let alpha = match alphas.iter().find(|(o, _)| *o == octave) {
-                Some((_, a)) => *a,
-                None => {
-                    let a = noise_type(rate, octave).unwrap_or(0);
-                    alphas.push((octave, a));
-                    a
-                }
-            };
+            let octave = octave_of(*m);
+            let alpha = alphas
+                .iter()
+                .find(|(o, _)| *o == octave)
+                .map_or(0, |(_, a)| *a);
             let edf = edf::edf(kind.estimator(), alpha, *m, x.len()).unwrap_or(1.0);
             let (lo, hi) = confidence_interval(dev, edf, ONE_SIGMA);
             Some(Point {

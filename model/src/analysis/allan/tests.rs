@@ -212,3 +212,27 @@ fn the_reported_curve_is_the_curve() {
     assert_eq!(reports.len(), total.div_ceil(FACTORS_PER_CHUNK));
     assert_eq!(reports.last(), Some(&(total, total)));
 }
+
+/// Every point carries the noise type of its octave, typed on the cores in any order: on a
+/// record whose type changes with τ (white plus a random walk), against one octave at a time.
+#[test]
+fn each_point_has_its_octaves_noise_type() {
+    let mut white = crate::stimulus::Gaussian::new(5, crate::stimulus::Stream::AngleRandomWalk(0));
+    let mut walk = crate::stimulus::Gaussian::new(5, crate::stimulus::Stream::RateRandomWalk(0));
+    let mut level = 0.0;
+    let rate: Vec<f64> = (0..200_000)
+        .map(|_| {
+            level += 0.003 * walk.sample();
+            white.sample() + level
+        })
+        .collect();
+    for grid in [Grid::Octave, Grid::Many] {
+        let points = curve(Kind::Overlapping, &rate, 100.0, grid);
+        let alphas: std::collections::BTreeSet<i32> = points.iter().map(|p| p.alpha).collect();
+        assert!(alphas.len() >= 2, "{alphas:?}");
+        for p in &points {
+            let octave = 1usize << (usize::BITS - 1 - p.m.leading_zeros());
+            assert_eq!(p.alpha, noise_type(&rate, octave).unwrap_or(0), "m {}", p.m);
+        }
+    }
+}
