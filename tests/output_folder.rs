@@ -240,6 +240,47 @@ fn interrupt(signal: &str) -> Option<i32> {
     code
 }
 
+/// The output folder is checked again when the run ends: a file a user put into the old
+/// package while `generate` ran is kept, the new package is not moved in (exit 1), and the
+/// staging folder is gone.
+#[test]
+fn a_package_changed_during_the_run_is_not_replaced() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = write_config(dir.path(), "rate.toml", "[plant]\nmodel = \"rate\"\n");
+    let out = dir.path().join("pkg");
+    assert!(generate(dir.path(), &out, &[]).status.success());
+    let child = Command::new(env!("CARGO_BIN_EXE_gyrofx"))
+        .args(["generate", "--config", &config, "--samples", "400", "--out"])
+        .arg(&out)
+        .env("GYROFX_TEST_HOLD_STAGING_MS", "3000")
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while !leftovers(dir.path())
+        .iter()
+        .any(|n| n.starts_with(".gyrofx-staging-"))
+    {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "no staging folder appeared"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    let before = hashes(&out);
+    let output = child.wait_with_output().unwrap();
+    assert_eq!(output.status.code(), Some(1));
+    assert!(text(&output).contains("notes.txt"), "{}", text(&output));
+    assert_eq!(hashes(&out), before, "the user's folder is untouched");
+    assert!(
+        leftovers(dir.path()).is_empty(),
+        "{:?}",
+        leftovers(dir.path())
+    );
+}
+
 #[test]
 fn sigint_and_sigterm_remove_the_staging_folder() {
     assert_eq!(interrupt("-INT"), Some(130));

@@ -135,12 +135,17 @@ fn parse_part(
         skipped: 0,
         stop: None,
     };
-    for (offset, line) in lines(bytes).enumerate() {
-        let text = match classify(line) {
-            Line::Skip => continue,
+    // Most parts hold no quote, no `\r`, no byte 0xEF (a BOM's first) and are valid UTF-8:
+    // checked once for the whole part (memchr and the ASCII fast path), not per line.
+    let clean = (!bytes.contains(&b'"') && !bytes.contains(&b'\r') && !bytes.contains(&0xef))
+        .then(|| std::str::from_utf8(bytes).ok())
+        .flatten();
+    let mut take = |offset: usize, line: Line| -> bool {
+        let text = match line {
+            Line::Skip => return true,
             Line::Foreign => {
                 part.stop = Some(Stop::Foreign);
-                return part;
+                return false;
             }
             Line::Text(text) => text,
         };
@@ -148,14 +153,37 @@ fn parse_part(
         // A line of empty cells is skipped, as the CSV crate skips it (checked only when the
         // cell read is empty: most lines are not).
         if cell.is_empty() && text.split(',').all(|cell| cell.trim().is_empty()) {
-            continue;
+            return true;
         }
         match cell_value(cell, first_line + offset as u64, column, gaps, bad) {
             Ok(Some(value)) => part.values.push(value),
             Ok(None) => part.skipped += 1,
             Err(e) => {
                 part.stop = Some(Stop::Bad(e));
-                return part;
+                return false;
+            }
+        }
+        true
+    };
+    match clean {
+        Some(text) => {
+            for (offset, line) in text.split_inclusive('\n').enumerate() {
+                let line = line.strip_suffix('\n').unwrap_or(line);
+                let line = if line.is_empty() || line.starts_with('#') {
+                    Line::Skip
+                } else {
+                    Line::Text(line)
+                };
+                if !take(offset, line) {
+                    break;
+                }
+            }
+        }
+        None => {
+            for (offset, line) in lines(bytes).enumerate() {
+                if !take(offset, classify(line)) {
+                    break;
+                }
             }
         }
     }

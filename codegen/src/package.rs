@@ -177,6 +177,8 @@ pub struct Staging {
     path: PathBuf,
     out: PathBuf,
     parent: PathBuf,
+    kind: Kind,
+    replace: Replace,
     committed: bool,
 }
 
@@ -208,6 +210,8 @@ impl Staging {
             path,
             out: out.to_path_buf(),
             parent,
+            kind,
+            replace,
             committed: false,
         })
     }
@@ -218,10 +222,11 @@ impl Staging {
     }
 
     /// Renames the staging folder to the output folder (a previous one moved aside first and
-    /// removed after).
+    /// removed after), once the output folder has been checked again.
     ///
     /// # Errors
-    /// [`Error::Output`] when the rename fails (the staging folder is removed).
+    /// [`Error::Output`] when the output folder may no longer be replaced or the rename fails
+    /// (the staging folder is removed).
     pub fn commit(mut self) -> Result<()> {
         if let Some(hold) = std::env::var("GYROFX_TEST_HOLD_STAGING_MS")
             .ok()
@@ -236,6 +241,8 @@ impl Staging {
                 std::io::Error::from(std::io::ErrorKind::Interrupted),
             ));
         }
+        // Checked again: the output folder may have changed during a long run.
+        output_folder::check(&self.out, self.kind, self.replace)?;
         let result = Self::move_into_place(&self.path, &self.out, &self.parent);
         self.committed = result.is_ok();
         result
