@@ -60,6 +60,21 @@ fn leftovers(dir: &Path) -> Vec<String> {
         .collect()
 }
 
+/// Waits (at most a minute) until a staging folder exists in `dir`.
+fn wait_for_staging(dir: &Path) {
+    let start = Instant::now();
+    while !leftovers(dir)
+        .iter()
+        .any(|n| n.starts_with(".gyrofx-staging-"))
+    {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "no staging folder appeared"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
 #[test]
 fn a_package_is_replaced_only_when_it_holds_nothing_but_its_own_unchanged_files() {
     let dir = tempfile::tempdir().unwrap();
@@ -214,17 +229,7 @@ fn interrupt(signal: &str) -> Option<i32> {
         .stderr(std::process::Stdio::null())
         .spawn()
         .unwrap();
-    let start = Instant::now();
-    while !leftovers(dir.path())
-        .iter()
-        .any(|n| n.starts_with(".gyrofx-staging-"))
-    {
-        assert!(
-            start.elapsed() < Duration::from_secs(60),
-            "no staging folder appeared"
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    wait_for_staging(dir.path());
     let status = Command::new("kill")
         .args([signal, &child.id().to_string()])
         .status()
@@ -257,17 +262,7 @@ fn a_package_changed_during_the_run_is_not_replaced() {
         .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap();
-    let start = Instant::now();
-    while !leftovers(dir.path())
-        .iter()
-        .any(|n| n.starts_with(".gyrofx-staging-"))
-    {
-        assert!(
-            start.elapsed() < Duration::from_secs(60),
-            "no staging folder appeared"
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    wait_for_staging(dir.path());
     std::fs::write(out.join("notes.txt"), "mine").unwrap();
     let before = hashes(&out);
     let output = child.wait_with_output().unwrap();

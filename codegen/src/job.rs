@@ -201,11 +201,14 @@ pub enum RateSource {
 }
 
 impl RateSource {
-    /// The true rate at sample `k`, °/s (0 beyond a recorded column's end).
+    /// The true rate at sample `k`, °/s.
+    ///
+    /// # Panics
+    /// Beyond a recorded column's end ([`Job::rate_source`] reads at least the run's samples).
     pub fn at(&self, k: usize) -> f64 {
         match self {
             RateSource::Synthetic { scenario, period_s } => scenario.rate_at(k as f64 * period_s),
-            RateSource::Recorded(values) => values.get(k).copied().unwrap_or(0.0),
+            RateSource::Recorded(values) => values[k],
         }
     }
 }

@@ -193,12 +193,7 @@ impl HashedFile {
         self.writer.flush().map_err(|e| Error::io(&self.path, e))?;
         Ok(FileEntry {
             path: self.relative,
-            sha256: self
-                .hasher
-                .finalize()
-                .iter()
-                .map(|b| format!("{b:02x}"))
-                .collect(),
+            sha256: crate::package::digest_hex(&self.hasher.finalize()),
             bytes: self.bytes,
         })
     }

@@ -278,7 +278,7 @@ fn run_with(
 
     // The gyros as the sequencer drives them, and the same gyros without reversal (same
     // noise streams) for the report, simulated a batch ahead of the chain.
-    let mut gyros = Gyros::new(job, rate.at(0))?;
+    let mut gyros = Gyros::new(job, if n > 0 { rate.at(0) } else { 0.0 })?;
     let mut sequencer = Sequencer::new(&est.schedule);
     let mut fixed = FixedChain::new(plan);
     let mut float = FloatChain::quantized(plan);
@@ -301,7 +301,7 @@ fn run_with(
             batch.modes.push([slot.mode_a, slot.mode_b]);
             batch.rates.push(rate.at(k));
         }
-        gyros.simulate(&mut batch, progress)?;
+        gyros.simulate(&mut batch, progress);
         for (i, k) in (first..last).enumerate() {
             if k % PROGRESS_STEP == PROGRESS_STEP - 1 {
                 progress.advance(PROGRESS_STEP as u64);
@@ -407,7 +407,6 @@ enum Gyros {
         reversed: Box<[FixedClosedLoop; 2]>,
         normal: Box<[FixedClosedLoop; 2]>,
         scale: f64,
-        saturations: [u64; 2],
     },
 }
 
@@ -460,14 +459,13 @@ impl Gyros {
                     reversed,
                     normal,
                     scale: libm::ldexp(1.0, input.frac),
-                    saturations: [0; 2],
                 }
             }
         })
     }
 
     /// Fills `batch.codes` and `batch.raw` for its rates and modes.
-    fn simulate(&mut self, batch: &mut GyroBatch, progress: &Progress) -> Result<()> {
+    fn simulate(&mut self, batch: &mut GyroBatch, progress: &Progress) {
         let len = batch.rates.len();
         batch.codes.clear();
         batch.raw.clear();
@@ -496,7 +494,6 @@ impl Gyros {
                 reversed,
                 normal,
                 scale,
-                saturations,
             } => {
                 let scale = *scale;
                 let (rates, modes) = (&batch.rates, &batch.modes);
@@ -529,19 +526,17 @@ impl Gyros {
                     batch.codes.push([code_a, code_b]);
                     batch.raw.push([raw_a, raw_b]);
                 }
-                *saturations = [
-                    reversed[0].resonator.adc_saturations(),
-                    reversed[1].resonator.adc_saturations(),
-                ];
             }
         }
-        Ok(())
     }
 
     /// ADC saturations of gyro A and B so far (the pick-offs' for resonator-level gyros).
     fn saturations(&self) -> [u64; 2] {
         match self {
-            Gyros::Rate { saturations, .. } | Gyros::Resonator { saturations, .. } => *saturations,
+            Gyros::Rate { saturations, .. } => *saturations,
+            Gyros::Resonator { reversed, .. } => reversed
+                .each_ref()
+                .map(|gyro| gyro.resonator.adc_saturations()),
         }
     }
 }
@@ -560,7 +555,6 @@ const REPORT_TAUS_S: [f64; 5] = [0.1, 1.0, 10.0, 100.0, 1000.0];
 /// The report accumulated sample by sample: per signal the sum of its error against the true
 /// rate and its overlapping ADEV at the report's averaging times.
 struct ReportStream {
-    fs: f64,
     factors: Vec<(f64, usize)>,
     errors: [f64; 4],
     deviations: [OverlappingStream; 4],
@@ -576,7 +570,6 @@ impl ReportStream {
             .collect();
         let ms: Vec<usize> = factors.iter().map(|(_, m)| *m).collect();
         ReportStream {
-            fs,
             deviations: std::array::from_fn(|_| OverlappingStream::new(&ms, fs)),
             factors,
             errors: [0.0; 4],
@@ -628,7 +621,6 @@ impl ReportStream {
                     .collect(),
             })
             .collect();
-        let _ = self.fs;
         Report {
             samples: self.samples,
             tau_s,
@@ -708,7 +700,7 @@ mod tests {
                     assert_eq!(entry.sha256, crate::package::sha256_hex(&bytes));
                 }
             }
-            assert_eq!(streamed.report, kept.report.clone());
+            assert_eq!(streamed.report, kept.report);
         }
     }
 
