@@ -4,6 +4,8 @@ use std::path::Path;
 
 use crate::error::{Error, Result};
 
+mod decimal;
+
 /// Reads the column `column` (by header name) of the CSV file at `path` as f64 values.
 ///
 /// The first row that is not a `#` comment is the header. Blank lines are skipped, so every
@@ -108,10 +110,12 @@ fn lines(bytes: &[u8]) -> impl Iterator<Item = &[u8]> {
     bytes.split_inclusive(|b| *b == b'\n')
 }
 
-/// One part of a block, parsed: its values and gaps, or where it stopped.
+/// One part of a block, parsed (its values went to the vector it was given): its gaps, its
+/// lines, and where it stopped.
 struct Part {
-    values: Vec<f64>,
     skipped: usize,
+    /// Lines gone through: all of the part's unless it stopped.
+    lines: u64,
     /// A foreign line (hand the file to the CSV reader) or a bad cell, whichever came first.
     stop: Option<Stop>,
 }
@@ -121,7 +125,8 @@ enum Stop {
     Bad(Error),
 }
 
-/// Parses the data lines of `bytes`, the first being line `first_line` of the file.
+/// Parses the data lines of `bytes`, the first being line `first_line` of the file, pushing
+/// their values onto `values`.
 fn parse_part(
     bytes: &[u8],
     first_line: u64,
@@ -129,10 +134,11 @@ fn parse_part(
     column: &str,
     gaps: bool,
     bad: &(dyn Fn(String) -> Error + Sync),
+    values: &mut Vec<f64>,
 ) -> Part {
     let mut part = Part {
-        values: Vec::with_capacity(bytes.len() / 8),
         skipped: 0,
+        lines: 0,
         stop: None,
     };
     // Most parts hold no quote, no `\r`, no byte 0xEF (a BOM's first) and are valid UTF-8:
@@ -140,7 +146,7 @@ fn parse_part(
     let clean = (!bytes.contains(&b'"') && !bytes.contains(&b'\r') && !bytes.contains(&0xef))
         .then(|| std::str::from_utf8(bytes).ok())
         .flatten();
-    let mut take = |offset: usize, line: Line| -> bool {
+    let take = |part: &mut Part, values: &mut Vec<f64>, offset: usize, line: Line| -> bool {
         let text = match line {
             Line::Skip => return true,
             Line::Foreign => {
@@ -156,7 +162,7 @@ fn parse_part(
             return true;
         }
         match cell_value(cell, first_line + offset as u64, column, gaps, bad) {
-            Ok(Some(value)) => part.values.push(value),
+            Ok(Some(value)) => values.push(value),
             Ok(None) => part.skipped += 1,
             Err(e) => {
                 part.stop = Some(Stop::Bad(e));
@@ -167,27 +173,84 @@ fn parse_part(
     };
     match clean {
         Some(text) => {
-            for (offset, line) in text.split_inclusive('\n').enumerate() {
-                let line = line.strip_suffix('\n').unwrap_or(line);
+            let bytes = text.as_bytes();
+            let mut start = 0;
+            let mut offset = 0;
+            while start < bytes.len() {
+                // The usual line, a plain decimal in the cell: parsed where it stands, in
+                // one pass that also finds the line's end.
+                let cell = if index == 0 {
+                    Some(start)
+                } else {
+                    cell_start(bytes, start, index)
+                };
+                if let Some((value, end)) = cell.and_then(|cell| {
+                    let (value, used) = decimal::parse_prefix(&bytes[cell..])?;
+                    Some((value, cell + used))
+                }) {
+                    match bytes.get(end) {
+                        None | Some(b'\n') => {
+                            values.push(value);
+                            start = end + 1;
+                            offset += 1;
+                            continue;
+                        }
+                        Some(b',') => {
+                            values.push(value);
+                            start = memchr::memchr(b'\n', &bytes[end..])
+                                .map_or(bytes.len(), |p| end + p + 1);
+                            offset += 1;
+                            continue;
+                        }
+                        _ => {}
+                    }
+                }
+                // Anything else (a comment, spaces, a gap, a bad cell) as the general path
+                // takes it.
+                let end = memchr::memchr(b'\n', &bytes[start..]).map_or(bytes.len(), |p| start + p);
+                let line = &text[start..end];
                 let line = if line.is_empty() || line.starts_with('#') {
                     Line::Skip
                 } else {
                     Line::Text(line)
                 };
-                if !take(offset, line) {
+                if !take(&mut part, values, offset, line) {
                     break;
                 }
+                start = end + 1;
+                offset += 1;
             }
+            part.lines = offset as u64;
         }
         None => {
             for (offset, line) in lines(bytes).enumerate() {
-                if !take(offset, classify(line)) {
+                if !take(&mut part, values, offset, classify(line)) {
                     break;
                 }
+                part.lines = offset as u64 + 1;
             }
         }
     }
     part
+}
+
+/// Where cell `index` (> 0) of the line starting at `start` begins: after its `index`-th
+/// comma, or `None` when the line ends first.
+fn cell_start(bytes: &[u8], start: usize, index: usize) -> Option<usize> {
+    let mut commas = 0;
+    for (i, b) in bytes[start..].iter().enumerate() {
+        match b {
+            b'\n' => return None,
+            b',' => {
+                commas += 1;
+                if commas == index {
+                    return Some(start + i + 1);
+                }
+            }
+            _ => {}
+        }
+    }
+    None
 }
 
 /// The common case without the CSV crate: unquoted cells, `\n` or `\r\n` line ends, no
@@ -201,135 +264,187 @@ fn read_plain(path: &Path, column: &str, gaps: bool) -> Result<Option<(Vec<f64>,
 
 /// [`read_plain`] with blocks of `block_size` bytes (tests cut files everywhere with small
 /// ones).
+///
+/// A reader thread reads the next block while the current one is parsed. Each block is cut
+/// into one part per core at line ends; the first part's values go straight onto the result,
+/// the others' through a buffer each that is kept from block to block. A part does not know
+/// its first line number until the parts before it are counted: when one stops at a bad
+/// cell, it is parsed again with its line number so the error names the file's line.
 fn read_plain_in_blocks(
     path: &Path,
     column: &str,
     gaps: bool,
     block_size: usize,
 ) -> Result<Option<(Vec<f64>, usize)>> {
-    use std::io::Read;
     let bad = |message: String| Error::Input {
         path: path.to_path_buf(),
         message,
     };
-    let mut file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get().min(8));
-    let mut block: Vec<u8> = Vec::with_capacity(block_size + (1 << 16));
+    let (full, blocks) = std::sync::mpsc::sync_channel::<std::io::Result<Vec<u8>>>(1);
+    let (empty, spare) = std::sync::mpsc::channel::<Vec<u8>>();
+    std::thread::scope(|scope| {
+        scope.spawn(move || read_blocks(file, block_size.max(1), &full, &spare));
+        let mut line_number = 0u64; // lines before the block
+        let mut index: Option<usize> = None;
+        let mut values = Vec::new();
+        let mut buffers: Vec<Vec<f64>> = vec![Vec::new(); cores.saturating_sub(1)];
+        let mut skipped = 0;
+        for block in blocks {
+            let block = block.map_err(|e| Error::io(path, e))?;
+            let mut rest = &block[..];
+            // The header: the first line that is neither blank nor a comment.
+            while index.is_none() {
+                let Some(line) = lines(rest).next() else {
+                    break;
+                };
+                rest = &rest[line.len()..];
+                line_number += 1;
+                match classify(line) {
+                    Line::Skip => {}
+                    Line::Foreign => return Ok(None),
+                    Line::Text(text) => {
+                        let header: Vec<&str> = text.split(',').map(str::trim).collect();
+                        if header.iter().all(|h| h.is_empty()) {
+                            return Ok(None);
+                        }
+                        index = Some(
+                            header
+                                .iter()
+                                .position(|h| *h == column)
+                                .ok_or_else(|| bad(no_column(column, &header)))?,
+                        );
+                    }
+                }
+            }
+            let Some(index) = index else {
+                let _ = empty.send(block);
+                continue;
+            };
+            let parts = cut_at_lines(rest, cores);
+            let bad = &bad;
+            let (first, others) = parts
+                .split_first()
+                .map_or((&[][..], &[][..]), |(f, o)| (*f, o));
+            let parsed: Vec<Part> = std::thread::scope(|scope| {
+                let handles: Vec<_> = others
+                    .iter()
+                    .zip(buffers.iter_mut())
+                    .map(|(part, buffer)| {
+                        buffer.clear();
+                        scope.spawn(move || parse_part(part, 0, index, column, gaps, bad, buffer))
+                    })
+                    .collect();
+                let mut parsed = vec![parse_part(first, 0, index, column, gaps, bad, &mut values)];
+                parsed.extend(
+                    handles
+                        .into_iter()
+                        .map(|h| h.join().expect("parsing does not panic")),
+                );
+                parsed
+            });
+            for (number, part) in parsed.into_iter().enumerate() {
+                if number > 0 {
+                    values.extend_from_slice(&buffers[number - 1]);
+                }
+                skipped += part.skipped;
+                match part.stop {
+                    None => line_number += part.lines,
+                    Some(Stop::Foreign) => return Ok(None),
+                    Some(Stop::Bad(_)) => {
+                        // Again, knowing its first line, for the error's line number.
+                        let text = if number == 0 {
+                            first
+                        } else {
+                            others[number - 1]
+                        };
+                        let again = parse_part(
+                            text,
+                            line_number + 1,
+                            index,
+                            column,
+                            gaps,
+                            bad,
+                            &mut Vec::new(),
+                        );
+                        return Err(match again.stop {
+                            Some(Stop::Bad(e)) => e,
+                            _ => unreachable!("a part parses the same twice"),
+                        });
+                    }
+                }
+            }
+            let _ = empty.send(block);
+        }
+        if index.is_none() {
+            return Ok(None);
+        }
+        if values.is_empty() {
+            return Err(bad("the file has a header but no samples".into()));
+        }
+        Ok(Some((values, skipped)))
+    })
+}
+
+/// Reads `file` in blocks of about `block_size` bytes that end at a line end (the last may
+/// not), sending each on `full`; a block sent back on `spare` is reused. Stops at the end of
+/// the file, at a read error (sent), or when the receiver is gone.
+fn read_blocks(
+    mut file: std::fs::File,
+    block_size: usize,
+    full: &std::sync::mpsc::SyncSender<std::io::Result<Vec<u8>>>,
+    spare: &std::sync::mpsc::Receiver<Vec<u8>>,
+) {
+    use std::io::Read;
     let mut carry: Vec<u8> = Vec::new();
-    let mut line_number = 0u64; // lines before the block
-    let mut index: Option<usize> = None;
-    let mut values = Vec::new();
-    let mut skipped = 0;
-    let mut eof = false;
-    while !eof {
+    loop {
+        let mut block = spare.try_recv().unwrap_or_default();
         block.clear();
         block.append(&mut carry);
-        let start = block.len();
-        block.resize(start + block_size.max(1), 0);
-        let mut filled = start;
-        while filled < block.len() {
-            let read = file
-                .read(&mut block[filled..])
-                .map_err(|e| Error::io(path, e))?;
-            if read == 0 {
-                eof = true;
-                break;
+        // Into the block's spare capacity, not zeroed first; fewer bytes than asked for is
+        // the end of the file (`read_to_end` reads until the limit or the end).
+        block.reserve(block_size);
+        let eof = match (&mut file).take(block_size as u64).read_to_end(&mut block) {
+            Ok(read) => read < block_size,
+            Err(e) => {
+                let _ = full.send(Err(e));
+                return;
             }
-            filled += read;
-        }
-        block.truncate(filled);
-        // Whole lines only; the rest waits for the next block.
-        let cut = if eof {
-            block.len()
-        } else {
+        };
+        if !eof {
+            // Whole lines only; the rest waits for the next block.
             match block.iter().rposition(|b| *b == b'\n') {
-                Some(p) => p + 1,
+                Some(p) => carry.extend_from_slice(&block[p + 1..]),
                 None => {
-                    carry = std::mem::take(&mut block);
+                    carry = block;
                     continue;
                 }
             }
+            block.truncate(block.len() - carry.len());
+        }
+        if (!block.is_empty() && full.send(Ok(block)).is_err()) || eof {
+            return;
+        }
+    }
+}
+
+/// `bytes` cut into at most `parts` pieces of about equal length, each ending at a line end
+/// (the last may not).
+fn cut_at_lines(mut bytes: &[u8], parts: usize) -> Vec<&[u8]> {
+    let target = bytes.len().div_ceil(parts.max(1)).max(1);
+    let mut out = Vec::with_capacity(parts);
+    while !bytes.is_empty() {
+        let end = if bytes.len() <= target {
+            bytes.len()
+        } else {
+            memchr::memchr(b'\n', &bytes[target..]).map_or(bytes.len(), |p| target + p + 1)
         };
-        carry.extend_from_slice(&block[cut..]);
-        let mut rest = &block[..cut];
-        // The header: the first line that is neither blank nor a comment.
-        while index.is_none() {
-            let Some(line) = lines(rest).next() else {
-                break;
-            };
-            rest = &rest[line.len()..];
-            line_number += 1;
-            match classify(line) {
-                Line::Skip => {}
-                Line::Foreign => return Ok(None),
-                Line::Text(text) => {
-                    let header: Vec<&str> = text.split(',').map(str::trim).collect();
-                    if header.iter().all(|h| h.is_empty()) {
-                        return Ok(None);
-                    }
-                    index = Some(
-                        header
-                            .iter()
-                            .position(|h| *h == column)
-                            .ok_or_else(|| bad(no_column(column, &header)))?,
-                    );
-                }
-            }
-        }
-        let Some(index) = index else {
-            continue;
-        };
-        // Parts cut at line ends, each with the number of its first line.
-        let mut parts = Vec::with_capacity(cores);
-        let mut first_line = line_number + 1;
-        let target = rest.len().div_ceil(cores).max(1);
-        while !rest.is_empty() {
-            let end = if rest.len() <= target {
-                rest.len()
-            } else {
-                rest[target..]
-                    .iter()
-                    .position(|b| *b == b'\n')
-                    .map_or(rest.len(), |p| target + p + 1)
-            };
-            let (part, tail) = rest.split_at(end);
-            let count = part.iter().filter(|b| **b == b'\n').count() as u64
-                + u64::from(!part.ends_with(b"\n"));
-            parts.push((part, first_line));
-            first_line += count;
-            rest = tail;
-        }
-        line_number = first_line - 1;
-        let bad = &bad;
-        let parsed: Vec<Part> = std::thread::scope(|scope| {
-            let handles: Vec<_> = parts
-                .iter()
-                .map(|(part, first)| {
-                    scope.spawn(move || parse_part(part, *first, index, column, gaps, bad))
-                })
-                .collect();
-            handles
-                .into_iter()
-                .map(|h| h.join().expect("parsing does not panic"))
-                .collect()
-        });
-        for part in parsed {
-            values.extend_from_slice(&part.values);
-            skipped += part.skipped;
-            match part.stop {
-                None => {}
-                Some(Stop::Foreign) => return Ok(None),
-                Some(Stop::Bad(e)) => return Err(e),
-            }
-        }
+        let (part, tail) = bytes.split_at(end);
+        out.push(part);
+        bytes = tail;
     }
-    if index.is_none() {
-        return Ok(None);
-    }
-    if values.is_empty() {
-        return Err(bad("the file has a header but no samples".into()));
-    }
-    Ok(Some((values, skipped)))
+    out
 }
 
 /// Any CSV the `csv` crate reads (quoted cells and all).
@@ -529,12 +644,18 @@ mod tests {
             Just("7, 8.25 \r\n".to_string()),
             (-1e6f64..1e6).prop_map(|v| format!("9,{v}\n")),
             (-1e6f64..1e6).prop_map(|v| format!("10,{v:e},extra\n")),
+            // Beyond the fast decimal path (more than 19 digits, large exponents) or on it.
+            any::<f64>()
+                .prop_filter("finite", |v| v.is_finite())
+                .prop_map(|v| format!("{v},{v:e}\n")),
+            (-1e3f64..1e3).prop_map(|v| format!("{v:.3},{v:.6}\n")),
         ];
         let header = prop_oneof![
             Just("t,rate_dps\n"),
             Just(" t , rate_dps \r\n"),
             Just("# generated\nt,rate_dps\n"),
             Just("t,other\n"),
+            Just("rate_dps,t\n"),
             Just(""),
         ];
         proptest!(ProptestConfig::with_cases(300), |(

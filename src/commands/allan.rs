@@ -107,10 +107,22 @@ pub fn run(args: Args) -> Result<ExitCode> {
                 (values.len() as f64).powi(2) / 4.0
             );
         }
+        // Welch with the largest power-of-two segment up to N/8, at most 2048 (half of the
+        // clamp's 4096: the power of two at or above the clamped length, halved), on its own
+        // thread beside the curve.
+        let segment = (values.len() / 8).clamp(8, 4096).next_power_of_two() / 2;
         let bar = super::progress::bar(1, &format!("allan: {}", path.display()), quiet);
-        let points = allan::curve_reporting(kind, &values, rate, grid, &mut |done, total| {
-            bar.set_length(total as u64);
-            bar.set_position(done as u64);
+        let (points, density) = std::thread::scope(|scope| {
+            let density = scope.spawn(|| {
+                (segment >= 8)
+                    .then(|| gyrofx_model::analysis::spectrum::welch(&values, rate, segment.max(8)))
+                    .and_then(|psd| psd.median_density(rate / 50.0, rate / 5.0))
+            });
+            let points = allan::curve_reporting(kind, &values, rate, grid, &mut |done, total| {
+                bar.set_length(total as u64);
+                bar.set_position(done as u64);
+            });
+            (points, density.join().expect("the spectrum does not panic"))
         });
         bar.finish_and_clear();
         let terms = noise::fit(&points, kind);
@@ -121,12 +133,6 @@ pub fn run(args: Args) -> Result<ExitCode> {
             path.display().to_string()
         };
         curves.push((label, points.clone(), terms));
-        // Welch with the largest power-of-two segment up to N/8, at most 2048 (half of the
-        // clamp's 4096: the power of two at or above the clamped length, halved).
-        let segment = (values.len() / 8).clamp(8, 4096).next_power_of_two() / 2;
-        let density = (segment >= 8)
-            .then(|| gyrofx_model::analysis::spectrum::welch(&values, rate, segment.max(8)))
-            .and_then(|psd| psd.median_density(rate / 50.0, rate / 5.0));
         if json {
             results.push(serde_json::json!({
                 "input": path.display().to_string(),

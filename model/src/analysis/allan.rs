@@ -290,60 +290,133 @@ pub fn deviation(kind: Kind, x: &[f64], m: usize, rate_hz: f64) -> Option<(f64, 
 /// Noise type at averaging factor `m` by the lag-1 autocorrelation of the m-averaged rate:
 /// the power-law exponent α (2, 1, 0, −1, −2), or `None` with fewer than 32 averages.
 pub fn noise_type(rate: &[f64], m: usize) -> Option<i32> {
-    let averages: Vec<f64> = rate
-        .chunks_exact(m.max(1))
-        .map(|c| c.iter().sum::<f64>() / c.len() as f64)
-        .collect();
-    if averages.len() < 32 {
-        return None;
-    }
-    let mut z = averages;
-    let mut d = 0;
-    loop {
-        let mean = z.iter().sum::<f64>() / z.len() as f64;
-        let denominator: f64 = z.iter().map(|v| (v - mean) * (v - mean)).sum();
-        let numerator: f64 = z.windows(2).map(|w| (w[0] - mean) * (w[1] - mean)).sum();
-        let r1 = if denominator > 0.0 {
-            numerator / denominator
-        } else {
-            0.0
-        };
-        let rho = r1 / (1.0 + r1);
-        if rho < 0.25 || d >= 2 {
-            let alpha = -2.0 * (rho + d as f64);
-            return Some((alpha.round() as i32).clamp(-2, 2));
-        }
-        // Differenced in place: the same values without another record-sized allocation.
-        for i in 0..z.len() - 1 {
-            z[i] = z[i + 1] - z[i];
-        }
-        z.pop();
-        d += 1;
+    let m = m.max(1);
+    let mut scratch = Vec::new();
+    if m == 1 {
+        type_of_averages(rate, &mut scratch)
+    } else {
+        let averages: Vec<f64> = rate
+            .chunks_exact(m)
+            .map(|c| c.iter().sum::<f64>() / m as f64)
+            .collect();
+        type_of_averages(&averages, &mut scratch)
     }
 }
 
-/// [`noise_type`] at each of `octaves` (0 where it has too few averages), the octaves shared
-/// out over the cores (each is a pass over the record): `(octave, α)` in their order.
-fn noise_types(rate: &[f64], octaves: &[usize]) -> Vec<(usize, i32)> {
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get().min(8));
-    let alpha = |m: usize| (m, noise_type(rate, m).unwrap_or(0));
-    if cores == 1 || octaves.len() < 2 {
-        return octaves.iter().map(|m| alpha(*m)).collect();
+/// The noise type of a series of averages: from the lag-1 autocorrelation `r1` of the series
+/// differenced `d` times, the first `d` (at most 2) where `ρ = r1/(1+r1) < 0.25` gives
+/// `α = −2(ρ + d)`, rounded (Riley and Greenhall's lag-1 method). `scratch` holds the
+/// differences when they are needed.
+fn type_of_averages(averages: &[f64], scratch: &mut Vec<f64>) -> Option<i32> {
+    if averages.len() < 32 {
+        return None;
     }
-    let mut found: Vec<(usize, i32)> = std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..cores)
-            .map(|c| {
-                let mine: Vec<usize> = octaves.iter().copied().skip(c).step_by(cores).collect();
-                scope.spawn(move || mine.into_iter().map(alpha).collect::<Vec<_>>())
-            })
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| h.join().expect("noise typing does not panic"))
-            .collect()
-    });
-    found.sort_unstable_by_key(|(m, _)| octaves.iter().position(|o| o == m));
-    found
+    // α for the series differenced `d` times, or `None` to difference once more.
+    let alpha = |r1: f64, d: usize| {
+        let rho = r1 / (1.0 + r1);
+        (rho < 0.25 || d >= 2).then(|| ((-2.0 * (rho + d as f64)).round() as i32).clamp(-2, 2))
+    };
+    if let Some(a) = alpha(lag_one_autocorrelation(averages), 0) {
+        return Some(a);
+    }
+    scratch.clear();
+    scratch.extend(averages.windows(2).map(|w| w[1] - w[0]));
+    if let Some(a) = alpha(lag_one_autocorrelation(scratch), 1) {
+        return Some(a);
+    }
+    for i in 0..scratch.len() - 1 {
+        scratch[i] = scratch[i + 1] - scratch[i];
+    }
+    scratch.pop();
+    alpha(lag_one_autocorrelation(scratch), 2)
+}
+
+/// Sum of `values` in four interleaved partial sums, which the compiler keeps in one vector
+/// register (a single running sum would wait on every addition).
+fn sum4(values: &[f64]) -> f64 {
+    let mut partial = [0.0f64; 4];
+    let chunks = values.chunks_exact(4);
+    let tail: f64 = chunks.remainder().iter().sum();
+    for chunk in chunks {
+        for k in 0..4 {
+            partial[k] += chunk[k];
+        }
+    }
+    (partial[0] + partial[1]) + (partial[2] + partial[3]) + tail
+}
+
+/// Lag-1 autocorrelation of `z` about its mean (0 for a constant series): one pass for the
+/// mean, one for the squares and the lagged products, each in four partial sums.
+fn lag_one_autocorrelation(z: &[f64]) -> f64 {
+    let n = z.len();
+    let mean = sum4(z) / n as f64;
+    let mut squares = [0.0f64; 4];
+    let mut products = [0.0f64; 4];
+    let (head, next) = (&z[..n - 1], &z[1..]);
+    let pairs = head.chunks_exact(4).zip(next.chunks_exact(4));
+    for (a, b) in pairs {
+        for k in 0..4 {
+            let centred = a[k] - mean;
+            squares[k] += centred * centred;
+            products[k] += centred * (b[k] - mean);
+        }
+    }
+    let done = (n - 1) / 4 * 4;
+    let mut square_tail = 0.0;
+    let mut product_tail = 0.0;
+    for i in done..n - 1 {
+        let centred = z[i] - mean;
+        square_tail += centred * centred;
+        product_tail += centred * (z[i + 1] - mean);
+    }
+    let last = z[n - 1] - mean;
+    square_tail += last * last;
+    let denominator = (squares[0] + squares[1]) + (squares[2] + squares[3]) + square_tail;
+    let numerator = (products[0] + products[1]) + (products[2] + products[3]) + product_tail;
+    if denominator > 0.0 {
+        numerator / denominator
+    } else {
+        0.0
+    }
+}
+
+/// [`noise_type`] at each of `octaves` (powers of two, ascending; 0 where there are fewer than
+/// 32 averages): `(octave, α)` in their order. The averages of each octave are the pairwise
+/// means of the previous octave's (the same means as [`noise_type`]'s up to rounding), so the
+/// whole pyramid costs one pass over the record and is kept one level at a time.
+fn noise_types(rate: &[f64], octaves: &[usize]) -> Vec<(usize, i32)> {
+    let mut scratch = Vec::new();
+    let mut level: Vec<f64> = Vec::new();
+    let mut m = 1usize;
+    let mut types = Vec::with_capacity(octaves.len());
+    for &octave in octaves {
+        if !octave.is_power_of_two() || octave < m {
+            types.push((octave, noise_type(rate, octave).unwrap_or(0)));
+            continue;
+        }
+        while m < octave {
+            if m == 1 {
+                level = rate
+                    .chunks_exact(2)
+                    .map(|pair| (pair[0] + pair[1]) * 0.5)
+                    .collect();
+            } else {
+                // In place: entry i reads entries 2i and 2i + 1, not yet overwritten.
+                let halves = level.len() / 2;
+                for i in 0..halves {
+                    level[i] = (level[2 * i] + level[2 * i + 1]) * 0.5;
+                }
+                level.truncate(halves);
+            }
+            m *= 2;
+        }
+        let averages: &[f64] = if m == 1 { rate } else { &level };
+        types.push((
+            octave,
+            type_of_averages(averages, &mut scratch).unwrap_or(0),
+        ));
+    }
+    types
 }
 
 /// Equivalent degrees of freedom of the overlapping ADEV with `points` phase points at
@@ -471,7 +544,8 @@ pub fn deviations(
             _ => ms.iter().map(|m| deviation(kind, x, *m, rate_hz)).collect(),
         }
     };
-    if factors.len() < 64 {
+    // Two threads once the passes outweigh a thread's start (a factor is a pass over x).
+    if factors.len() < 2 || factors.len() * x.len() < 1 << 20 {
         return compute(factors);
     }
     // Interleaved halves balance the work (large m have fewer terms).
@@ -522,20 +596,20 @@ pub fn curve_reporting(
 ) -> Vec<Point> {
     let x = phase(rate);
     let factors = factors(kind, grid, x.len());
-    let mut values = Vec::with_capacity(factors.len());
-    for chunk in factors.chunks(FACTORS_PER_CHUNK) {
-        values.extend(deviations(kind, &x, chunk, rate_hz));
-        progress(values.len(), factors.len());
-    }
     let octave_of = |m: usize| 1usize << (usize::BITS - 1 - m.leading_zeros());
-    let mut octaves: Vec<usize> = factors
-        .iter()
-        .zip(&values)
-        .filter(|(_, value)| value.is_some())
-        .map(|(m, _)| octave_of(*m))
-        .collect();
+    // The noise types need only the rate: found beside the deviations (an octave without a
+    // deviation is typed but not used).
+    let mut octaves: Vec<usize> = factors.iter().map(|m| octave_of(*m)).collect();
     octaves.dedup();
-    let alphas = noise_types(rate, &octaves);
+    let (values, alphas) = std::thread::scope(|scope| {
+        let alphas = scope.spawn(|| noise_types(rate, &octaves));
+        let mut values = Vec::with_capacity(factors.len());
+        for chunk in factors.chunks(FACTORS_PER_CHUNK) {
+            values.extend(deviations(kind, &x, chunk, rate_hz));
+            progress(values.len(), factors.len());
+        }
+        (values, alphas.join().expect("noise typing does not panic"))
+    });
     factors
         .iter()
         .zip(values)

@@ -144,6 +144,95 @@ fn noise_types_are_identified() {
     assert_eq!(noise_type(&white_pm, 1), Some(2));
 }
 
+/// The lag-1 method as written out plainly: averages collected, each difference stored, every
+/// sum its own pass.
+fn plain_lag_one(rate: &[f64], m: usize, d: usize) -> (Vec<f64>, f64) {
+    let mut z: Vec<f64> = rate
+        .chunks_exact(m)
+        .map(|c| c.iter().sum::<f64>() / c.len() as f64)
+        .collect();
+    let averages = z.clone();
+    for _ in 0..d {
+        z = z.windows(2).map(|w| w[1] - w[0]).collect();
+    }
+    let mean = z.iter().sum::<f64>() / z.len() as f64;
+    let denominator: f64 = z.iter().map(|v| (v - mean) * (v - mean)).sum();
+    let numerator: f64 = z.windows(2).map(|w| (w[0] - mean) * (w[1] - mean)).sum();
+    let r1 = if denominator > 0.0 {
+        numerator / denominator
+    } else {
+        0.0
+    };
+    (averages, r1)
+}
+
+#[test]
+fn the_fast_lag_one_method_agrees_with_the_plain_one() {
+    use proptest::prelude::*;
+    let values = prop_oneof![
+        4 => -1e3f64..1e3,
+        1 => Just(0.0f64),
+        1 => any::<i16>().prop_map(f64::from),
+    ];
+    proptest!(ProptestConfig::with_cases(300), |(
+        white in proptest::collection::vec(values, 32..3000),
+        m in 1usize..40,
+        integrate in 0usize..3,
+    )| {
+        // White, random-walk or twice-integrated records: each difference order is taken.
+        let mut rate = white;
+        for _ in 0..integrate {
+            let mut sum = 0.0;
+            rate = rate.iter().map(|v| { sum += v; sum }).collect();
+        }
+        prop_assume!(rate.len() / m >= 3);
+        for d in 0..=2usize {
+            let (averages, want) = plain_lag_one(&rate, m, d);
+            let mut z = averages;
+            for _ in 0..d {
+                z = z.windows(2).map(|w| w[1] - w[0]).collect();
+            }
+            let got = lag_one_autocorrelation(&z);
+            prop_assert!((got - want).abs() <= 1e-9 * (1.0 + want.abs()), "m {} d {}: {} vs {}", m, d, got, want);
+        }
+    });
+}
+
+#[test]
+fn the_octave_pyramid_types_each_octave_as_its_plain_averages_do() {
+    use crate::stimulus::{Gaussian, Stream};
+    let mut g = Gaussian::new(9, Stream::AngleRandomWalk(0));
+    let white: Vec<f64> = (0..50_000).map(|_| g.sample()).collect();
+    let mut sum = 0.0;
+    let walk: Vec<f64> = white
+        .iter()
+        .map(|v| {
+            sum += v;
+            sum
+        })
+        .collect();
+    let white_pm: Vec<f64> = white.windows(2).map(|w| w[1] - w[0]).collect();
+    // A mix whose type changes across the octaves (white at short τ, walk at long).
+    let mix: Vec<f64> = white
+        .iter()
+        .zip(&walk)
+        .map(|(w, r)| 30.0 * w + 0.05 * r)
+        .collect();
+    let octaves: Vec<usize> = (0..12).map(|k| 1 << k).collect();
+    let mut seen = std::collections::BTreeSet::new();
+    for rate in [&white, &walk, &white_pm, &mix] {
+        for (octave, alpha) in noise_types(rate, &octaves) {
+            assert_eq!(
+                alpha,
+                noise_type(rate, octave).unwrap_or(0),
+                "octave {octave}"
+            );
+            seen.insert(alpha);
+        }
+    }
+    assert!(seen.len() >= 3, "the records cover several types: {seen:?}");
+}
+
 #[test]
 fn confidence_intervals_cover_the_truth_about_68_percent_of_the_time() {
     use crate::stimulus::{Gaussian, Stream};
