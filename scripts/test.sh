@@ -4,10 +4,11 @@
 #   scripts/test.sh
 #
 # Installs the simulators and synthesis tool with apt-get where missing (iverilog, verilator,
-# ghdl, yosys, make, and the DejaVu font the plots use) and FuseSoC with pip in a virtualenv:
+# ghdl, yosys, make, and the DejaVu font the plots use), FuseSoC with pip in a virtualenv, and
+# maturin, numpy and pytest in another (for the Python package in python/):
 # a missing simulator is a failure, never a skipped test. Then: rustfmt,
 # clippy, Verilator lint of the RTL, and the whole test suite (unit, property, end-to-end
-# with both simulators, golden vectors). Benchmarks are compiled (clippy --all-targets) but
+# with both simulators, golden vectors), then the Python package's wheel and pytest suite. Benchmarks are compiled (clippy --all-targets) but
 # not run: run them with `cargo bench`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -84,3 +85,19 @@ ghdl -a --std=08 -Werror -Wunused -Wbinding -Wbody -Wspecs --workdir="$ghdl_work
 rm -rf "$ghdl_work"
 echo "== cargo test"
 cargo test --workspace
+
+# The Python package (python/): pyo3 + numpy, built by maturin as an abi3 wheel into a
+# virtualenv from PyPI (reused across runs), then its pytest suite against the CLI's vectors.
+echo "== python: cargo fmt, clippy, maturin wheel, pytest"
+python_venv="${XDG_CACHE_HOME:-$HOME/.cache}/gyrofx/python-venv"
+if [ ! -x "$python_venv/bin/maturin" ] || ! "$python_venv/bin/python" -c "import numpy, pytest" >/dev/null 2>&1; then
+    echo "== installing maturin, numpy, pytest into $python_venv"
+    python3 -m venv "$python_venv"
+    "$python_venv/bin/pip" install -q "maturin>=1.5,<2" numpy pytest
+fi
+cargo fmt --manifest-path python/Cargo.toml -- --check
+cargo clippy --manifest-path python/Cargo.toml --all-targets --quiet -- -D warnings
+rm -rf python/target/wheels
+"$python_venv/bin/maturin" build --release --quiet -m python/Cargo.toml --out python/target/wheels
+"$python_venv/bin/pip" install -q --force-reinstall --no-deps python/target/wheels/gyrofx-*.whl
+GYROFX_CLI="$PWD/target/debug/gyrofx" "$python_venv/bin/python" -m pytest -q python/tests

@@ -1,0 +1,183 @@
+"""Type stubs of gyrofx's compiled model (see the module docstring and python/README.md).
+
+Codes are two's-complement integers of the named port's format (``s24.14``: signed, 24-bit
+word, 14 fraction bits; real value = code · 2^-14); flags are 0/1; a mode is 1 normal, 0
+reverse. Real values are °/s. Every refused input raises ``GyrofxError``.
+"""
+
+from os import PathLike
+from typing import Dict, Optional, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+Codes = npt.NDArray[np.int64]
+Reals = npt.NDArray[np.float64]
+BandwidthSelect = Union[int, npt.ArrayLike]
+
+class GyrofxError(ValueError):
+    """A refused config, format or argument; the message is the CLI's."""
+
+def quantize(
+    values: npt.ArrayLike, fmt: str, rounding: str = "nearest", overflow: str = "saturate"
+) -> Codes:
+    """Real values to codes of ``fmt``. rounding: floor, ceil, zero, nearest (ties up),
+    round (ties away from zero), convergent (ties to even); overflow: saturate or wrap."""
+
+def to_real(codes: npt.ArrayLike, fmt: str) -> Reals:
+    """Codes of ``fmt`` to real values (code · 2^-frac); codes outside ``fmt`` are refused."""
+
+class Plan:
+    """A resolved config: every block's formats, ROMs and designs, as ``gyrofx generate``
+    resolves them."""
+
+    @staticmethod
+    def default() -> Plan: ...
+    @staticmethod
+    def preset(name: str) -> Plan:
+        """gu2019, xue2015 or mpu6050 over the default."""
+    @staticmethod
+    def from_toml(text: str, origin: str = "<toml text>") -> Plan:
+        """A (partial) config over the default; ``origin`` names it in errors."""
+    @staticmethod
+    def from_file(path: Union[str, PathLike[str]], preset: Optional[str] = None) -> Plan: ...
+    @staticmethod
+    def from_package(folder: Union[str, PathLike[str]]) -> Plan:
+        """The config a generated package was made from (its manifest.json)."""
+    def toml(self) -> str:
+        """The whole resolved config (every key)."""
+    @property
+    def fs_hz(self) -> float: ...
+    @property
+    def bandwidths_hz(self) -> list[float]:
+        """KF bandwidths, Hz, in ROM order (``bw_sel`` indexes them)."""
+    def formats(self) -> Dict[str, str]:
+        """Every quantization point's format by ``block.signal``, e.g. ``"kf.input": "s24.14"``."""
+    def kf(self) -> Kf: ...
+    def kf_float(self, ideal: bool = False) -> KfFloat: ...
+    def sequencer(self) -> Sequencer: ...
+    def estimator(self) -> Estimator: ...
+    def estimator_float(self, ideal: bool = False) -> EstimatorFloat: ...
+    def mean_filter(self) -> MeanFilter: ...
+    def mean_filter_float(self) -> MeanFilterFloat: ...
+    def chain(self) -> Chain: ...
+    def chain_float(self, ideal: bool = False) -> ChainFloat: ...
+
+class Kf:
+    """The bit-accurate steady-state KF (gyrofx_kf); rate_out follows z by one clock in the RTL."""
+
+    input_format: str
+    output_format: str
+    latency_clocks: int
+    def reset(self) -> None: ...
+    def step(self, z: int, bw_sel: int = 0) -> int:
+        """One step: ``z`` (input-format code) -> ``rate_out`` (output-format code)."""
+    def process(self, z: npt.ArrayLike, bw_sel: BandwidthSelect = 0) -> Codes: ...
+    def state(self) -> Tuple[int, int]:
+        """``(x1, x2)`` as state-format codes."""
+    def error_bound_lsb(self, samples: int, switches: int = 0) -> float:
+        """Derived bound on |fixed - float twin| in output LSB after ``samples`` steps."""
+
+class KfFloat:
+    """The KF's float twin, °/s."""
+
+    def reset(self) -> None: ...
+    def step(self, z: float, bw_sel: int = 0) -> float: ...
+    def process(self, z: npt.ArrayLike, bw_sel: BandwidthSelect = 0) -> Reals: ...
+
+class Sequencer:
+    """The mode-reversal sequencer (gyrofx_sequencer): combinational slot outputs per clock."""
+
+    def reset(self) -> None: ...
+    def step(self) -> Dict[str, int]:
+        """mode_a, mode_b, blank_a, blank_b, interval_a, interval_b, done_a, done_b,
+        window_done of this clock; then advances."""
+    def process(self, samples: int) -> Dict[str, Codes]: ...
+
+class Estimator:
+    """The least-squares bias estimator (gyrofx_bias_estimator)."""
+
+    input_format: str
+    bias_format: str
+    def reset(self) -> None: ...
+    def step(
+        self,
+        y_a: int,
+        y_b: int,
+        blank_a: int,
+        blank_b: int,
+        done_a: int,
+        done_b: int,
+        interval_a: int,
+        interval_b: int,
+        window_done: int,
+    ) -> Tuple[int, int, int]:
+        """``(bias_a, bias_b, estimated)`` after the clock."""
+    def process(
+        self,
+        y_a: npt.ArrayLike,
+        y_b: npt.ArrayLike,
+        blank_a: npt.ArrayLike,
+        blank_b: npt.ArrayLike,
+        done_a: npt.ArrayLike,
+        done_b: npt.ArrayLike,
+        interval_a: npt.ArrayLike,
+        interval_b: npt.ArrayLike,
+        window_done: npt.ArrayLike,
+    ) -> Dict[str, Codes]: ...
+
+class EstimatorFloat:
+    """The estimator's float twin, °/s."""
+
+    def reset(self) -> None: ...
+    def step(
+        self,
+        y_a: float,
+        y_b: float,
+        blank_a: int,
+        blank_b: int,
+        done_a: int,
+        done_b: int,
+        interval_a: int,
+        interval_b: int,
+        window_done: int,
+    ) -> Tuple[float, float]: ...
+
+class MeanFilter:
+    """The mean filter with gross-error rejection (gyrofx_mean_filter)."""
+
+    window: int
+    input_format: str
+    output_format: str
+    def reset(self) -> None: ...
+    def step(self, x: int) -> Optional[Tuple[int, int]]:
+        """``(y, kept)`` on a block's last sample (y_valid), else None."""
+    def process(self, x: npt.ArrayLike) -> Dict[str, Codes]:
+        """y_valid, y, kept per input sample (y and kept 0 where y_valid is 0)."""
+
+class MeanFilterFloat:
+    """The mean filter's float twin, °/s."""
+
+    def reset(self) -> None: ...
+    def step(self, x: float) -> Optional[Tuple[float, int]]: ...
+
+class Chain:
+    """The whole chain (gyrofx_top): sequencer, estimator, calibration and KF."""
+
+    def reset(self) -> None: ...
+    def next_modes(self) -> Tuple[int, int]:
+        """The modes the next step runs in (what a plant needs first)."""
+    def step(self, y_a: int, y_b: int, bw_sel: int = 0) -> Dict[str, int]:
+        """mode_a, mode_b, out_valid, rate_out, bias_a, bias_b, estimated."""
+    def process(
+        self, y_a: npt.ArrayLike, y_b: npt.ArrayLike, bw_sel: BandwidthSelect = 0
+    ) -> Dict[str, Codes]: ...
+
+class ChainFloat:
+    """The chain's float twin, °/s."""
+
+    def reset(self) -> None: ...
+    def step(self, y_a: float, y_b: float, bw_sel: int = 0) -> Dict[str, Optional[float]]:
+        """out_valid, rate (None when the KF did not step), bias_a, bias_b."""

@@ -1,0 +1,203 @@
+//! [`Plan`]: a config resolved into every block's formats, ROMs and designs, as `generate`
+//! resolves it; the blocks are built from it.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use gyrofx_codegen::config::Config;
+use gyrofx_codegen::job::Job;
+
+use crate::blocks::{
+    Chain, ChainFloat, Estimator, EstimatorFloat, Kf, KfFloat, MeanFilter, MeanFilterFloat,
+    Sequencer,
+};
+use crate::refused;
+
+/// A resolved gyrofx config: the embedded default overlaid by a preset, a TOML text or a file,
+/// checked as the CLI checks it, with every block's plan.
+#[pyclass(module = "gyrofx", frozen)]
+pub(crate) struct Plan {
+    pub(crate) job: Arc<Job>,
+}
+
+impl Plan {
+    fn resolve(config: gyrofx_codegen::error::Result<Config>) -> PyResult<Plan> {
+        let job = config.and_then(Job::new).map_err(refused)?;
+        Ok(Plan { job: Arc::new(job) })
+    }
+}
+
+#[pymethods]
+impl Plan {
+    /// The embedded default config (`gyrofx init` prints it).
+    #[staticmethod]
+    fn default() -> PyResult<Plan> {
+        Plan::resolve(Ok(Config::embedded()))
+    }
+
+    /// A named preset (gu2019, xue2015, mpu6050) over the default.
+    #[staticmethod]
+    fn preset(name: &str) -> PyResult<Plan> {
+        Plan::resolve(Config::from_preset_and_file(Some(name), None))
+    }
+
+    /// A (partial) config in TOML over the default; `origin` names it in errors.
+    #[staticmethod]
+    #[pyo3(signature = (text, origin = "<toml text>"))]
+    fn from_toml(text: &str, origin: &str) -> PyResult<Plan> {
+        Plan::resolve(Config::from_toml(text, origin))
+    }
+
+    /// A config file over the default (optionally over a preset), as `--config` and `--preset`.
+    #[staticmethod]
+    #[pyo3(signature = (path, preset = None))]
+    fn from_file(path: PathBuf, preset: Option<&str>) -> PyResult<Plan> {
+        Plan::resolve(Config::from_preset_and_file(preset, Some(&path)))
+    }
+
+    /// The config a `gyrofx generate` package was made from (its `manifest.json`), so the
+    /// blocks built here reproduce that package's vectors.
+    #[staticmethod]
+    fn from_package(folder: PathBuf) -> PyResult<Plan> {
+        let path = folder.join("manifest.json");
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| refused(format!("{}: cannot read: {e}", path.display())))?;
+        let manifest: serde_json::Value = serde_json::from_str(&text)
+            .map_err(|e| refused(format!("{}: not JSON: {e}", path.display())))?;
+        if manifest.get("tool").and_then(|t| t.as_str()) != Some("gyrofx") {
+            return Err(refused(format!(
+                "{}: not a gyrofx package manifest (no \"tool\": \"gyrofx\")",
+                path.display()
+            )));
+        }
+        let config = manifest
+            .get("config")
+            .cloned()
+            .ok_or_else(|| refused(format!("{}: has no \"config\"", path.display())))?;
+        let config: Config = serde_json::from_value(config)
+            .map_err(|e| refused(format!("{}: its config: {e}", path.display())))?;
+        Plan::resolve(Ok(config))
+    }
+
+    /// The whole resolved config as TOML (every key present).
+    fn toml(&self) -> String {
+        self.job.config.to_toml()
+    }
+
+    /// The chain's sample rate, Hz.
+    #[getter]
+    fn fs_hz(&self) -> f64 {
+        self.job.config.stimulus.fs_hz
+    }
+
+    /// The KF's bandwidths, Hz, in ROM order (`bw_sel` indexes them).
+    #[getter]
+    fn bandwidths_hz(&self) -> Vec<f64> {
+        self.job.settings.kf.bandwidths_hz.clone()
+    }
+
+    /// Every quantization point's format, by `block.signal` (`"kf.input": "s18.14"`, ...).
+    fn formats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let dict = PyDict::new(py);
+        for (name, format) in formats(&self.job) {
+            dict.set_item(name, format)?;
+        }
+        Ok(dict)
+    }
+
+    /// The bit-accurate KF (`gyrofx_kf`).
+    fn kf(&self) -> Kf {
+        Kf::new(self.job.kf())
+    }
+
+    /// The KF's float twin: with the quantized gains (`ideal=False`, the fixed KF's arithmetic
+    /// without rounding) or the designed ones (`ideal=True`).
+    #[pyo3(signature = (ideal = false))]
+    fn kf_float(&self, ideal: bool) -> KfFloat {
+        KfFloat::new(self.job.kf(), ideal)
+    }
+
+    /// The mode-reversal sequencer (`gyrofx_sequencer`).
+    fn sequencer(&self) -> Sequencer {
+        Sequencer::new(&self.job.chain.estimator.schedule)
+    }
+
+    /// The bit-accurate bias estimator (`gyrofx_bias_estimator`).
+    fn estimator(&self) -> Estimator {
+        Estimator::new(&self.job.chain.estimator)
+    }
+
+    /// The estimator's float twin (quantized or designed gains).
+    #[pyo3(signature = (ideal = false))]
+    fn estimator_float(&self, ideal: bool) -> EstimatorFloat {
+        EstimatorFloat::new(&self.job.chain.estimator, ideal)
+    }
+
+    /// The bit-accurate mean filter with gross-error rejection (`gyrofx_mean_filter`).
+    fn mean_filter(&self) -> MeanFilter {
+        MeanFilter::new(&self.job.mean_filter)
+    }
+
+    /// The mean filter's float twin.
+    fn mean_filter_float(&self) -> MeanFilterFloat {
+        MeanFilterFloat::new(&self.job.mean_filter)
+    }
+
+    /// The whole chain: sequencer, estimator, calibration and KF (`gyrofx_top`).
+    fn chain(&self) -> Chain {
+        Chain::new(&self.job.chain)
+    }
+
+    /// The chain's float twin (quantized or designed coefficients).
+    #[pyo3(signature = (ideal = false))]
+    fn chain_float(&self, ideal: bool) -> ChainFloat {
+        ChainFloat::new(&self.job.chain, ideal)
+    }
+
+    fn __repr__(&self) -> String {
+        let kf = self.job.kf();
+        format!(
+            "gyrofx.Plan(fs_hz={}, bandwidths_hz={:?}, kf {} -> {})",
+            self.job.config.stimulus.fs_hz, self.job.settings.kf.bandwidths_hz, kf.input, kf.output
+        )
+    }
+}
+
+/// The formats of every block's quantization points, in a fixed order.
+fn formats(job: &Job) -> Vec<(String, String)> {
+    let kf = job.kf();
+    let estimator = &job.chain.estimator;
+    let mean = &job.mean_filter;
+    let out: Vec<(&str, gyrofx_model::fx::Format)> = vec![
+        ("kf.input", kf.input),
+        ("kf.state", kf.state),
+        ("kf.output", kf.output),
+        ("kf.g1", kf.coefficient[0]),
+        ("kf.g2", kf.coefficient[1]),
+        ("kf.error", kf.error),
+        ("kf.product_g1", kf.product[0]),
+        ("kf.product_g2", kf.product[1]),
+        ("kf.sum_x1", kf.sum[0]),
+        ("kf.sum_x2", kf.sum[1]),
+        ("estimator.input", estimator.input),
+        ("estimator.accumulator", estimator.accumulator),
+        ("estimator.reciprocal", estimator.reciprocal),
+        ("estimator.mean", estimator.mean),
+        ("estimator.gain", estimator.gain),
+        ("estimator.dot", estimator.dot),
+        ("estimator.bias", estimator.bias),
+        ("estimator.calibrated", estimator.calibrated),
+        ("mean_filter.input", mean.input),
+        ("mean_filter.output", mean.output),
+        ("mean_filter.sum", mean.sum),
+        ("mean_filter.deviation", mean.deviation),
+        ("mean_filter.reciprocal", mean.reciprocal),
+        ("mean_filter.product", mean.product),
+    ];
+    out.into_iter()
+        .map(|(name, format)| (name.to_string(), format.to_string()))
+        .collect()
+}

@@ -1,0 +1,266 @@
+"""The Python model against the Rust CLI's vectors, the derived error bound and exact arithmetic.
+
+Nothing here is compared with numbers copied from the code under test: the expected values come
+from the vectors `gyrofx generate` writes (and the repository's golden vectors), from Python's
+own exact rational arithmetic, or from the CLI's own error messages.
+"""
+
+import fractions
+import math
+import pathlib
+
+import numpy as np
+import pytest
+
+import gyrofx
+from conftest import REPOSITORY, read_vectors, run_cli
+
+
+def replay_kf(kf, rows):
+    """Steps `kf` through KF vector rows; returns how many outputs were compared."""
+    compared = 0
+    for row in rows:
+        if row["rst"] == "1":
+            kf.reset()
+            continue
+        got = kf.step(int(row["z"]), int(row["bw_sel"]))
+        assert row["out_valid"] == "1", row
+        assert got == int(row["rate_out"]), f"sample {row['sample']}: {got} != {row['rate_out']}"
+        compared += 1
+    return compared
+
+
+def leading_run(rows):
+    """The rows before the first reset (the record `process` replays without one)."""
+    run = []
+    for row in rows:
+        if row["rst"] == "1":
+            break
+        run.append(row)
+    return run
+
+
+def test_the_kf_reproduces_the_repositorys_golden_vectors():
+    rows = read_vectors(REPOSITORY / "vectors" / "kf" / "kf_vectors.csv")
+    plan = gyrofx.Plan.from_package(REPOSITORY / "vectors")
+    assert replay_kf(plan.kf(), rows) > 1000
+
+
+def test_the_kf_reproduces_a_fresh_package(package):
+    rows = read_vectors(package / "kf" / "kf_vectors.csv")
+    assert replay_kf(gyrofx.Plan.from_package(package).kf(), rows) > 1000
+
+
+def test_a_flipped_expected_bit_is_caught(package):
+    rows = read_vectors(package / "kf" / "kf_vectors.csv")
+    victim = next(i for i, r in enumerate(rows) if r["rst"] == "0" and int(r["rate_out"]) != 0)
+    rows[victim] = dict(rows[victim], rate_out=str(int(rows[victim]["rate_out"]) ^ 1))
+    with pytest.raises(AssertionError):
+        replay_kf(gyrofx.Plan.default().kf(), rows)
+
+
+def test_the_sequencer_reproduces_its_vectors(package):
+    sequencer = gyrofx.Plan.from_package(package).sequencer()
+    ports = ["mode_a", "mode_b", "blank_a", "blank_b", "interval_a", "interval_b", "done_a", "done_b", "window_done"]
+    compared = 0
+    for row in read_vectors(package / "sequencer" / "sequencer_vectors.csv"):
+        if row["rst"] == "1":
+            sequencer.reset()
+            continue
+        got = sequencer.step()
+        assert [got[p] for p in ports] == [int(row[p]) for p in ports], row
+        compared += 1
+    assert compared > 1000
+
+
+def test_the_estimator_reproduces_its_vectors(package):
+    estimator = gyrofx.Plan.from_package(package).estimator()
+    inputs = ["y_a", "y_b", "blank_a", "blank_b", "done_a", "done_b", "interval_a", "interval_b", "window_done"]
+    rows = read_vectors(package / "estimator" / "estimator_vectors.csv")
+    estimated = 0
+    for row in rows:
+        if row["rst"] == "1":
+            estimator.reset()
+            continue
+        bias_a, bias_b, done = estimator.step(*(int(row[p]) for p in inputs))
+        assert (bias_a, bias_b, done) == (int(row["bias_a"]), int(row["bias_b"]), int(row["estimated"])), row
+        estimated += done
+    assert estimated > 0, "the record reaches an estimate"
+    # process() on the same record gives the same outputs.
+    body = leading_run(rows)
+    assert any(r["estimated"] == "1" for r in body), "the replayed run reaches an estimate"
+    fresh = gyrofx.Plan.from_package(package).estimator()
+    out = fresh.process(*(np.array([int(r[p]) for r in body], dtype=np.int64) for p in inputs))
+    assert list(out["bias_a"]) == [int(r["bias_a"]) for r in body]
+    assert list(out["estimated"]) == [int(r["estimated"]) for r in body]
+
+
+def test_the_mean_filter_reproduces_its_vectors(package):
+    mean_filter = gyrofx.Plan.from_package(package).mean_filter()
+    blocks = 0
+    for row in read_vectors(package / "mean_filter" / "mean_filter_vectors.csv"):
+        if row["rst"] == "1":
+            mean_filter.reset()
+            continue
+        got = mean_filter.step(int(row["x"]))
+        if row["y_valid"] == "1":
+            assert got == (int(row["y"]), int(row["kept"])), row
+            blocks += 1
+        else:
+            assert got is None, row
+    assert blocks > 10
+
+
+def test_the_chain_and_its_float_twin_reproduce_the_top_vectors(package):
+    plan = gyrofx.Plan.from_package(package)
+    chain, twin = plan.chain(), plan.chain_float()
+    input_format = plan.formats()["estimator.input"]
+    ports = ["mode_a", "mode_b", "out_valid", "rate_out", "bias_a", "bias_b", "estimated"]
+    rows = read_vectors(package / "top" / "top_vectors.csv")
+    valid = 0
+    for row in rows:
+        if row["rst"] == "1":
+            chain.reset()
+            twin.reset()
+            continue
+        y = [int(row["y_a"]), int(row["y_b"])]
+        got = chain.step(y[0], y[1], int(row["bw_sel"]))
+        want = {p: int(row[p]) if row[p] != "" else 0 for p in ports}
+        assert got == want, row
+        y_real = gyrofx.to_real(np.array(y, dtype=np.int64), input_format)
+        float_sample = twin.step(float(y_real[0]), float(y_real[1]), int(row["bw_sel"]))
+        if row["float_rate_dps"]:
+            # The CSV prints the shortest round-trip text: equal as doubles.
+            assert float_sample["rate"] == float(row["float_rate_dps"]), row
+            valid += 1
+        else:
+            assert float_sample["rate"] is None
+    assert valid > 100
+    # process() over the same stimulus: the same port streams.
+    body = leading_run(rows)
+    assert sum(r["out_valid"] == "1" for r in body) > 100
+    fresh = plan.chain()
+    out = fresh.process(
+        np.array([int(r["y_a"]) for r in body], dtype=np.int64),
+        np.array([int(r["y_b"]) for r in body], dtype=np.int64),
+        np.array([int(r["bw_sel"]) for r in body], dtype=np.int64),
+    )
+    assert list(out["rate_out"]) == [int(r["rate_out"]) if r["rate_out"] else 0 for r in body]
+
+
+def test_the_kf_stays_within_its_derived_bound_of_the_float_twin():
+    plan = gyrofx.Plan.default()
+    kf, twin = plan.kf(), plan.kf_float()
+    fmt_in, fmt_out = kf.input_format, kf.output_format
+    rng = np.random.default_rng(7)
+    samples = 20_000
+    z = gyrofx.quantize(rng.normal(5.0, 30.0, samples), fmt_in)
+    fixed = gyrofx.to_real(kf.process(z, 2), fmt_out)
+    real = twin.process(gyrofx.to_real(z, fmt_in), 2)
+    lsb = 2.0 ** -int(fmt_out.split(".")[1])
+    worst = np.max(np.abs(fixed - real)) / lsb
+    bound = kf.error_bound_lsb(samples)
+    assert 0 < worst <= bound, (worst, bound)
+
+
+def test_process_equals_step_for_the_kf_and_mean_filter():
+    plan = gyrofx.Plan.default()
+    rng = np.random.default_rng(3)
+    z = gyrofx.quantize(rng.normal(0.0, 50.0, 3000), plan.kf().input_format)
+    select = rng.integers(0, len(plan.bandwidths_hz), z.size)
+    stepped = plan.kf()
+    assert list(plan.kf().process(z, select)) == [stepped.step(int(a), int(b)) for a, b in zip(z, select)]
+    mean = plan.mean_filter()
+    x = gyrofx.quantize(rng.normal(0.0, 50.0, 3000), mean.input_format)
+    out = plan.mean_filter().process(x)
+    for i, code in enumerate(x):
+        got = mean.step(int(code))
+        assert (got is not None) == bool(out["y_valid"][i])
+        if got is not None:
+            assert got == (out["y"][i], out["kept"][i])
+
+
+def exact_quantize(value, frac, width, rounding, overflow):
+    """Python's own rational arithmetic: the reference for `quantize`."""
+    scaled = fractions.Fraction(value) * fractions.Fraction(2) ** frac
+    floor = math.floor(scaled)
+    rest = scaled - floor
+    half = fractions.Fraction(1, 2)
+    if rounding == "floor":
+        code = floor
+    elif rounding == "ceil":
+        code = math.ceil(scaled)
+    elif rounding == "zero":
+        code = math.trunc(scaled)
+    elif rounding == "nearest":
+        code = floor + (1 if rest >= half else 0)
+    elif rounding == "round":
+        code = floor + (1 if rest > half or (rest == half and scaled > 0) else 0)
+    else:  # convergent
+        code = floor + (1 if rest > half or (rest == half and floor % 2 == 1) else 0)
+    low, high = -(1 << (width - 1)), (1 << (width - 1)) - 1
+    if overflow == "saturate":
+        return min(max(code, low), high)
+    return ((code - low) % (1 << width)) + low
+
+
+@pytest.mark.parametrize("rounding", ["floor", "ceil", "zero", "nearest", "round", "convergent"])
+@pytest.mark.parametrize("overflow", ["saturate", "wrap"])
+def test_quantize_matches_exact_arithmetic(rounding, overflow):
+    rng = np.random.default_rng(11)
+    width, frac = 10, 3
+    ties = (np.arange(-700, 700) + 0.5) / 8.0  # every tie, including past the range
+    values = np.concatenate([ties, rng.uniform(-100.0, 100.0, 2000), [0.0, -0.0, 63.9375, -64.0]])
+    got = gyrofx.quantize(values, f"s{width}.{frac}", rounding, overflow)
+    want = [exact_quantize(v, frac, width, rounding, overflow) for v in values]
+    assert got.dtype == np.int64
+    assert list(got) == want
+    back = gyrofx.to_real(got, f"s{width}.{frac}")
+    assert list(back) == [c / 8.0 for c in want]
+
+
+def test_errors_are_gyrofx_errors_with_the_clis_messages(tmp_path):
+    bad = "[kf]\nbandwidths_hz = [10.0, 500.0]\n"
+    config = tmp_path / "bad.toml"
+    config.write_text(bad)
+    cli = run_cli("generate", "--config", str(config), "--out", str(tmp_path / "o"), check=False)
+    assert cli.returncode != 0
+    with pytest.raises(gyrofx.GyrofxError) as python:
+        gyrofx.Plan.from_file(config)
+    assert str(python.value) in cli.stderr, (str(python.value), cli.stderr)
+    with pytest.raises(gyrofx.GyrofxError, match="one of gu2019, xue2015, mpu6050"):
+        gyrofx.Plan.preset("nope")
+    kf = gyrofx.Plan.default().kf()
+    with pytest.raises(gyrofx.GyrofxError, match=r"z = 8388608 is not a code of s24\.14"):
+        kf.step(8388608)
+    with pytest.raises(gyrofx.GyrofxError, match=r"bw_sel = 3 does not address"):
+        kf.step(0, 3)
+    with pytest.raises(gyrofx.GyrofxError, match=r"values\[1\] = NaN"):
+        gyrofx.quantize(np.array([1.0, np.nan]), "s8.2")
+    with pytest.raises(gyrofx.GyrofxError, match="format \"q8\""):
+        gyrofx.quantize(np.array([1.0]), "q8")
+    with pytest.raises(gyrofx.GyrofxError, match="y_b has 2 samples but y_a has 3"):
+        gyrofx.Plan.default().chain().process(np.zeros(3, dtype=np.int64), np.zeros(2, dtype=np.int64))
+    with pytest.raises(gyrofx.GyrofxError, match="not a gyrofx package manifest"):
+        (tmp_path / "manifest.json").write_text('{"tool": "other"}')
+        gyrofx.Plan.from_package(tmp_path)
+
+
+def test_plans_and_formats():
+    default = gyrofx.Plan.default()
+    formats = default.formats()
+    assert formats["kf.input"] == default.kf().input_format
+    assert formats["kf.output"] == default.kf().output_format
+    assert formats["mean_filter.input"] == default.mean_filter().input_format
+    assert all(f[0] in "su" and "." in f for f in formats.values())
+    assert gyrofx.Plan.preset("mpu6050").toml() != default.toml()
+    assert gyrofx.Plan.from_toml("[kf]\nbandwidths_hz = [5.0]\n").bandwidths_hz == [5.0]
+    # The resolved config round-trips.
+    assert gyrofx.Plan.from_toml(default.toml()).formats() == formats
+
+
+def test_the_stubs_name_every_public_class():
+    stubs = (pathlib.Path(gyrofx.__file__).parent / "__init__.pyi").read_text()
+    for name in gyrofx.__all__:
+        if name != "__version__":
+            assert name in stubs, name
