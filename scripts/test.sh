@@ -87,13 +87,14 @@ echo "== cargo test"
 cargo test --workspace
 
 # The Python package (python/): pyo3 + numpy, built by maturin as an abi3 wheel into a
-# virtualenv from PyPI (reused across runs), then its pytest suite against the CLI's vectors.
+# virtualenv from PyPI (reused across runs), then its pytest suite: the model against the CLI's
+# vectors, and the package's cocotb tests in Icarus (python/tests/test_cocotb.py).
 echo "== python: cargo fmt, clippy, maturin wheel, pytest"
 python_venv="${XDG_CACHE_HOME:-$HOME/.cache}/gyrofx/python-venv"
-if [ ! -x "$python_venv/bin/maturin" ] || ! "$python_venv/bin/python" -c "import numpy, pytest" >/dev/null 2>&1; then
-    echo "== installing maturin, numpy, pytest into $python_venv"
+if [ ! -x "$python_venv/bin/maturin" ] || ! "$python_venv/bin/python" -c "import numpy, pytest, cocotb" >/dev/null 2>&1; then
+    echo "== installing maturin, numpy, pytest, cocotb into $python_venv"
     python3 -m venv "$python_venv"
-    "$python_venv/bin/pip" install -q "maturin>=1.5,<2" numpy pytest
+    "$python_venv/bin/pip" install -q "maturin>=1.5,<2" numpy pytest "cocotb>=2.0,<3"
 fi
 cargo fmt --manifest-path python/Cargo.toml -- --check
 cargo clippy --manifest-path python/Cargo.toml --all-targets --quiet -- -D warnings

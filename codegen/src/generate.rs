@@ -180,6 +180,9 @@ pub fn build_package(
             );
         }
     }
+    for (path, text) in crate::cocotb::files(&run.blocks, provenance) {
+        package.add(path, text);
+    }
     for block in &run.blocks {
         for file in block_files(block, provenance) {
             match file {

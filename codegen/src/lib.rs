@@ -10,6 +10,7 @@
 
 pub mod block;
 pub mod blocks;
+pub mod cocotb;
 pub mod config;
 pub mod error;
 pub mod generate;

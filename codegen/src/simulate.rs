@@ -17,10 +17,13 @@ pub enum Simulator {
     Verilator,
     /// GHDL (`--std=08`), the VHDL RTL and testbenches.
     Ghdl,
+    /// The cocotb tests (`cocotb/`) in Icarus Verilog, checked live against the `gyrofx`
+    /// Python model.
+    Cocotb,
 }
 
 impl Simulator {
-    /// Every simulator.
+    /// The three HDL simulators (`--sim all`); the cocotb tests are asked for by name.
     pub const ALL: [Simulator; 3] = [Simulator::Icarus, Simulator::Verilator, Simulator::Ghdl];
 
     /// CLI name (also the Makefile's target prefix).
@@ -29,6 +32,7 @@ impl Simulator {
             Simulator::Icarus => "iverilog",
             Simulator::Verilator => "verilator",
             Simulator::Ghdl => "ghdl",
+            Simulator::Cocotb => "cocotb",
         }
     }
 
@@ -38,6 +42,7 @@ impl Simulator {
             Simulator::Icarus => &["iverilog", "vvp", "make"],
             Simulator::Verilator => &["verilator", "make"],
             Simulator::Ghdl => &["ghdl", "make"],
+            Simulator::Cocotb => &["iverilog", "vvp", "make", "cocotb-config", "python3"],
         }
     }
 }
@@ -49,8 +54,9 @@ impl std::str::FromStr for Simulator {
             "iverilog" | "icarus" => Ok(Simulator::Icarus),
             "verilator" => Ok(Simulator::Verilator),
             "ghdl" => Ok(Simulator::Ghdl),
+            "cocotb" => Ok(Simulator::Cocotb),
             other => Err(Error::Simulation(format!(
-                "simulator {other:?} is not supported: use iverilog, verilator or ghdl"
+                "simulator {other:?} is not supported: use iverilog, verilator, ghdl or cocotb"
             ))),
         }
     }
@@ -194,8 +200,14 @@ pub fn run_reporting(
     let names = block_names(out, simulator, options)?;
     for program in simulator.programs() {
         if !on_path(program) {
+            let how = match (simulator, *program) {
+                (Simulator::Cocotb, "cocotb-config" | "python3") => {
+                    "pip install cocotb and <gyrofx>/python into a virtualenv and put its bin/ on PATH; scripts/test.sh does"
+                }
+                _ => "scripts/test.sh installs it with apt-get",
+            };
             return Err(Error::Simulation(format!(
-                "{program} is not on PATH: {} needs it (scripts/test.sh installs it with apt-get)",
+                "{program} is not on PATH: {} needs it ({how})",
                 simulator.name()
             )));
         }

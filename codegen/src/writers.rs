@@ -203,6 +203,42 @@ ghdl-{name}:
             name = b.name,
         );
     }
+    let cocotb = crate::cocotb::tested(blocks);
+    if !cocotb.is_empty() {
+        let names: Vec<&str> = cocotb.iter().map(|b| b.name).collect();
+        let _ = write!(
+            out,
+            "
+# The cocotb tests ({folder}/): make sim-cocotb or make cocotb-<block> ({list}). They need
+# cocotb 2.x and the gyrofx Python package (pip install <gyrofx>/python) for the python3 on
+# PATH. COCOTB_SIM picks cocotb's simulator: icarus (its Verilator support needs 5.036 or later).
+COCOTB_SIM ?= icarus
+.PHONY: sim-cocotb{phony}
+sim-cocotb:{targets}
+",
+            folder = crate::cocotb::FOLDER,
+            list = names.join(", "),
+            phony = names
+                .iter()
+                .map(|n| format!(" cocotb-{n}"))
+                .collect::<String>(),
+            targets = names
+                .iter()
+                .map(|n| format!(" cocotb-{n}"))
+                .collect::<String>(),
+        );
+        for name in names {
+            let _ = write!(
+                out,
+                "
+cocotb-{name}:
+\t@echo \"== {name}\"
+\tcd {name} && $(MAKE) --no-print-directory -f ../{folder}/{name}.mk SIM=$(COCOTB_SIM)
+",
+                folder = crate::cocotb::FOLDER,
+            );
+        }
+    }
     let _ = write!(
         out,
         "\nclean:\n\trm -rf {}\n",
@@ -215,7 +251,7 @@ ghdl-{name}:
 /// removes them), as the marker lists them ([`crate::output_folder::Marker`]): a
 /// regenerated package may replace a folder holding these.
 pub fn build_outputs(blocks: &[Block]) -> Vec<String> {
-    blocks
+    let mut outputs: Vec<String> = blocks
         .iter()
         .flat_map(|b| {
             let n = b.name;
@@ -233,7 +269,9 @@ pub fn build_outputs(blocks: &[Block]) -> Vec<String> {
                 format!("{n}/e~{tb}.lst"),
             ]
         })
-        .collect()
+        .collect();
+    outputs.extend(crate::cocotb::build_outputs(blocks));
+    outputs
 }
 
 /// The package's README.
@@ -282,6 +320,15 @@ testbenches `tb_<module>.v` (Verilog) and `tb_<module>.vhd` (VHDL-2008); the ROM
 reads. `hdl/` holds the RTL in both languages. Line 2 of each hex file names every
 field and its format. `report.md` has the Allan table; `manifest.json` the config, formats,
 SHA-256 of every file, overflow counts and fixed-vs-float error statistics.
+
+`cocotb/` holds a cocotb test per block that has a Python model (`make sim-cocotb`, or
+`make cocotb-kf`; cocotb 2.x and the gyrofx Python package, `pip install <gyrofx>/python`, for
+the python3 on PATH; Icarus by default, `COCOTB_SIM` picks another of cocotb's simulators,
+Verilator from 5.036 on). Each drives the RTL with random and directed stimulus (seed
+`COCOTB_RANDOM_SEED`, default 1) and checks it live against the model of this package's
+manifest: outputs with a valid flag as a stream whatever the latency, so your own RTL with
+another pipeline depth passes as long as its valid-qualified stream matches; the reference
+timing for combinational ports and registered ports without a valid flag.
 
 Fixed vs float (same quantized coefficients): KF max {kf:.3} LSB (bound {kfb:.3}), chain max
 {ch:.3} LSB (bound {chb:.3}), bias estimates max {bi:.3} LSB (bound {bib:.3}), mean filter max

@@ -15,7 +15,8 @@ pub struct Args {
     /// The package folder.
     #[arg(long)]
     out: PathBuf,
-    /// Simulators, comma-separated: iverilog, verilator, ghdl (the VHDL RTL), or all.
+    /// Simulators, comma-separated: iverilog, verilator, ghdl (the VHDL RTL), cocotb (the
+    /// cocotb tests in Icarus against the gyrofx Python model), or all (the first three).
     #[arg(long, default_value = "iverilog")]
     sim: String,
     /// Latency mask: samples not compared at the start and from every reset sample on.

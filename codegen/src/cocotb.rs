@@ -1,0 +1,197 @@
+//! The package's cocotb tests (`cocotb/`): per block with a Python model, a Verilog wrapper
+//! that sets the block's parameters from its `<block>_params.vh`, a cocotb makefile and a test
+//! module that drives the RTL with random and directed stimulus and checks it live against the
+//! `gyrofx` Python package (the same Rust model as the vectors). The shared driver and
+//! scoreboard are `cocotb/gyrofx_cocotb.py`.
+//!
+//! Run from the package: `make cocotb-<block>` (`COCOTB_SIM=icarus`, the default), or
+//! `gyrofx verify --sim cocotb`. cocotb 2.x runs Verilator only from 5.036 on; Debian 12's
+//! 5.006 is refused by cocotb's own makefile, so Icarus is the simulator CI runs.
+
+use std::fmt::Write as _;
+
+use crate::block::{Block, Signal};
+use crate::hdl::RTL_SOURCES;
+use crate::writers::Provenance;
+
+/// The shared driver, protocol and scoreboard.
+const SHARED: &str = include_str!("cocotb/gyrofx_cocotb.py");
+
+/// Blocks with a cocotb test (a Python model of theirs exists), with the test module.
+pub const TESTS: [(&str, &str); 5] = [
+    ("sequencer", include_str!("cocotb/test_sequencer.py")),
+    ("estimator", include_str!("cocotb/test_estimator.py")),
+    ("kf", include_str!("cocotb/test_kf.py")),
+    ("top", include_str!("cocotb/test_top.py")),
+    ("mean_filter", include_str!("cocotb/test_mean_filter.py")),
+];
+
+/// Folder of the cocotb files in a package.
+pub const FOLDER: &str = "cocotb";
+
+/// The blocks of `blocks` that have a cocotb test, in the package's order.
+pub fn tested(blocks: &[Block]) -> Vec<&Block> {
+    blocks
+        .iter()
+        .filter(|b| TESTS.iter().any(|(name, _)| *name == b.name))
+        .collect()
+}
+
+/// Every file of the package's `cocotb/` folder: `(path, text)`.
+pub fn files(blocks: &[Block], provenance: &Provenance) -> Vec<(String, String)> {
+    let tested = tested(blocks);
+    if tested.is_empty() {
+        return Vec::new();
+    }
+    let python = |text: &str| format!("{}\n{text}", provenance.line("#"));
+    let mut files = vec![(format!("{FOLDER}/gyrofx_cocotb.py"), python(SHARED))];
+    for block in tested {
+        let test = TESTS
+            .iter()
+            .find(|(name, _)| *name == block.name)
+            .map(|(_, text)| *text)
+            .expect("tested blocks have a test");
+        files.push((format!("{FOLDER}/test_{}.py", block.name), python(test)));
+        files.push((
+            format!("{FOLDER}/cocotb_{}.v", block.module),
+            wrapper(block, provenance),
+        ));
+        files.push((
+            format!("{FOLDER}/{}.mk", block.name),
+            makefile(block, provenance),
+        ));
+    }
+    files
+}
+
+fn port(direction: &str, signal: &Signal) -> String {
+    let signed = if signal.format.signed { "signed " } else { "" };
+    let range = if signal.format.width > 1 {
+        format!("[{}:0] ", signal.format.width - 1)
+    } else {
+        String::new()
+    };
+    format!("    {direction} wire {signed}{range}{}", signal.name)
+}
+
+/// `cocotb_<module>`: the block's module with this package's parameters, the test's top level.
+pub fn wrapper(block: &Block, provenance: &Provenance) -> String {
+    let top = format!("cocotb_{}", block.module);
+    let mut ports = vec![
+        "    input wire clk".to_string(),
+        "    input wire rst".into(),
+        "    input wire ce".into(),
+    ];
+    ports.extend(block.inputs.iter().map(|s| port("input", s)));
+    ports.extend(block.outputs.iter().map(|o| port("output", &o.signal)));
+    let params: Vec<String> = block
+        .params
+        .iter()
+        .map(|p| format!("    .{0}(P_{0})", p.name))
+        .collect();
+    let mut connections = vec![
+        "    .clk(clk)".to_string(),
+        "    .rst(rst)".into(),
+        "    .ce(ce)".into(),
+    ];
+    connections.extend(
+        block
+            .inputs
+            .iter()
+            .map(|s| format!("    .{0}({0})", s.name)),
+    );
+    connections.extend(
+        block
+            .outputs
+            .iter()
+            .map(|o| format!("    .{0}({0})", o.signal.name)),
+    );
+    let mut out = String::new();
+    let _ = write!(
+        out,
+        "{provenance}
+`resetall
+`timescale 1ns / 1ps
+`default_nettype none
+
+// {top}: {module} ({title}) with this package's parameters ({params_file}), the top level of
+// the cocotb test {folder}/test_{name}.py. Compiled in the block's folder (ROM paths and the
+// include are relative to it).
+module {top} (
+{ports}
+);
+
+`include \"{params_file}\"
+
+{module} #(
+{params}
+) dut (
+{connections}
+);
+
+endmodule
+
+`resetall
+",
+        provenance = provenance.line("//"),
+        module = block.module,
+        title = block.title,
+        params_file = block.file("params.vh"),
+        folder = FOLDER,
+        name = block.name,
+        ports = ports.join(",\n"),
+        params = params.join(",\n"),
+        connections = connections.join(",\n"),
+    );
+    out
+}
+
+/// `<block>.mk`: cocotb's makefile set up for the block, run from the block's folder.
+pub fn makefile(block: &Block, provenance: &Provenance) -> String {
+    let sources: Vec<String> = RTL_SOURCES
+        .iter()
+        .map(|(name, _)| format!("../hdl/{name}"))
+        .collect();
+    format!(
+        "{provenance}
+# The cocotb test of {name} ({module}); run it from the package folder with make cocotb-{name}
+# (or from {name}/ with make -f ../{folder}/{name}.mk). Needs cocotb 2.x and the gyrofx Python
+# package importable by the python3 on PATH. SIM=icarus (cocotb's Verilator support needs
+# Verilator 5.036 or later).
+SIM ?= icarus
+# One seed, one stimulus: COCOTB_RANDOM_SEED=<n> picks another.
+export COCOTB_RANDOM_SEED ?= 1
+TOPLEVEL_LANG = verilog
+VERILOG_SOURCES = {sources} ../{folder}/cocotb_{module}.v
+COMPILE_ARGS += -I.
+COCOTB_TOPLEVEL = cocotb_{module}
+COCOTB_TEST_MODULES = test_{name}
+export PYTHONPATH := $(abspath ../{folder})$(if $(PYTHONPATH),:$(PYTHONPATH))
+export GYROFX_PACKAGE ?= $(abspath ..)
+include $(shell cocotb-config --makefiles)/Makefile.sim
+",
+        provenance = provenance.line("#"),
+        name = block.name,
+        module = block.module,
+        folder = FOLDER,
+        sources = sources.join(" "),
+    )
+}
+
+/// What running the cocotb tests writes into the package (for `make clean` and the marker).
+pub fn build_outputs(blocks: &[Block]) -> Vec<String> {
+    let tested = tested(blocks);
+    let mut out: Vec<String> = tested
+        .iter()
+        .flat_map(|b| {
+            [
+                format!("{}/sim_build/", b.name),
+                format!("{}/results.xml", b.name),
+            ]
+        })
+        .collect();
+    if !tested.is_empty() {
+        out.push(format!("{FOLDER}/__pycache__/"));
+    }
+    out
+}
