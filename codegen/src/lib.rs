@@ -14,6 +14,7 @@ pub mod cocotb;
 pub mod config;
 pub mod error;
 pub mod generate;
+pub mod golden;
 pub mod hdl;
 pub mod input;
 pub mod job;

@@ -3,6 +3,7 @@
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 
+use gyrofx_codegen::golden::check_code;
 use gyrofx_model::fx::{from_f64, Format, Overflow, Rounding};
 
 use crate::refused;
@@ -20,19 +21,6 @@ pub(crate) fn format(text: &str) -> PyResult<Format> {
         )));
     }
     Ok(format)
-}
-
-/// Checks that `code` is a code of `format` (`what` names it in the error).
-pub(crate) fn check_code(code: i64, format: Format, what: &str) -> PyResult<()> {
-    if format.contains(i128::from(code)) {
-        Ok(())
-    } else {
-        Err(refused(format!(
-            "{what} = {code} is not a code of {format}: allowed {}..={}",
-            format.min_code(),
-            format.max_code()
-        )))
-    }
 }
 
 /// Quantizes real values to codes of `fmt`.
@@ -81,7 +69,7 @@ pub(crate) fn to_real<'py>(
     let codes = codes.as_array();
     let mut values = Vec::with_capacity(codes.len());
     for (index, code) in codes.iter().enumerate() {
-        check_code(*code, format, &format!("codes[{index}]"))?;
+        check_code(*code, format, &format!("codes[{index}]")).map_err(refused)?;
         values.push(format.to_f64(i128::from(*code)));
     }
     Ok(values.into_pyarray(py))
