@@ -84,6 +84,43 @@ pub fn wrapper(block: &Block, provenance: &Provenance) -> String {
     ];
     ports.extend(block.inputs.iter().map(|s| port("input", s)));
     ports.extend(block.outputs.iter().map(|o| port("output", &o.signal)));
+    let mut out = String::new();
+    let _ = write!(
+        out,
+        "{provenance}
+`resetall
+`timescale 1ns / 1ps
+`default_nettype none
+
+// {top}: {module} ({title}) with this package's parameters ({params_file}), the top level of
+// the cocotb test {folder}/test_{name}.py. Compiled in the block's folder (ROM paths and the
+// include are relative to it).
+module {top} (
+{ports}
+);
+
+`include \"{params_file}\"
+
+{instance}
+endmodule
+
+`resetall
+",
+        provenance = provenance.line("//"),
+        module = block.module,
+        title = block.title,
+        params_file = block.file("params.vh"),
+        folder = FOLDER,
+        name = block.name,
+        ports = ports.join(",\n"),
+        instance = instance(block),
+    );
+    out
+}
+
+/// The block's module named `dut`, its parameters from `P_<NAME>` (the params file's), each
+/// port on the signal of its name.
+pub fn instance(block: &Block) -> String {
     let params: Vec<String> = block
         .params
         .iter()
@@ -106,44 +143,12 @@ pub fn wrapper(block: &Block, provenance: &Provenance) -> String {
             .iter()
             .map(|o| format!("    .{0}({0})", o.signal.name)),
     );
-    let mut out = String::new();
-    let _ = write!(
-        out,
-        "{provenance}
-`resetall
-`timescale 1ns / 1ps
-`default_nettype none
-
-// {top}: {module} ({title}) with this package's parameters ({params_file}), the top level of
-// the cocotb test {folder}/test_{name}.py. Compiled in the block's folder (ROM paths and the
-// include are relative to it).
-module {top} (
-{ports}
-);
-
-`include \"{params_file}\"
-
-{module} #(
-{params}
-) dut (
-{connections}
-);
-
-endmodule
-
-`resetall
-",
-        provenance = provenance.line("//"),
-        module = block.module,
-        title = block.title,
-        params_file = block.file("params.vh"),
-        folder = FOLDER,
-        name = block.name,
-        ports = ports.join(",\n"),
-        params = params.join(",\n"),
-        connections = connections.join(",\n"),
-    );
-    out
+    format!(
+        "{} #(\n{}\n) dut (\n{}\n);\n",
+        block.module,
+        params.join(",\n"),
+        connections.join(",\n")
+    )
 }
 
 /// `<block>.mk`: cocotb's makefile set up for the block, run from the block's folder.

@@ -180,7 +180,10 @@ pub fn build_package(
             );
         }
     }
-    for (path, text) in crate::cocotb::files(&run.blocks, provenance) {
+    for (path, text) in crate::cocotb::files(&run.blocks, provenance)
+        .into_iter()
+        .chain(crate::dpi::files(&run.blocks, provenance))
+    {
         package.add(path, text);
     }
     for block in &run.blocks {

@@ -35,7 +35,10 @@ pub fn check_codes(codes: &[i64], format: Format, port: &str) -> PortResult<()> 
     // whose upper half no i64 reaches).
     let min = i64::try_from(format.min_code()).unwrap_or(i64::MIN);
     let max = i64::try_from(format.max_code()).unwrap_or(i64::MAX);
-    if codes.iter().fold(false, |bad, c| bad | (*c < min) | (*c > max)) {
+    if codes
+        .iter()
+        .fold(false, |bad, c| bad | (*c < min) | (*c > max))
+    {
         let index = codes.iter().position(|c| *c < min || *c > max).unwrap_or(0);
         check_code(codes[index], format, &format!("{port}[{index}]"))?;
     }

@@ -12,6 +12,7 @@ pub mod block;
 pub mod blocks;
 pub mod cocotb;
 pub mod config;
+pub mod dpi;
 pub mod error;
 pub mod generate;
 pub mod golden;

@@ -20,6 +20,9 @@ pub enum Simulator {
     /// The cocotb tests (`cocotb/`) in Icarus Verilog, checked live against the `gyrofx`
     /// Python model.
     Cocotb,
+    /// The DPI-C testbenches (`dpi/`) in Verilator against gyrofx's C library (the
+    /// `GYROFX_CAPI_LIB` environment variable names `libgyrofx_capi.a`).
+    Dpi,
 }
 
 impl Simulator {
@@ -33,6 +36,7 @@ impl Simulator {
             Simulator::Verilator => "verilator",
             Simulator::Ghdl => "ghdl",
             Simulator::Cocotb => "cocotb",
+            Simulator::Dpi => "dpi",
         }
     }
 
@@ -43,6 +47,7 @@ impl Simulator {
             Simulator::Verilator => &["verilator", "make"],
             Simulator::Ghdl => &["ghdl", "make"],
             Simulator::Cocotb => &["iverilog", "vvp", "make", "cocotb-config", "python3"],
+            Simulator::Dpi => &["verilator", "make"],
         }
     }
 }
@@ -55,8 +60,9 @@ impl std::str::FromStr for Simulator {
             "verilator" => Ok(Simulator::Verilator),
             "ghdl" => Ok(Simulator::Ghdl),
             "cocotb" => Ok(Simulator::Cocotb),
+            "dpi" => Ok(Simulator::Dpi),
             other => Err(Error::Simulation(format!(
-                "simulator {other:?} is not supported: use iverilog, verilator, ghdl or cocotb"
+                "simulator {other:?} is not supported: use iverilog, verilator, ghdl, cocotb or dpi"
             ))),
         }
     }
@@ -209,6 +215,15 @@ pub fn run_reporting(
             return Err(Error::Simulation(format!(
                 "{program} is not on PATH: {} needs it ({how})",
                 simulator.name()
+            )));
+        }
+    }
+    if simulator == Simulator::Dpi {
+        let library = std::env::var_os("GYROFX_CAPI_LIB").map(std::path::PathBuf::from);
+        if !library.as_ref().is_some_and(|l| l.is_file()) {
+            return Err(Error::Simulation(format!(
+                "dpi needs GYROFX_CAPI_LIB, the path of libgyrofx_capi.a (cargo build --release -p gyrofx-capi in the gyrofx repository); it is {}",
+                library.map_or("not set".to_string(), |l| format!("{} (no such file)", l.display()))
             )));
         }
     }

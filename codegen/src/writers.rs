@@ -239,6 +239,47 @@ cocotb-{name}:
             );
         }
     }
+    let dpi = crate::dpi::tested(blocks);
+    if !dpi.is_empty() {
+        let names: Vec<&str> = dpi.iter().map(|b| b.name).collect();
+        let _ = write!(
+            out,
+            "
+# The DPI-C testbenches ({folder}/): make sim-dpi or make dpi-<block> ({list}), in Verilator,
+# against gyrofx's C library: GYROFX_CAPI_LIB=<path to libgyrofx_capi.a> (cargo build --release
+# -p gyrofx-capi in the gyrofx repository). DPI_PLUSARGS: +samples=<n> +seed=<n> +flip=<k>.
+GYROFX_CAPI_LIB ?=
+DPI_PLUSARGS ?=
+.PHONY: sim-dpi{phony}
+sim-dpi:{targets}
+",
+            folder = crate::dpi::FOLDER,
+            list = names.join(", "),
+            phony = names
+                .iter()
+                .map(|n| format!(" dpi-{n}"))
+                .collect::<String>(),
+            targets = names
+                .iter()
+                .map(|n| format!(" dpi-{n}"))
+                .collect::<String>(),
+        );
+        for block in dpi {
+            let tb = format!("tb_dpi_{}", block.module);
+            let _ = write!(
+                out,
+                "
+dpi-{name}:
+\t@echo \"== {name}\"
+\t@test -n \"$(GYROFX_CAPI_LIB)\" || (echo \"GYROFX_CAPI_LIB is not set: point it at libgyrofx_capi.a (cargo build --release -p gyrofx-capi)\" >&2; exit 2)
+\tcd {name} && $(VERILATOR) --binary --timing -Wno-fatal -Wno-WIDTH -Wno-DECLFILENAME -Wno-UNUSEDSIGNAL -j 2 --top-module {tb} -Mdir obj_dpi $(RTL) ../{folder}/{tb}.sv -LDFLAGS \"$(abspath $(GYROFX_CAPI_LIB)) -lpthread -ldl -lm\" >dpi_build.log 2>&1 || (cat dpi_build.log; exit 1)
+\tcd {name} && ./obj_dpi/V{tb} $(DPI_PLUSARGS)
+",
+                name = block.name,
+                folder = crate::dpi::FOLDER,
+            );
+        }
+    }
     let _ = write!(
         out,
         "\nclean:\n\trm -rf {}\n",
@@ -271,6 +312,12 @@ pub fn build_outputs(blocks: &[Block]) -> Vec<String> {
         })
         .collect();
     outputs.extend(crate::cocotb::build_outputs(blocks));
+    outputs.extend(crate::dpi::tested(blocks).iter().flat_map(|b| {
+        [
+            format!("{}/obj_dpi/", b.name),
+            format!("{}/dpi_build.log", b.name),
+        ]
+    }));
     outputs
 }
 

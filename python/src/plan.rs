@@ -62,24 +62,7 @@ impl Plan {
     /// blocks built here reproduce that package's vectors.
     #[staticmethod]
     fn from_package(folder: PathBuf) -> PyResult<Plan> {
-        let path = folder.join("manifest.json");
-        let text = std::fs::read_to_string(&path)
-            .map_err(|e| refused(format!("{}: cannot read: {e}", path.display())))?;
-        let manifest: serde_json::Value = serde_json::from_str(&text)
-            .map_err(|e| refused(format!("{}: not JSON: {e}", path.display())))?;
-        if manifest.get("tool").and_then(|t| t.as_str()) != Some("gyrofx") {
-            return Err(refused(format!(
-                "{}: not a gyrofx package manifest (no \"tool\": \"gyrofx\")",
-                path.display()
-            )));
-        }
-        let config = manifest
-            .get("config")
-            .cloned()
-            .ok_or_else(|| refused(format!("{}: has no \"config\"", path.display())))?;
-        let config: Config = serde_json::from_value(config)
-            .map_err(|e| refused(format!("{}: its config: {e}", path.display())))?;
-        Plan::resolve(Ok(config))
+        Plan::resolve(Config::from_package(&folder))
     }
 
     /// The whole resolved config as TOML (every key present).

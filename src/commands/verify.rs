@@ -16,7 +16,8 @@ pub struct Args {
     #[arg(long)]
     out: PathBuf,
     /// Simulators, comma-separated: iverilog, verilator, ghdl (the VHDL RTL), cocotb (the
-    /// cocotb tests in Icarus against the gyrofx Python model), or all (the first three).
+    /// cocotb tests in Icarus against the gyrofx Python model), dpi (the DPI-C testbenches in
+    /// Verilator against libgyrofx_capi: set GYROFX_CAPI_LIB), or all (the first three).
     #[arg(long, default_value = "iverilog")]
     sim: String,
     /// Latency mask: samples not compared at the start and from every reset sample on.

@@ -331,6 +331,34 @@ impl Config {
         Ok(config)
     }
 
+    /// The config a `gyrofx generate` package was made from: the `config` of its
+    /// `manifest.json` (every key resolved), so a model built from it reproduces the
+    /// package's vectors.
+    ///
+    /// # Errors
+    /// [`Error::Input`] when the folder has no readable gyrofx manifest or its config does not
+    /// parse.
+    pub fn from_package(folder: &Path) -> Result<Config> {
+        let path = folder.join("manifest.json");
+        let bad = |message: String| Error::Input {
+            path: path.clone(),
+            message,
+        };
+        let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
+        let manifest: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| bad(format!("not JSON: {e}")))?;
+        if manifest.get("tool").and_then(|t| t.as_str()) != Some("gyrofx") {
+            return Err(bad(
+                "not a gyrofx package manifest (no \"tool\": \"gyrofx\")".into(),
+            ));
+        }
+        let config = manifest
+            .get("config")
+            .cloned()
+            .ok_or_else(|| bad("has no \"config\"".into()))?;
+        serde_json::from_value(config).map_err(|e| bad(format!("its config: {e}")))
+    }
+
     /// The config as TOML (resolved: every key present).
     pub fn to_toml(&self) -> String {
         toml::to_string(self).expect("config serializes")

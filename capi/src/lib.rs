@@ -1,0 +1,590 @@
+//! gyrofx's bit-accurate model behind a C ABI, for C and C++ testbenches (a Verilator harness)
+//! and SystemVerilog through DPI-C. The header is `capi/include/gyrofx.h` (cbindgen; a test
+//! keeps it equal to the code).
+//!
+//! Every block wraps [`gyrofx_codegen::golden`]: the same model as the vectors, codes in and out
+//! exactly as the RTL ports carry them (`int64_t` two's-complement values, flags 0/1, a mode 1
+//! normal / 0 reverse). The signatures keep to DPI-C's types (`chandle` = pointer, `longint` =
+//! `int64_t`, `int` = `int32_t`, `string` = `const char *`) so a SystemVerilog testbench imports
+//! them as they are.
+//!
+//! Ownership: every `gyrofx_*_new` / `gyrofx_plan_*` result is freed by its `gyrofx_*_free`
+//! (NULL is accepted and ignored). Errors: a constructor returns NULL and a step returns -1;
+//! `gyrofx_last_error()` then holds the message (the CLI's, naming the port or config field,
+//! the value and what is allowed), valid until the thread's next failing call. Nothing here
+//! panics across the boundary; a handle is used by one thread at a time.
+
+#![allow(unsafe_code)]
+
+use std::cell::RefCell;
+use std::ffi::{c_char, CStr, CString};
+use std::path::Path;
+
+use gyrofx_codegen::config::Config;
+use gyrofx_codegen::golden;
+use gyrofx_codegen::job::Job;
+
+thread_local! {
+    static LAST_ERROR: RefCell<CString> = RefCell::new(CString::default());
+}
+
+fn fail(message: impl std::fmt::Display) {
+    let text = message.to_string().replace('\0', " ");
+    LAST_ERROR.with(|e| *e.borrow_mut() = CString::new(text).unwrap_or_default());
+}
+
+/// The message of the calling thread's last failure ("" before any).
+#[no_mangle]
+pub extern "C" fn gyrofx_last_error() -> *const c_char {
+    LAST_ERROR.with(|e| e.borrow().as_ptr())
+}
+
+/// The library's version ("0.1.0"), static.
+#[no_mangle]
+pub extern "C" fn gyrofx_version() -> *const c_char {
+    concat!(env!("CARGO_PKG_VERSION"), "\0").as_ptr().cast()
+}
+
+/// A resolved config (the embedded default overlaid by a TOML text, a file or a package's
+/// manifest), as `gyrofx generate` resolves it.
+pub struct GyrofxPlan {
+    job: Job,
+}
+
+/// Reads a C string argument, failing with the argument's name when it is NULL or not UTF-8.
+///
+/// # Safety
+/// `text` is NULL or a NUL-terminated string.
+unsafe fn text<'a>(text: *const c_char, what: &str) -> Option<&'a str> {
+    if text.is_null() {
+        fail(format!("{what} is NULL"));
+        return None;
+    }
+    // SAFETY: non-NULL and NUL-terminated by the caller's contract.
+    match unsafe { CStr::from_ptr(text) }.to_str() {
+        Ok(text) => Some(text),
+        Err(_) => {
+            fail(format!("{what} is not UTF-8"));
+            None
+        }
+    }
+}
+
+fn plan(config: gyrofx_codegen::error::Result<Config>) -> *mut GyrofxPlan {
+    match config.and_then(Job::new) {
+        Ok(job) => Box::into_raw(Box::new(GyrofxPlan { job })),
+        Err(e) => {
+            fail(e);
+            std::ptr::null_mut()
+        }
+    }
+}
+
+/// The embedded default config.
+#[no_mangle]
+pub extern "C" fn gyrofx_plan_default() -> *mut GyrofxPlan {
+    plan(Ok(Config::embedded()))
+}
+
+/// A (partial) TOML config over the default; NULL on an error.
+///
+/// # Safety
+/// `toml` is NULL or a NUL-terminated string.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_plan_from_toml(toml: *const c_char) -> *mut GyrofxPlan {
+    // SAFETY: forwarded contract.
+    match unsafe { text(toml, "toml") } {
+        Some(toml) => plan(Config::from_toml(toml, "<toml text>")),
+        None => std::ptr::null_mut(),
+    }
+}
+
+/// A config file over the default (as `--config`); NULL on an error.
+///
+/// # Safety
+/// `path` is NULL or a NUL-terminated string.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_plan_from_file(path: *const c_char) -> *mut GyrofxPlan {
+    // SAFETY: forwarded contract.
+    match unsafe { text(path, "path") } {
+        Some(path) => plan(Config::from_file(Path::new(path))),
+        None => std::ptr::null_mut(),
+    }
+}
+
+/// The config a generated package was made from (`<folder>/manifest.json`); NULL on an error.
+///
+/// # Safety
+/// `folder` is NULL or a NUL-terminated string.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_plan_from_package(folder: *const c_char) -> *mut GyrofxPlan {
+    // SAFETY: forwarded contract.
+    match unsafe { text(folder, "folder") } {
+        Some(folder) => plan(gyrofx_codegen::config::Config::from_package(Path::new(
+            folder,
+        ))),
+        None => std::ptr::null_mut(),
+    }
+}
+
+/// Frees a plan (blocks made from it stay valid: they hold their own copy).
+///
+/// # Safety
+/// `plan` is NULL or a pointer from a `gyrofx_plan_*` function, not freed before.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_plan_free(plan: *mut GyrofxPlan) {
+    if !plan.is_null() {
+        // SAFETY: made by Box::into_raw and not freed before, by contract.
+        drop(unsafe { Box::from_raw(plan) });
+    }
+}
+
+/// Frees a block made by one of the `gyrofx_*_new` functions.
+///
+/// # Safety
+/// `block` is NULL or from `Box::into_raw` of a `T`, not freed before.
+unsafe fn free<T>(block: *mut T) {
+    if !block.is_null() {
+        // SAFETY: by contract.
+        drop(unsafe { Box::from_raw(block) });
+    }
+}
+
+/// A block made from a plan, or NULL (with the error) when the plan is NULL.
+///
+/// # Safety
+/// `plan` is NULL or a live plan.
+unsafe fn new<T>(plan: *const GyrofxPlan, make: impl FnOnce(&Job) -> T) -> *mut T {
+    // SAFETY: NULL or live, by contract.
+    match unsafe { plan.as_ref() } {
+        Some(plan) => Box::into_raw(Box::new(make(&plan.job))),
+        None => {
+            fail("plan is NULL");
+            std::ptr::null_mut()
+        }
+    }
+}
+
+/// Runs `step` on a live block, storing the error; 0 or -1.
+///
+/// # Safety
+/// `block` is NULL or a live block of type `T`.
+unsafe fn with<T>(block: *mut T, step: impl FnOnce(&mut T) -> golden::PortResult<()>) -> i32 {
+    // SAFETY: NULL or live and not shared across threads, by contract.
+    let Some(block) = (unsafe { block.as_mut() }) else {
+        fail("block is NULL");
+        return -1;
+    };
+    match step(block) {
+        Ok(()) => 0,
+        Err(message) => {
+            fail(message);
+            -1
+        }
+    }
+}
+
+/// Writes `value` through `out` when it is not NULL.
+///
+/// # Safety
+/// `out` is NULL or valid for a write.
+unsafe fn put<V>(out: *mut V, value: V) {
+    // SAFETY: by contract.
+    if let Some(out) = unsafe { out.as_mut() } {
+        *out = value;
+    }
+}
+
+/// The steady-state KF (`gyrofx_kf`).
+pub struct GyrofxKf(golden::Kf);
+
+/// A KF from reset; NULL when `plan` is NULL.
+///
+/// # Safety
+/// `plan` is NULL or a live plan.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_kf_new(plan: *const GyrofxPlan) -> *mut GyrofxKf {
+    // SAFETY: forwarded contract.
+    unsafe { new(plan, |job| GyrofxKf(golden::Kf::new(job.kf()))) }
+}
+
+/// Frees a KF.
+///
+/// # Safety
+/// `kf` is NULL or from `gyrofx_kf_new`, not freed before.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_kf_free(kf: *mut GyrofxKf) {
+    // SAFETY: forwarded contract.
+    unsafe { free(kf) }
+}
+
+/// The synchronous reset. Returns 0, or -1 for a NULL handle.
+///
+/// # Safety
+/// `kf` is NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_kf_reset(kf: *mut GyrofxKf) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe {
+        with(kf, |kf| {
+            kf.0.reset();
+            Ok(())
+        })
+    }
+}
+
+/// One sample: `z` (input-format code) and `bw_sel`; writes `rate_out`. Returns 0, or -1 for
+/// a refused input (state unchanged; `gyrofx_last_error()` says why).
+///
+/// # Safety
+/// `kf` is NULL or live; `rate_out` NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_kf_step(
+    kf: *mut GyrofxKf,
+    z: i64,
+    bw_sel: i32,
+    rate_out: *mut i64,
+) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe {
+        with(kf, |kf| {
+            let rate = kf.0.step(z, i64::from(bw_sel))?;
+            put(rate_out, rate);
+            Ok(())
+        })
+    }
+}
+
+/// The mode-reversal sequencer (`gyrofx_sequencer`).
+pub struct GyrofxSequencer(golden::Sequencer);
+
+/// A sequencer from reset; NULL when `plan` is NULL.
+///
+/// # Safety
+/// `plan` is NULL or a live plan.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_sequencer_new(plan: *const GyrofxPlan) -> *mut GyrofxSequencer {
+    // SAFETY: forwarded contract.
+    unsafe {
+        new(plan, |job| {
+            GyrofxSequencer(golden::Sequencer::new(&job.chain.estimator.schedule))
+        })
+    }
+}
+
+/// Frees a sequencer.
+///
+/// # Safety
+/// `sequencer` is NULL or from `gyrofx_sequencer_new`, not freed before.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_sequencer_free(sequencer: *mut GyrofxSequencer) {
+    // SAFETY: forwarded contract.
+    unsafe { free(sequencer) }
+}
+
+/// The synchronous reset. Returns 0, or -1 for a NULL handle.
+///
+/// # Safety
+/// `sequencer` is NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_sequencer_reset(sequencer: *mut GyrofxSequencer) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe {
+        with(sequencer, |s| {
+            s.0.reset();
+            Ok(())
+        })
+    }
+}
+
+/// One clock that takes a sample: writes this clock's (combinational) slot, then advances.
+/// Returns 0, or -1 for a NULL handle.
+///
+/// # Safety
+/// `sequencer` is NULL or live; each output NULL or writable.
+#[no_mangle]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn gyrofx_sequencer_step(
+    sequencer: *mut GyrofxSequencer,
+    mode_a: *mut i32,
+    mode_b: *mut i32,
+    blank_a: *mut i32,
+    blank_b: *mut i32,
+    interval_a: *mut i32,
+    interval_b: *mut i32,
+    done_a: *mut i32,
+    done_b: *mut i32,
+    window_done: *mut i32,
+) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe {
+        with(sequencer, |s| {
+            let outputs = [
+                mode_a,
+                mode_b,
+                blank_a,
+                blank_b,
+                interval_a,
+                interval_b,
+                done_a,
+                done_b,
+                window_done,
+            ];
+            for (out, code) in outputs.into_iter().zip(s.0.step()) {
+                put(out, code as i32);
+            }
+            Ok(())
+        })
+    }
+}
+
+/// The least-squares bias estimator (`gyrofx_bias_estimator`).
+pub struct GyrofxEstimator(golden::Estimator);
+
+/// An estimator from reset; NULL when `plan` is NULL.
+///
+/// # Safety
+/// `plan` is NULL or a live plan.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_estimator_new(plan: *const GyrofxPlan) -> *mut GyrofxEstimator {
+    // SAFETY: forwarded contract.
+    unsafe {
+        new(plan, |job| {
+            GyrofxEstimator(golden::Estimator::new(&job.chain.estimator))
+        })
+    }
+}
+
+/// Frees an estimator.
+///
+/// # Safety
+/// `estimator` is NULL or from `gyrofx_estimator_new`, not freed before.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_estimator_free(estimator: *mut GyrofxEstimator) {
+    // SAFETY: forwarded contract.
+    unsafe { free(estimator) }
+}
+
+/// The synchronous reset. Returns 0, or -1 for a NULL handle.
+///
+/// # Safety
+/// `estimator` is NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_estimator_reset(estimator: *mut GyrofxEstimator) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe {
+        with(estimator, |e| {
+            e.0.reset();
+            Ok(())
+        })
+    }
+}
+
+/// One sample: both gyros' codes and the sequencer's slot; writes the registered outputs
+/// after the clock. Returns 0, or -1 for a refused input.
+///
+/// # Safety
+/// `estimator` is NULL or live; each output NULL or writable.
+#[no_mangle]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn gyrofx_estimator_step(
+    estimator: *mut GyrofxEstimator,
+    y_a: i64,
+    y_b: i64,
+    blank_a: i32,
+    blank_b: i32,
+    done_a: i32,
+    done_b: i32,
+    interval_a: i32,
+    interval_b: i32,
+    window_done: i32,
+    bias_a: *mut i64,
+    bias_b: *mut i64,
+    estimated: *mut i32,
+) -> i32 {
+    let slot = [
+        blank_a,
+        blank_b,
+        done_a,
+        done_b,
+        interval_a,
+        interval_b,
+        window_done,
+    ]
+    .map(i64::from);
+    // SAFETY: forwarded contract.
+    unsafe {
+        with(estimator, |e| {
+            let [a, b, done] = e.0.step([y_a, y_b], slot)?;
+            put(bias_a, a);
+            put(bias_b, b);
+            put(estimated, done as i32);
+            Ok(())
+        })
+    }
+}
+
+/// The mean filter with gross-error rejection (`gyrofx_mean_filter`).
+pub struct GyrofxMeanFilter(golden::MeanFilter);
+
+/// A mean filter from reset; NULL when `plan` is NULL.
+///
+/// # Safety
+/// `plan` is NULL or a live plan.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_mean_filter_new(plan: *const GyrofxPlan) -> *mut GyrofxMeanFilter {
+    // SAFETY: forwarded contract.
+    unsafe {
+        new(plan, |job| {
+            GyrofxMeanFilter(golden::MeanFilter::new(&job.mean_filter))
+        })
+    }
+}
+
+/// Frees a mean filter.
+///
+/// # Safety
+/// `filter` is NULL or from `gyrofx_mean_filter_new`, not freed before.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_mean_filter_free(filter: *mut GyrofxMeanFilter) {
+    // SAFETY: forwarded contract.
+    unsafe { free(filter) }
+}
+
+/// The synchronous reset. Returns 0, or -1 for a NULL handle.
+///
+/// # Safety
+/// `filter` is NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_mean_filter_reset(filter: *mut GyrofxMeanFilter) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe {
+        with(filter, |f| {
+            f.0.reset();
+            Ok(())
+        })
+    }
+}
+
+/// One sample `x`: writes `y_valid` and, on a block's last sample, `y` and `kept` (else 0).
+/// Returns 0, or -1 for a refused input.
+///
+/// # Safety
+/// `filter` is NULL or live; each output NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_mean_filter_step(
+    filter: *mut GyrofxMeanFilter,
+    x: i64,
+    y_valid: *mut i32,
+    y: *mut i64,
+    kept: *mut i64,
+) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe {
+        with(filter, |f| {
+            let (valid, mean, count) = match f.0.step(x)? {
+                Some((mean, count)) => (1, mean, count),
+                None => (0, 0, 0),
+            };
+            put(y_valid, valid);
+            put(y, mean);
+            put(kept, count);
+            Ok(())
+        })
+    }
+}
+
+/// The whole chain (`gyrofx_top`).
+pub struct GyrofxChain(golden::Chain);
+
+/// A chain from reset; NULL when `plan` is NULL.
+///
+/// # Safety
+/// `plan` is NULL or a live plan.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_chain_new(plan: *const GyrofxPlan) -> *mut GyrofxChain {
+    // SAFETY: forwarded contract.
+    unsafe { new(plan, |job| GyrofxChain(golden::Chain::new(&job.chain))) }
+}
+
+/// Frees a chain.
+///
+/// # Safety
+/// `chain` is NULL or from `gyrofx_chain_new`, not freed before.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_chain_free(chain: *mut GyrofxChain) {
+    // SAFETY: forwarded contract.
+    unsafe { free(chain) }
+}
+
+/// The synchronous reset. Returns 0, or -1 for a NULL handle.
+///
+/// # Safety
+/// `chain` is NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_chain_reset(chain: *mut GyrofxChain) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe {
+        with(chain, |c| {
+            c.0.reset();
+            Ok(())
+        })
+    }
+}
+
+/// The modes (1 normal, 0 reverse) the next sample runs in. Returns 0, or -1 for NULL.
+///
+/// # Safety
+/// `chain` is NULL or live; each output NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_chain_next_modes(
+    chain: *mut GyrofxChain,
+    mode_a: *mut i32,
+    mode_b: *mut i32,
+) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe {
+        with(chain, |c| {
+            let [a, b] = c.0.next_modes();
+            put(mode_a, a as i32);
+            put(mode_b, b as i32);
+            Ok(())
+        })
+    }
+}
+
+/// One sample: both gyros' codes and `bw_sel`; writes the output ports (`rate_out` 0 where
+/// `out_valid` is 0). Returns 0, or -1 for a refused input.
+///
+/// # Safety
+/// `chain` is NULL or live; each output NULL or writable.
+#[no_mangle]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn gyrofx_chain_step(
+    chain: *mut GyrofxChain,
+    y_a: i64,
+    y_b: i64,
+    bw_sel: i32,
+    mode_a: *mut i32,
+    mode_b: *mut i32,
+    out_valid: *mut i32,
+    rate_out: *mut i64,
+    bias_a: *mut i64,
+    bias_b: *mut i64,
+    estimated: *mut i32,
+) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe {
+        with(chain, |c| {
+            let [ma, mb, valid, rate, a, b, done] = c.0.step(y_a, y_b, i64::from(bw_sel))?;
+            put(mode_a, ma as i32);
+            put(mode_b, mb as i32);
+            put(out_valid, valid as i32);
+            put(rate_out, rate);
+            put(bias_a, a);
+            put(bias_b, b);
+            put(estimated, done as i32);
+            Ok(())
+        })
+    }
+}

@@ -1,0 +1,354 @@
+//! The package's DPI-C testbenches (`dpi/`): per block with a golden model, a SystemVerilog
+//! testbench that imports the model's step from gyrofx's C ABI (`capi/`, `libgyrofx_capi`)
+//! and scoreboards the DUT against it in Verilator, with random stimulus over the whole input
+//! range and a small-signal half.
+//!
+//! Outputs qualified by a valid flag are compared as a stream (a queue of expected values),
+//! whatever the latency; combinational outputs before the clock edge that takes the sample,
+//! registered outputs without a valid flag one clock after it. Each testbench prints
+//! `PASS n=<N>` or `FAIL mismatches=<M> n=<N>` and exits non-zero on a mismatch or a refused
+//! model call. Plusargs: `+samples=<n>`, `+seed=<n>`, `+flip=<k>` (flip bit 0 of the k-th
+//! expected value: the testbench must then fail).
+
+use std::fmt::Write as _;
+
+use crate::block::{Block, Signal};
+use crate::cocotb::instance;
+use crate::writers::Provenance;
+
+/// Folder of the DPI-C testbenches in a package.
+pub const FOLDER: &str = "dpi";
+
+/// Blocks with a DPI-C testbench.
+pub const BLOCKS: [&str; 5] = ["sequencer", "estimator", "kf", "top", "mean_filter"];
+
+/// The blocks of `blocks` that have a DPI-C testbench, in the package's order.
+pub fn tested(blocks: &[Block]) -> Vec<&Block> {
+    blocks.iter().filter(|b| BLOCKS.contains(&b.name)).collect()
+}
+
+/// Every file of the package's `dpi/` folder: `(path, text)`.
+pub fn files(blocks: &[Block], provenance: &Provenance) -> Vec<(String, String)> {
+    tested(blocks)
+        .into_iter()
+        .map(|block| {
+            (
+                format!("{FOLDER}/tb_dpi_{}.sv", block.module),
+                testbench(block, provenance),
+            )
+        })
+        .collect()
+}
+
+fn declaration(signal: &Signal, kind: &str) -> String {
+    let signed = if signal.format.signed { " signed" } else { "" };
+    let range = if signal.format.width > 1 {
+        format!(" [{}:0]", signal.format.width - 1)
+    } else {
+        String::new()
+    };
+    format!("{kind}{signed}{range} {};", signal.name)
+}
+
+/// Imports every block's model functions need (the plan's and the error's, then the block's).
+fn imports(block: &str) -> &'static str {
+    match block {
+        "kf" => {
+            "import \"DPI-C\" function chandle gyrofx_kf_new(input chandle plan);
+import \"DPI-C\" function int gyrofx_kf_reset(input chandle kf);
+import \"DPI-C\" function int gyrofx_kf_step(input chandle kf, input longint z, input int bw_sel, output longint rate_out);"
+        }
+        "mean_filter" => {
+            "import \"DPI-C\" function chandle gyrofx_mean_filter_new(input chandle plan);
+import \"DPI-C\" function int gyrofx_mean_filter_reset(input chandle filter);
+import \"DPI-C\" function int gyrofx_mean_filter_step(input chandle filter, input longint x, output int y_valid, output longint y, output longint kept);"
+        }
+        "top" => {
+            "import \"DPI-C\" function chandle gyrofx_chain_new(input chandle plan);
+import \"DPI-C\" function int gyrofx_chain_reset(input chandle chain);
+import \"DPI-C\" function int gyrofx_chain_step(input chandle chain, input longint y_a, input longint y_b, input int bw_sel,
+    output int mode_a, output int mode_b, output int out_valid, output longint rate_out,
+    output longint bias_a, output longint bias_b, output int estimated);"
+        }
+        _ => {
+            "import \"DPI-C\" function chandle gyrofx_sequencer_new(input chandle plan);
+import \"DPI-C\" function int gyrofx_sequencer_reset(input chandle sequencer);
+import \"DPI-C\" function int gyrofx_sequencer_step(input chandle sequencer, output int mode_a, output int mode_b,
+    output int blank_a, output int blank_b, output int interval_a, output int interval_b,
+    output int done_a, output int done_b, output int window_done);
+import \"DPI-C\" function chandle gyrofx_estimator_new(input chandle plan);
+import \"DPI-C\" function int gyrofx_estimator_reset(input chandle estimator);
+import \"DPI-C\" function int gyrofx_estimator_step(input chandle estimator, input longint y_a, input longint y_b,
+    input int blank_a, input int blank_b, input int done_a, input int done_b,
+    input int interval_a, input int interval_b, input int window_done,
+    output longint bias_a, output longint bias_b, output int estimated);"
+        }
+    }
+}
+
+/// The per-sample body of the block's stimulus loop (after the driver set `ce`; `k` counts
+/// samples) and the names of its model handles.
+fn body(block: &Block) -> (&'static str, String) {
+    match block.name {
+        "kf" => (
+            "kf = gyrofx_kf_new(plan);",
+            "            bw_sel = (k % 97 == 0) ? $urandom_range(P_ROM_DEPTH - 1, 0) : bw_sel;
+            z = random_code(P_IN_W, k);
+            check_call(gyrofx_kf_step(kf, longint'(z), int'(bw_sel), rate));
+            expect_stream(rate, 0);
+            @(posedge clk);"
+                .to_string(),
+        ),
+        "mean_filter" => (
+            "filter = gyrofx_mean_filter_new(plan);",
+            "            x = random_code(P_IN_W, k);
+            check_call(gyrofx_mean_filter_step(filter, longint'(x), valid, rate, model_kept));
+            if (valid == 1) expect_stream(rate, model_kept);
+            @(posedge clk);"
+                .to_string(),
+        ),
+        "top" => (
+            "chain = gyrofx_chain_new(plan);",
+            "            bw_sel = (k % 97 == 0) ? $urandom_range(P_ROM_DEPTH - 1, 0) : bw_sel;
+            y_a = random_code(P_IN_W, k);
+            y_b = random_code(P_IN_W, k + 1);
+            check_call(gyrofx_chain_step(chain, longint'(y_a), longint'(y_b), int'(bw_sel),
+                model_mode_a, model_mode_b, valid, rate, bias_a_model, bias_b_model, estimated_model));
+            #1;
+            compare(longint'(mode_a), longint'(model_mode_a), \"mode_a\");
+            compare(longint'(mode_b), longint'(model_mode_b), \"mode_b\");
+            if (valid == 1) expect_stream(rate, 0);
+            @(posedge clk);
+            #1;
+            compare(longint'(bias_a), flip_next(bias_a_model), \"bias_a\");
+            compare(longint'(bias_b), bias_b_model, \"bias_b\");
+            compare(longint'(estimated), longint'(estimated_model), \"estimated\");"
+                .to_string(),
+        ),
+        "sequencer" => (
+            "sequencer = gyrofx_sequencer_new(plan);",
+            "            check_call(gyrofx_sequencer_step(sequencer, model_mode_a, model_mode_b, model_blank_a,
+                model_blank_b, model_interval_a, model_interval_b, model_done_a, model_done_b,
+                model_window_done));
+            #1;
+            compare(longint'(mode_a), flip_next(longint'(model_mode_a)), \"mode_a\");
+            compare(longint'(mode_b), longint'(model_mode_b), \"mode_b\");
+            compare(longint'(blank_a), longint'(model_blank_a), \"blank_a\");
+            compare(longint'(blank_b), longint'(model_blank_b), \"blank_b\");
+            compare(longint'(interval_a), longint'(model_interval_a), \"interval_a\");
+            compare(longint'(interval_b), longint'(model_interval_b), \"interval_b\");
+            compare(longint'(done_a), longint'(model_done_a), \"done_a\");
+            compare(longint'(done_b), longint'(model_done_b), \"done_b\");
+            compare(longint'(window_done), longint'(model_window_done), \"window_done\");
+            @(posedge clk);"
+                .to_string(),
+        ),
+        _ => (
+            "sequencer = gyrofx_sequencer_new(plan);\n        estimator = gyrofx_estimator_new(plan);",
+            "            // The slot comes from the sequencer's own model: the estimator's protocol.
+            check_call(gyrofx_sequencer_step(sequencer, model_mode_a, model_mode_b, model_blank_a,
+                model_blank_b, model_interval_a, model_interval_b, model_done_a, model_done_b,
+                model_window_done));
+            y_a = random_code(P_IN_W, k);
+            y_b = random_code(P_IN_W, k + 1);
+            blank_a = model_blank_a[0];
+            blank_b = model_blank_b[0];
+            done_a = model_done_a[0];
+            done_b = model_done_b[0];
+            interval_a = model_interval_a[TB_INTERVAL_W - 1:0];
+            interval_b = model_interval_b[TB_INTERVAL_W - 1:0];
+            window_done = model_window_done[0];
+            check_call(gyrofx_estimator_step(estimator, longint'(y_a), longint'(y_b), model_blank_a,
+                model_blank_b, model_done_a, model_done_b, model_interval_a, model_interval_b,
+                model_window_done, bias_a_model, bias_b_model, estimated_model));
+            @(posedge clk);
+            #1;
+            compare(longint'(bias_a), flip_next(bias_a_model), \"bias_a\");
+            compare(longint'(bias_b), bias_b_model, \"bias_b\");
+            compare(longint'(estimated), longint'(estimated_model), \"estimated\");"
+                .to_string(),
+        ),
+    }
+}
+
+/// The valid flag and the ports of the block's stream outputs (`None`: no stream).
+fn stream(block: &str) -> Option<(&'static str, &'static str, Option<&'static str>)> {
+    match block {
+        "kf" | "top" => Some(("out_valid", "rate_out", None)),
+        "mean_filter" => Some(("y_valid", "y", Some("kept"))),
+        _ => None,
+    }
+}
+
+/// The DPI-C testbench of `block`.
+pub fn testbench(block: &Block, provenance: &Provenance) -> String {
+    let tb = format!("tb_dpi_{}", block.module);
+    let (handles, step) = body(block);
+    let mut declarations: Vec<String> = block
+        .inputs
+        .iter()
+        .map(|s| declaration(s, "logic"))
+        .collect();
+    declarations.extend(block.outputs.iter().map(|o| declaration(&o.signal, "wire")));
+    let interval_width = block
+        .inputs
+        .iter()
+        .chain(block.outputs.iter().map(|o| &o.signal))
+        .find(|s| s.name == "interval_a")
+        .map_or(1, |s| s.format.width);
+    let monitor = match stream(block.name) {
+        Some((valid, value, second)) => format!(
+            "// The stream: each valid-qualified output against the oldest expected one, whatever
+// the latency (sampled mid-cycle, after the registers settled).
+always @(negedge clk) begin
+    if (!rst && {valid} == 1'b1) begin
+        if (expected_first.size() == 0) begin
+            mismatches = mismatches + 1;
+            $display(\"MISMATCH {value} = %0d with none expected\", longint'({value}));
+        end else begin
+            compare(longint'({value}), expected_first.pop_front(), \"{value}\");
+            {second}
+        end
+    end
+end
+",
+            second = match second {
+                Some(name) =>
+                    format!("compare(longint'({name}), expected_second.pop_front(), \"{name}\");"),
+                None => "void'(expected_second.pop_front());".to_string(),
+            },
+        ),
+        None => String::new(),
+    };
+    let mut out = String::new();
+    let _ = write!(
+        out,
+        "{provenance}
+// Language: SystemVerilog (Verilator --binary --timing), with DPI-C imports from libgyrofx_capi.
+`timescale 1ns / 1ps
+`default_nettype none
+
+/*
+ * {tb}: {module} ({title}) against gyrofx's golden model through DPI-C (see the package
+ * README): random codes over the input range (every other stretch of 64 samples at 1/256 of
+ * it), the model of this package's manifest stepped beside the DUT. PASS n=<N> or
+ * FAIL mismatches=<M> n=<N>; plusargs +samples=<n> (default 4000), +seed=<n>, +flip=<k>.
+ */
+module {tb};
+
+`include \"{params_file}\"
+localparam integer TB_INTERVAL_W = {interval_width};
+
+import \"DPI-C\" function chandle gyrofx_plan_from_package(input string folder);
+import \"DPI-C\" function void gyrofx_plan_free(input chandle plan);
+import \"DPI-C\" function string gyrofx_last_error();
+{imports}
+
+logic clk = 1'b0;
+always #5 clk = ~clk;
+logic rst = 1'b1;
+logic ce = 1'b0;
+{declarations}
+
+{instance}
+chandle plan, kf, filter, chain, sequencer, estimator;
+longint rate, model_kept, bias_a_model, bias_b_model;
+int valid, model_mode_a, model_mode_b, estimated_model;
+int model_blank_a, model_blank_b, model_interval_a, model_interval_b;
+int model_done_a, model_done_b, model_window_done;
+longint expected_first[$];
+longint expected_second[$];
+int compared = 0;
+int mismatches = 0;
+int expected_count = 0;
+int flip = -1;
+int samples = 4000;
+int seed = 1;
+int k;
+
+// A random code of a `width`-bit signed port: the whole range, or 1/256 of it in every
+// other stretch of 64 samples (small signals, where rounding rather than saturation rules).
+function automatic longint random_code(input int width, input int sample);
+    longint wide;
+    wide = {{$urandom(), $urandom()}};
+    wide = wide >>> (64 - width);
+    if ((sample / 64) % 2 == 1) wide = wide >>> 8;
+    return wide;
+endfunction
+
+// The next expected value, bit 0 flipped when it is the +flip=<k>-th.
+function automatic longint flip_next(input longint value);
+    flip_next = (expected_count == flip) ? (value ^ 64'sd1) : value;
+    expected_count = expected_count + 1;
+endfunction
+
+function automatic void expect_stream(input longint first, input longint second);
+    expected_first.push_back(flip_next(first));
+    expected_second.push_back(second);
+endfunction
+
+function automatic void compare(input longint actual, input longint expected, input string name);
+    compared = compared + 1;
+    if (actual != expected) begin
+        mismatches = mismatches + 1;
+        if (mismatches <= 10)
+            $display(\"MISMATCH sample %0d signal %s expected %0d actual %0d\", k, name, expected, actual);
+    end
+endfunction
+
+function automatic void check_call(input int status);
+    if (status != 0) $fatal(1, \"the model refused an input: %s\", gyrofx_last_error());
+endfunction
+
+{monitor}
+initial begin
+    void'($value$plusargs(\"samples=%d\", samples));
+    void'($value$plusargs(\"seed=%d\", seed));
+    void'($value$plusargs(\"flip=%d\", flip));
+    void'($urandom(seed));
+    plan = gyrofx_plan_from_package(\"..\");
+    if (plan == null) $fatal(1, \"gyrofx_plan_from_package: %s\", gyrofx_last_error());
+    {handles}
+    repeat (4) @(posedge clk);
+    @(negedge clk);
+    rst = 1'b0;
+    for (k = 0; k < samples; k = k + 1) begin
+        @(negedge clk);
+        ce = 1'b1;
+{step}
+        if ($urandom_range(3, 0) == 0) begin
+            @(negedge clk);
+            ce = 1'b0;
+            @(posedge clk);
+        end
+    end
+    @(negedge clk);
+    ce = 1'b0;
+    repeat (16) @(posedge clk);
+    @(negedge clk);
+    if (expected_first.size() != 0) begin
+        mismatches = mismatches + 1;
+        $display(\"MISMATCH %0d expected outputs never came\", expected_first.size());
+    end
+    gyrofx_plan_free(plan);
+    if (mismatches == 0 && compared > 0) begin
+        $display(\"PASS n=%0d\", compared);
+        $finish;
+    end else begin
+        $display(\"FAIL mismatches=%0d n=%0d\", mismatches, compared);
+        $fatal(1, \"{tb} failed\");
+    end
+end
+
+endmodule
+",
+        provenance = provenance.line("//"),
+        module = block.module,
+        title = block.title,
+        params_file = block.file("params.vh"),
+        imports = imports(block.name),
+        declarations = declarations.join("\n"),
+        instance = instance(block),
+    );
+    out
+}

@@ -1,0 +1,185 @@
+//! The C ABI (`capi/`) end to end: a C program against the header, the package's DPI-C
+//! testbenches in Verilator (through `gyrofx verify --sim dpi`), their failure on one flipped
+//! expected bit and on a mutated RTL line, and the C++ Verilator harness example.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use common::{generate_default, run_tool, text};
+use gyrofx_codegen::config::Config;
+use gyrofx_codegen::golden;
+use gyrofx_codegen::job::Job;
+
+/// The repository.
+fn repository() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// `libgyrofx_capi.a` of this build (the workspace builds it beside the test binaries' folder).
+fn library() -> PathBuf {
+    let exe = std::env::current_exe().unwrap();
+    let profile = exe.parent().and_then(Path::parent).unwrap();
+    let library = profile.join("libgyrofx_capi.a");
+    assert!(
+        library.is_file(),
+        "{} is missing: cargo test --workspace builds it (the capi member)",
+        library.display()
+    );
+    library
+}
+
+#[test]
+fn a_c_program_gets_the_models_results_and_its_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let program = dir.path().join("check_api");
+    let (built, log) = run_tool(
+        "gcc",
+        &[
+            "-std=c99",
+            "-Wall",
+            "-Werror",
+            "-I",
+            repository().join("capi/include").to_str().unwrap(),
+            repository()
+                .join("capi/examples/check_api.c")
+                .to_str()
+                .unwrap(),
+            library().to_str().unwrap(),
+            "-lpthread",
+            "-ldl",
+            "-lm",
+            "-o",
+            program.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    assert!(built, "{log}");
+    let (ran, out) = run_tool(program.to_str().unwrap(), &[], dir.path());
+    assert!(ran, "{out}");
+    assert!(
+        out.contains("bad plan NULL: ") && out.contains("kf.bandwidths_hz"),
+        "{out}"
+    );
+    assert!(
+        out.contains("refused z: -1 z = 1099511627776 is not a code of"),
+        "{out}"
+    );
+    assert!(
+        out.contains("refused bw_sel: -1 bw_sel = 2 does not address"),
+        "{out}"
+    );
+    assert!(out.contains("null step: -1 block is NULL"), "{out}");
+    // The same steps in Rust: the C side must see the same codes.
+    let job =
+        Job::new(Config::from_toml("[kf]\nbandwidths_hz = [5.0, 10.0]\n", "t").unwrap()).unwrap();
+    let mut kf = golden::Kf::new(job.kf());
+    let want: Vec<String> = (0..50i64)
+        .map(|k| {
+            let z = (k * 7919 % 20001) - 10000;
+            format!("rate {}", kf.step(z, k / 25).unwrap())
+        })
+        .collect();
+    let got: Vec<&str> = out.lines().filter(|l| l.starts_with("rate ")).collect();
+    assert_eq!(got, want);
+}
+
+#[test]
+fn the_dpi_testbenches_pass_fail_on_a_flipped_bit_and_on_a_mutated_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let package = generate_default(dir.path(), "1000");
+    let library = library();
+    // Every block through verify (Verilator, the model through DPI-C).
+    let output = Command::new(env!("CARGO_BIN_EXE_gyrofx"))
+        .args(["verify", "--out", package.to_str().unwrap(), "--sim", "dpi"])
+        .env("GYROFX_CAPI_LIB", &library)
+        .output()
+        .unwrap();
+    let log = text(&output);
+    assert!(output.status.success(), "{log}");
+    assert!(log.contains("dpi: passed"), "{log}");
+    for block in ["sequencer", "estimator", "kf", "top", "mean_filter"] {
+        assert!(log.contains(&format!("== {block}")), "{block}: {log}");
+    }
+    // One flipped expected bit fails it with exactly one mismatch.
+    let make = |folder: &Path, target: &str, extra: &[&str]| {
+        let mut args = vec![
+            "--no-print-directory".to_string(),
+            target.to_string(),
+            format!("GYROFX_CAPI_LIB={}", library.display()),
+        ];
+        args.extend(extra.iter().map(|s| s.to_string()));
+        let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+        run_tool("make", &refs, folder)
+    };
+    for block in ["kf", "estimator"] {
+        let (passed, log) = make(
+            &package,
+            &format!("dpi-{block}"),
+            &["DPI_PLUSARGS=+flip=30"],
+        );
+        assert!(!passed, "{block}: {log}");
+        assert!(log.contains("FAIL mismatches=1 "), "{block}: {log}");
+    }
+    // A mutated RTL line fails it.
+    let rtl = package.join("hdl/gyrofx_kf.v");
+    let source = std::fs::read_to_string(&rtl).unwrap();
+    assert!(source.contains("x2_reg <= x2_next;"));
+    std::fs::write(
+        &rtl,
+        source.replace("x2_reg <= x2_next;", "x2_reg <= x2_reg;"),
+    )
+    .unwrap();
+    let (passed, log) = make(&package, "dpi-kf", &[]);
+    assert!(!passed && log.contains("FAIL mismatches="), "{log}");
+    std::fs::write(&rtl, source).unwrap();
+    // Without the library the error says what to set.
+    let output = Command::new(env!("CARGO_BIN_EXE_gyrofx"))
+        .args(["verify", "--out", package.to_str().unwrap(), "--sim", "dpi"])
+        .env_remove("GYROFX_CAPI_LIB")
+        .output()
+        .unwrap();
+    assert!(!output.status.success());
+    assert!(
+        text(&output).contains("GYROFX_CAPI_LIB"),
+        "{}",
+        text(&output)
+    );
+}
+
+#[test]
+fn the_cpp_verilator_harness_checks_the_kf_against_the_c_api() {
+    let dir = tempfile::tempdir().unwrap();
+    let package = generate_default(dir.path(), "500");
+    let kf = package.join("kf");
+    let harness = repository().join("capi/examples/verilator_kf_harness.cpp");
+    let ldflags = format!("{} -lpthread -ldl -lm", library().display());
+    let include = format!("-I{}", repository().join("capi/include").display());
+    let (built, log) = run_tool(
+        "verilator",
+        &[
+            "--cc",
+            "--exe",
+            "--build",
+            "-j",
+            "2",
+            "-Wno-fatal",
+            "-I.",
+            "--top-module",
+            "cocotb_gyrofx_kf",
+            "../hdl/gyrofx_quantize.v",
+            "../hdl/gyrofx_kf.v",
+            "../cocotb/cocotb_gyrofx_kf.v",
+            harness.to_str().unwrap(),
+            "-CFLAGS",
+            &include,
+            "-LDFLAGS",
+            &ldflags,
+        ],
+        &kf,
+    );
+    assert!(built, "{log}");
+    let (passed, out) = run_tool("./obj_dir/Vcocotb_gyrofx_kf", &["3000"], &kf);
+    assert!(passed && out.contains("PASS n=3000"), "{out}");
+}
