@@ -377,6 +377,12 @@ manifest: outputs with a valid flag as a stream whatever the latency, so your ow
 another pipeline depth passes as long as its valid-qualified stream matches; the reference
 timing for combinational ports and registered ports without a valid flag.
 
+`dpi/` holds a SystemVerilog testbench per block of those that imports the model's `step`
+from gyrofx's C library through DPI-C and scoreboards the DUT in Verilator the same way:
+`make sim-dpi GYROFX_CAPI_LIB=<gyrofx>/target/release/libgyrofx_capi.a` (built by
+`cargo build --release -p gyrofx-capi`), or `make dpi-kf ...`; `DPI_PLUSARGS` takes
+`+samples=<n> +seed=<n> +flip=<k>` (flip bit 0 of the k-th expected value: it must then fail).
+
 Fixed vs float (same quantized coefficients): KF max {kf:.3} LSB (bound {kfb:.3}), chain max
 {ch:.3} LSB (bound {chb:.3}), bias estimates max {bi:.3} LSB (bound {bib:.3}), mean filter max
 {mf:.3} LSB (bound {mfb:.3}).
