@@ -84,6 +84,9 @@ ghdl -a --std=08 -Werror -Wunused -Wbinding -Wbody -Wspecs --workdir="$ghdl_work
     hdl/gyrofx_cic.vhd hdl/gyrofx_gyro_loop.vhd hdl/gyrofx_system.vhd hdl/gyrofx_testbench_pkg.vhd
 rm -rf "$ghdl_work"
 echo "== cargo test"
+# The C library's archive (libgyrofx_capi.a) is an artifact of a plain build, not of the test
+# build: tests/dpi.rs links it into a C program, a C++ Verilator harness and the DPI-C testbenches.
+cargo build -p gyrofx-capi
 cargo test --workspace
 
 # The Python package (python/): pyo3 + numpy, built by maturin as an abi3 wheel into a

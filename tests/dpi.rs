@@ -24,7 +24,7 @@ fn library() -> PathBuf {
     let library = profile.join("libgyrofx_capi.a");
     assert!(
         library.is_file(),
-        "{} is missing: cargo test --workspace builds it (the capi member)",
+        "{} is missing: cargo build -p gyrofx-capi makes it (scripts/test.sh does, before the tests)",
         library.display()
     );
     library

@@ -70,14 +70,14 @@ pub fn provenance(
 }
 
 /// One file of a block's folder: its text, or the entry of a file its rows were streamed to.
-enum BlockFile {
+pub(crate) enum BlockFile {
     Text(String, String),
     Written(FileEntry),
 }
 
 /// Every file of one block's folder, in the package's order: the parameter include, the
 /// vector files (streamed already: their entries), the testbenches and the ROM images.
-fn block_files(block: &Block, provenance: &Provenance) -> Vec<BlockFile> {
+pub(crate) fn block_files(block: &Block, provenance: &Provenance) -> Vec<BlockFile> {
     let text =
         |name: String, content: String| BlockFile::Text(format!("{}/{name}", block.name), content);
     let mut files = vec![text(
@@ -102,7 +102,7 @@ fn block_files(block: &Block, provenance: &Provenance) -> Vec<BlockFile> {
     files
 }
 
-fn block_manifest(block: &Block) -> serde_json::Value {
+pub(crate) fn block_manifest(block: &Block) -> serde_json::Value {
     let fields = |signals: Vec<(&str, String)>| -> Vec<serde_json::Value> {
         signals
             .into_iter()

@@ -38,6 +38,8 @@ pub enum Kind {
     Synth,
     /// `gyrofx reproduce --out`: a paper's reproduction.
     Reproduce,
+    /// `gyrofx filter --vectors`: the KF's vectors of a filtered record.
+    Filter,
 }
 
 impl Kind {
@@ -47,11 +49,12 @@ impl Kind {
             Kind::Generate => "generate",
             Kind::Synth => "synth",
             Kind::Reproduce => "reproduce",
+            Kind::Filter => "filter",
         }
     }
 
     fn from_name(name: &str) -> Option<Kind> {
-        [Kind::Generate, Kind::Synth, Kind::Reproduce]
+        [Kind::Generate, Kind::Synth, Kind::Reproduce, Kind::Filter]
             .into_iter()
             .find(|k| k.name() == name)
     }

@@ -9,8 +9,11 @@ use std::io::Write;
 use anyhow::{Context, Result};
 
 use gyrofx_codegen::config::Config;
-use gyrofx_codegen::job::{design_bandwidths, plan_for};
+use gyrofx_codegen::filter_package::FilterPackage;
+use gyrofx_codegen::job::{design_bandwidths, plan_for, Job};
 use gyrofx_codegen::output_folder;
+use gyrofx_codegen::package::sha256_hex;
+use gyrofx_codegen::writers::Provenance;
 use gyrofx_model::fx::{from_f64, Overflow, Rounding};
 use gyrofx_model::kf::{FixedKf, FloatKf};
 
@@ -38,6 +41,14 @@ pub struct Args {
     /// KF quantizer overflowed; without it that is a warning.
     #[arg(long)]
     strict: bool,
+    /// Also write the KF block's vectors of this record into this folder: its RTL, ROM,
+    /// Verilog, VHDL, cocotb and DPI-C testbenches, a Makefile and a manifest with the
+    /// recording's SHA-256.
+    #[arg(long)]
+    vectors: Option<PathBuf>,
+    /// Replace the --vectors folder even when gyrofx did not write it.
+    #[arg(long)]
+    force: bool,
 }
 
 /// Samples the KF runs between two formatting rounds.
@@ -74,6 +85,24 @@ fn format_rows(rows: &[Row], first: usize, plan: &gyrofx_model::kf::Plan) -> Vec
     text
 }
 
+/// The command that rewrites the vectors (as the files' generated-by line gives it).
+fn filter_provenance(job: &Job, csv: &CsvColumn, fs: f64, bandwidth: Option<f64>) -> Provenance {
+    let mut command = format!(
+        "gyrofx filter --input {} --column {} --fs {fs}",
+        csv.input.display(),
+        csv.column
+    );
+    if let Some(bw) = bandwidth {
+        command.push_str(&format!(" --bandwidth {bw}"));
+    }
+    command.push_str(" --output <file> --vectors <folder>");
+    Provenance {
+        version: env!("CARGO_PKG_VERSION").to_string(),
+        command,
+        config_sha256: sha256_hex(job.config.to_toml().as_bytes()),
+    }
+}
+
 /// Writes the CSV atomically (one row per sample: the input, its code, the fixed-point and the
 /// float rate) and prints a summary with the saturation and overflow counts.
 pub fn run(args: Args) -> Result<ExitCode> {
@@ -84,6 +113,8 @@ pub fn run(args: Args) -> Result<ExitCode> {
         config,
         output,
         strict,
+        vectors,
+        force,
     } = args;
     let output = output.as_path();
     if let (Ok(input), Ok(existing)) = (csv.input.canonicalize(), output.canonicalize()) {
@@ -130,6 +161,21 @@ pub fn run(args: Args) -> Result<ExitCode> {
         config.kf.rrw_deg_per_h_per_sqrt_h,
     )?;
     let plan = plan_for(&settings, &designs)?;
+    // The vectors' folder is checked, and their files opened, before the work.
+    let job_and_package = match &vectors {
+        Some(folder) => {
+            let job = Job::new(config.clone())?;
+            let provenance = filter_provenance(&job, &csv, fs, bandwidth);
+            let package =
+                FilterPackage::create(folder, &job, &provenance, super::options::replace(force))?;
+            Some((job, provenance, package))
+        }
+        None => None,
+    };
+    let (job, mut package) = match job_and_package {
+        Some((job, provenance, package)) => (Some((job, provenance)), Some(package)),
+        None => (None, None),
+    };
     let values = csv.read()?;
     let mut fixed = FixedKf::new(&plan);
     let mut float = FloatKf::new(plan.gains.clone());
@@ -157,9 +203,13 @@ pub fn run(args: Args) -> Result<ExitCode> {
                 let q = from_f64(*value, plan.input, Rounding::Nearest, Overflow::Saturate)?;
                 saturated += u64::from(q.overflowed);
                 let z = q.code as i64;
+                let rate = fixed.step(z, 0);
+                if let Some(package) = package.as_mut() {
+                    package.push(z, rate);
+                }
                 rows.push(Row {
                     z,
-                    rate: fixed.step(z, 0),
+                    rate,
                     reference: float.step(*value, 0),
                 });
             }
@@ -207,6 +257,24 @@ pub fn run(args: Args) -> Result<ExitCode> {
     staged
         .persist(output)
         .with_context(|| format!("output {}: cannot move into place", output.display()))?;
+    if let (Some(package), Some((job, provenance)), Some(folder)) = (package, job, &vectors) {
+        let recording = serde_json::json!({
+            "input": csv.input.display().to_string(),
+            "column": csv.column,
+            "sha256": gyrofx_codegen::package::file_sha256(&csv.input)?,
+            "samples": values.len(),
+            "fs_hz": fs,
+            "bandwidth_hz": settings.bandwidths_hz[0],
+            "quantization": format!("nearest, saturate into {}", plan.input),
+        });
+        let files = package.finish(&job, &provenance, recording)?;
+        println!(
+            "wrote the KF's vectors of the record ({} files) -> {}; run them with make -C {} iverilog-kf",
+            files.len(),
+            folder.display(),
+            folder.display()
+        );
+    }
     println!(
         "filtered {} samples at {} Hz, bandwidth {} Hz -> {}; ADC saturations {}, overflows x1 {} x2 {} rate_hat {}",
         values.len(),
