@@ -214,6 +214,9 @@ pub fn build_package(
         "report": run.report,
     });
     let sections = manifest.as_object_mut().expect("an object");
+    if let Some(recording) = &job.recording {
+        sections.insert("recording".into(), recording.manifest(run.samples));
+    }
     for block in crate::blocks::of(job) {
         if let Some((key, section)) = block.manifest(job, &roms, &run) {
             sections.insert(key.to_string(), section);

@@ -29,6 +29,31 @@ pub fn read_column_with_gaps(path: &Path, column: &str) -> Result<(Vec<f64>, usi
     read(path, column, true)
 }
 
+/// The header of the CSV file at `path`: the cells of its first line that is neither blank nor
+/// a `#` comment, trimmed.
+///
+/// # Errors
+/// [`Error::Io`] when the file cannot be read, [`Error::Input`] when it has no header line.
+pub fn read_header(path: &Path) -> Result<Vec<String>> {
+    use std::io::BufRead;
+    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    for line in std::io::BufReader::new(file).lines() {
+        let line = line.map_err(|e| Error::io(path, e))?;
+        let line = line.trim_start_matches('\u{feff}').trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        return Ok(line
+            .split(',')
+            .map(|cell| cell.trim().trim_matches('"').to_string())
+            .collect());
+    }
+    Err(Error::Input {
+        path: path.to_path_buf(),
+        message: "the file is empty: expected a header line naming the columns".into(),
+    })
+}
+
 fn read(path: &Path, column: &str, gaps: bool) -> Result<(Vec<f64>, usize)> {
     match read_plain(path, column, gaps)? {
         Some(result) => Ok(result),

@@ -11,6 +11,7 @@ use gyrofx_model::mean_filter;
 use crate::config::{Config, GyroLoop, KfSettings, Settings, Source};
 use crate::error::{Error, Result};
 use crate::input::read_column;
+use crate::recording::Recording;
 
 /// A resolved job.
 #[derive(Clone, Debug)]
@@ -32,6 +33,9 @@ pub struct Job {
     /// ([`crate::blocks::system::chain_plan`]); `None` on the rate plant, whose loops' output
     /// need not be the chain's input.
     pub system_chain: Option<chain::Plan>,
+    /// Recorded gyro outputs that drive the chain instead of the plant (`generate
+    /// --recording`), checked against the config by [`Job::with_recording`].
+    pub recording: Option<std::sync::Arc<Recording>>,
 }
 
 /// Designs one filter per bandwidth of `settings` at `fs_hz` for the noise model (°/√h, °/h/√h).
@@ -131,7 +135,35 @@ impl Job {
             mean_filter,
             gyro_loops,
             system_chain,
+            recording: None,
         })
+    }
+
+    /// The job with `recording` driving the chain: its rate must be the config's and its
+    /// modes (when it has a mode column) the sequencer's over the job's samples, which must
+    /// not exceed its rows.
+    ///
+    /// # Errors
+    /// A recording shorter than the job's samples, at another rate, or out of step.
+    pub fn with_recording(mut self, recording: Recording) -> Result<Job> {
+        let samples = self.config.samples;
+        if recording.len() < samples {
+            return Err(Error::Config {
+                field: "samples".into(),
+                value: samples.to_string(),
+                allowed: format!(
+                    "at most the recording's {} rows (leave --samples out to use them all)",
+                    recording.len()
+                ),
+            });
+        }
+        recording.check(
+            self.config.stimulus.fs_hz,
+            &self.chain.estimator.schedule,
+            samples,
+        )?;
+        self.recording = Some(std::sync::Arc::new(recording));
+        Ok(self)
     }
 
     /// The KF's plan.

@@ -25,6 +25,7 @@ pub mod output_folder;
 pub mod package;
 pub mod plot;
 pub mod progress;
+pub mod recording;
 pub mod report;
 pub mod reproduce;
 pub mod rom;

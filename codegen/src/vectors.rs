@@ -255,7 +255,12 @@ fn run_with(
     let chunk = (n / (2 * entries)).max(1);
     // One reset of the whole chain, late in the run, so that the report has a long stretch of
     // calibrated output before it.
-    let reset_at = if n >= 20 { Some(n - n / 10) } else { None };
+    // A recording runs without it: its rows follow the sequencer from the first on.
+    let reset_at = if n >= 20 && job.recording.is_none() {
+        Some(n - n / 10)
+    } else {
+        None
+    };
 
     let mut builders: Vec<_> = Vec::new();
     for registered in crate::blocks::of(job).filter(|b| b.has_vectors()) {
@@ -408,6 +413,14 @@ enum Gyros {
         normal: Box<[FixedClosedLoop; 2]>,
         scale: f64,
     },
+    /// Recorded outputs (`generate --recording`): already in the sequencer's modes; the
+    /// report's "without reversal" rows show the same record.
+    Recorded {
+        recording: std::sync::Arc<crate::recording::Recording>,
+        next: usize,
+        input: Format,
+        saturations: [u64; 2],
+    },
 }
 
 /// Start-up before the record: the loops lock from rest (about 80 ms for paper 004's gyro).
@@ -424,6 +437,14 @@ impl Gyros {
     fn new(job: &Job, rate0: f64) -> Result<Self> {
         let seed = job.config.seed;
         let input = job.chain.estimator.input;
+        if let Some(recording) = &job.recording {
+            return Ok(Gyros::Recorded {
+                recording: recording.clone(),
+                next: 0,
+                input,
+                saturations: [0; 2],
+            });
+        }
         Ok(match &job.settings.resonator {
             None => {
                 let plant = &job.settings.plant;
@@ -527,6 +548,26 @@ impl Gyros {
                     batch.raw.push([raw_a, raw_b]);
                 }
             }
+            Gyros::Recorded {
+                recording,
+                next,
+                input,
+                saturations,
+            } => {
+                let rows = *next..*next + len;
+                let [(a, sat_a), (b, sat_b)] =
+                    [0, 1].map(|g| adc(&recording.rates_dps[g][rows.clone()], *input));
+                saturations[0] += sat_a;
+                saturations[1] += sat_b;
+                batch
+                    .codes
+                    .extend(a.into_iter().zip(b).map(|(a, b)| [a, b]));
+                batch.raw.extend(
+                    rows.clone()
+                        .map(|k| [recording.rates_dps[0][k], recording.rates_dps[1][k]]),
+                );
+                *next += len;
+            }
         }
     }
 
@@ -537,6 +578,7 @@ impl Gyros {
             Gyros::Resonator { reversed, .. } => reversed
                 .each_ref()
                 .map(|gyro| gyro.resonator.adc_saturations()),
+            Gyros::Recorded { saturations, .. } => *saturations,
         }
     }
 }

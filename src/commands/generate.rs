@@ -1,6 +1,7 @@
 //! `gyrofx generate`: the verification package (vectors, ROMs, testbenches, RTL, manifest),
 //! written atomically.
 
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Result;
@@ -8,8 +9,10 @@ use anyhow::Result;
 use gyrofx_codegen::generate::{generate, overflow_list, Contents, Options, Output};
 use gyrofx_codegen::job::Job;
 use gyrofx_codegen::progress::Progress;
+use gyrofx_codegen::recording::{Recording, Units};
 
 use super::options::{ConfigSource, OutputFolder};
+use super::usage;
 
 /// Write the verification package (vectors, ROM, testbench, RTL, manifest) atomically.
 #[derive(clap::Args)]
@@ -38,6 +41,29 @@ pub struct Args {
     /// No progress bar (it shows only on a terminal).
     #[arg(long)]
     quiet: bool,
+    /// Recorded outputs of the two gyros (CSV) that drive the chain's blocks (sequencer,
+    /// estimator, KF, top, mean filter) instead of the simulated plant; the manifest records
+    /// its SHA-256. Samples: its rows (or --samples of them).
+    #[arg(long)]
+    recording: Option<PathBuf>,
+    /// The recording's columns of gyro A and B, by name or 0-based index.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        num_args = 1,
+        default_value = "y_a_dps,y_b_dps"
+    )]
+    recording_columns: Vec<String>,
+    /// The recording's unit: dps (°/s) or rad/s.
+    #[arg(long, default_value = "dps")]
+    recording_units: String,
+    /// The recording's sample rate, Hz (must be the config's stimulus.fs_hz).
+    #[arg(long, allow_negative_numbers = true)]
+    recording_rate: Option<f64>,
+    /// A column with gyro A's mode per row (1 normal, 0 or -1 reverse), checked against the
+    /// configured sequencer; without it the rows are taken to follow the sequencer.
+    #[arg(long)]
+    recording_mode: Option<String>,
 }
 
 /// Writes the package and prints what it holds: the files, the KF plan, the fixed-point
@@ -52,6 +78,11 @@ pub fn run(args: Args) -> Result<ExitCode> {
         blocks,
         no_csv,
         quiet,
+        recording,
+        recording_columns,
+        recording_units,
+        recording_rate,
+        recording_mode,
     } = args;
     let contents = Contents {
         blocks,
@@ -60,15 +91,45 @@ pub fn run(args: Args) -> Result<ExitCode> {
     contents.check().map_err(super::Usage)?;
     let out = folder.out.as_path();
     let mut config = source.load()?;
-    if let Some(n) = samples {
-        config.samples = n;
-    }
+    let recording = match recording {
+        Some(path) => {
+            let [a, b] = <[String; 2]>::try_from(recording_columns).map_err(|c| {
+                super::Usage(format!(
+                    "--recording-columns {}: name gyro A's and gyro B's columns, e.g. y_a_dps,y_b_dps or 1,2",
+                    c.join(",")
+                ))
+            })?;
+            let units: Units = recording_units
+                .parse()
+                .map_err(|e: String| super::Usage(format!("--recording-units: {e}")))?;
+            let Some(rate) = recording_rate else {
+                usage!("--recording needs --recording-rate HZ (the recording's sample rate; the chain runs at stimulus.fs_hz = {} Hz)", config.stimulus.fs_hz);
+            };
+            let recording =
+                Recording::read(&path, [&a, &b], units, rate, recording_mode.as_deref())?;
+            // Every row, unless --samples asks for fewer.
+            config.samples = samples.unwrap_or(recording.len());
+            Some(recording)
+        }
+        None => {
+            if let Some(n) = samples {
+                config.samples = n;
+            }
+            None
+        }
+    };
     if let Some(s) = seed {
         config.seed = s;
     }
-    let job = Job::new(config)?;
+    let mut job = Job::new(config)?;
+    if let Some(recording) = recording {
+        job = job.with_recording(recording)?;
+    }
     contents.check_for(&job).map_err(super::Usage)?;
-    let provenance = source.provenance(&job, Output::Package);
+    let mut provenance = source.provenance(&job, Output::Package);
+    if let Some(recording) = &job.recording {
+        provenance.command.push_str(&recording.arguments());
+    }
     let options = Options {
         replace: folder.replace(),
         strict,
