@@ -12,6 +12,7 @@ use std::fmt::Write as _;
 
 use crate::block::{Block, Signal};
 use crate::hdl::RTL_SOURCES;
+use crate::testbench::verilog::instance;
 use crate::writers::Provenance;
 
 /// The shared driver, protocol and scoreboard.
@@ -116,39 +117,6 @@ endmodule
         instance = instance(block),
     );
     out
-}
-
-/// The block's module named `dut`, its parameters from `P_<NAME>` (the params file's), each
-/// port on the signal of its name.
-pub fn instance(block: &Block) -> String {
-    let params: Vec<String> = block
-        .params
-        .iter()
-        .map(|p| format!("    .{0}(P_{0})", p.name))
-        .collect();
-    let mut connections = vec![
-        "    .clk(clk)".to_string(),
-        "    .rst(rst)".into(),
-        "    .ce(ce)".into(),
-    ];
-    connections.extend(
-        block
-            .inputs
-            .iter()
-            .map(|s| format!("    .{0}({0})", s.name)),
-    );
-    connections.extend(
-        block
-            .outputs
-            .iter()
-            .map(|o| format!("    .{0}({0})", o.signal.name)),
-    );
-    format!(
-        "{} #(\n{}\n) dut (\n{}\n);\n",
-        block.module,
-        params.join(",\n"),
-        connections.join(",\n")
-    )
 }
 
 /// `<block>.mk`: cocotb's makefile set up for the block, run from the block's folder.

@@ -13,7 +13,7 @@
 use std::fmt::Write as _;
 
 use crate::block::{Block, Signal};
-use crate::cocotb::instance;
+use crate::testbench::verilog::instance;
 use crate::writers::Provenance;
 
 /// Folder of the DPI-C testbenches in a package.

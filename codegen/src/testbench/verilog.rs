@@ -45,6 +45,39 @@ fn mismatch(o: &Output) -> String {
     )
 }
 
+/// The block's module named `dut`, its parameters from `P_<NAME>` (the params file's), each
+/// port on the signal of its name.
+pub fn instance(block: &Block) -> String {
+    let params: Vec<String> = block
+        .params
+        .iter()
+        .map(|p| format!("    .{0}(P_{0})", p.name))
+        .collect();
+    let mut connections = vec![
+        "    .clk(clk)".to_string(),
+        "    .rst(rst)".into(),
+        "    .ce(ce)".into(),
+    ];
+    connections.extend(
+        block
+            .inputs
+            .iter()
+            .map(|s| format!("    .{0}({0})", s.name)),
+    );
+    connections.extend(
+        block
+            .outputs
+            .iter()
+            .map(|o| format!("    .{0}({0})", o.signal.name)),
+    );
+    format!(
+        "{} #(\n{}\n) dut (\n{}\n);\n",
+        block.module,
+        params.join(",\n"),
+        connections.join(",\n")
+    )
+}
+
 /// The testbench of `block`.
 pub fn testbench(block: &Block, provenance: &Provenance) -> String {
     let tb = format!("tb_{}", block.module);
@@ -100,31 +133,7 @@ reg ce = 1'b0;",
         let _ = writeln!(out, "{}", declaration("wire", &o.signal, "", false));
     }
     // DUT
-    let _ = writeln!(out, "\n{} #(", block.module);
-    let params: Vec<String> = block
-        .params
-        .iter()
-        .map(|p| format!("    .{0}(P_{0})", p.name))
-        .collect();
-    let _ = writeln!(out, "{}\n) dut (", params.join(",\n"));
-    let mut ports = vec![
-        "    .clk(clk)".to_string(),
-        "    .rst(rst)".into(),
-        "    .ce(ce)".into(),
-    ];
-    ports.extend(
-        block
-            .inputs
-            .iter()
-            .map(|s| format!("    .{0}({0})", s.name)),
-    );
-    ports.extend(
-        block
-            .outputs
-            .iter()
-            .map(|o| format!("    .{0}({0})", o.signal.name)),
-    );
-    let _ = writeln!(out, "{}\n);\n", ports.join(",\n"));
+    let _ = writeln!(out, "\n{}", instance(block));
 
     // Variables
     let _ = writeln!(
