@@ -4,7 +4,7 @@
 //! `gyrofx` Python package (the same Rust model as the vectors). The shared driver and
 //! scoreboard are `cocotb/gyrofx_cocotb.py`.
 //!
-//! Run from the package: `make cocotb-<block>` (`COCOTB_SIM=icarus`, the default), or
+//! Run from the package: `make cocotb-<block>` (`SIM=icarus`, the default), or
 //! `gyrofx verify --sim cocotb`. cocotb 2.x runs Verilator only from 5.036 on; Debian 12's
 //! 5.006 is refused by cocotb's own makefile, so Icarus is the simulator CI runs.
 

@@ -211,8 +211,8 @@ ghdl-{name}:
             "
 # The cocotb tests ({folder}/): make sim-cocotb or make cocotb-<block> ({list}). They need
 # cocotb 2.x and the gyrofx Python package (pip install <gyrofx>/python) for the python3 on
-# PATH. COCOTB_SIM picks cocotb's simulator: icarus (its Verilator support needs 5.036 or later).
-COCOTB_SIM ?= icarus
+# PATH. SIM picks cocotb's simulator: icarus (its Verilator support needs 5.036 or later).
+SIM ?= icarus
 .PHONY: sim-cocotb{phony}
 sim-cocotb:{targets}
 ",
@@ -233,7 +233,7 @@ sim-cocotb:{targets}
                 "
 cocotb-{name}:
 \t@echo \"== {name}\"
-\tcd {name} && $(MAKE) --no-print-directory -f ../{folder}/{name}.mk SIM=$(COCOTB_SIM)
+\tcd {name} && $(MAKE) --no-print-directory -f ../{folder}/{name}.mk SIM=$(SIM)
 ",
                 folder = crate::cocotb::FOLDER,
             );
@@ -370,7 +370,7 @@ SHA-256 of every file, overflow counts and fixed-vs-float error statistics.
 
 `cocotb/` holds a cocotb test per block that has a Python model (`make sim-cocotb`, or
 `make cocotb-kf`; cocotb 2.x and the gyrofx Python package, `pip install <gyrofx>/python`, for
-the python3 on PATH; Icarus by default, `COCOTB_SIM` picks another of cocotb's simulators,
+the python3 on PATH; Icarus by default (`SIM=icarus`), `SIM` picks another of cocotb's simulators,
 Verilator from 5.036 on). Each drives the RTL with random and directed stimulus (seed
 `COCOTB_RANDOM_SEED`, default 1) and checks it live against the model of this package's
 manifest: outputs with a valid flag as a stream whatever the latency, so your own RTL with
