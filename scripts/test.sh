@@ -12,6 +12,9 @@
 # not run: run them with `cargo bench`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# Nothing here reads the terminal: with stdin from whatever started the script, cargo's probe of
+# rustc (`rustc -`, which reads its program from stdin) once read stray text and failed.
+exec </dev/null
 
 font=/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf
 missing=()
