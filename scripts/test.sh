@@ -12,8 +12,18 @@
 # not run: run them with `cargo bench`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-# Nothing here reads the terminal: with stdin from whatever started the script, cargo's probe of
-# rustc (`rustc -`, which reads its program from stdin) once read stray text and failed.
+# cargo probes rustc with `rustc -`, whose program comes from /dev/null: on a machine where
+# /dev/null had become a regular file collecting every `>/dev/null`, that probe read stray
+# compiler messages and failed. Put the device back where we can, else say so.
+if [ ! -c /dev/null ]; then
+    if [ "$(id -u)" -eq 0 ]; then
+        echo "== /dev/null is not a character device: recreating it"
+        rm -f /dev/null && mknod -m 666 /dev/null c 1 3
+    else
+        echo "FAIL: /dev/null is not a character device (ask an administrator: mknod -m 666 /dev/null c 1 3)" >&2
+        exit 1
+    fi
+fi
 exec </dev/null
 
 font=/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf
