@@ -162,7 +162,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
     )?;
     let plan = plan_for(&settings, &designs)?;
     // The vectors' folder is checked, and their files opened, before the work.
-    let job_and_package = match &vectors {
+    let mut kf_vectors = match &vectors {
         Some(folder) => {
             let job = Job::new(config.clone())?;
             let provenance = filter_provenance(&job, &csv, fs, bandwidth);
@@ -171,10 +171,6 @@ pub fn run(args: Args) -> Result<ExitCode> {
             Some((job, provenance, package))
         }
         None => None,
-    };
-    let (job, mut package) = match job_and_package {
-        Some((job, provenance, package)) => (Some((job, provenance)), Some(package)),
-        None => (None, None),
     };
     let values = csv.read()?;
     let mut fixed = FixedKf::new(&plan);
@@ -204,7 +200,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
                 saturated += u64::from(q.overflowed);
                 let z = q.code as i64;
                 let rate = fixed.step(z, 0);
-                if let Some(package) = package.as_mut() {
+                if let Some((_, _, package)) = kf_vectors.as_mut() {
                     package.push(z, rate);
                 }
                 rows.push(Row {
@@ -257,7 +253,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
     staged
         .persist(output)
         .with_context(|| format!("output {}: cannot move into place", output.display()))?;
-    if let (Some(package), Some((job, provenance)), Some(folder)) = (package, job, &vectors) {
+    if let (Some((job, provenance, package)), Some(folder)) = (kf_vectors, &vectors) {
         let recording = serde_json::json!({
             "input": csv.input.display().to_string(),
             "column": csv.column,
