@@ -18,7 +18,8 @@ use crate::writers::Provenance;
 /// The shared driver, protocol and scoreboard.
 const SHARED: &str = include_str!("cocotb/gyrofx_cocotb.py");
 
-/// Blocks with a cocotb test (a Python model of theirs exists), with the test module.
+/// Blocks with a cocotb test (those with a golden model, [`crate::golden::BLOCKS`]), with the
+/// test module.
 pub const TESTS: [(&str, &str); 5] = [
     ("sequencer", include_str!("cocotb/test_sequencer.py")),
     ("estimator", include_str!("cocotb/test_estimator.py")),
@@ -167,4 +168,13 @@ pub fn build_outputs(blocks: &[Block]) -> Vec<String> {
         out.push(format!("{FOLDER}/__pycache__/"));
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn every_block_with_a_golden_model_has_a_cocotb_test() {
+        let names: Vec<&str> = super::TESTS.iter().map(|(name, _)| *name).collect();
+        assert_eq!(names, crate::golden::BLOCKS);
+    }
 }

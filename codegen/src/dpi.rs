@@ -19,12 +19,13 @@ use crate::writers::Provenance;
 /// Folder of the DPI-C testbenches in a package.
 pub const FOLDER: &str = "dpi";
 
-/// Blocks with a DPI-C testbench.
-pub const BLOCKS: [&str; 5] = ["sequencer", "estimator", "kf", "top", "mean_filter"];
-
-/// The blocks of `blocks` that have a DPI-C testbench, in the package's order.
+/// The blocks of `blocks` that have a DPI-C testbench (those with a golden model), in the
+/// package's order.
 pub fn tested(blocks: &[Block]) -> Vec<&Block> {
-    blocks.iter().filter(|b| BLOCKS.contains(&b.name)).collect()
+    blocks
+        .iter()
+        .filter(|b| crate::golden::BLOCKS.contains(&b.name))
+        .collect()
 }
 
 /// Every file of the package's `dpi/` folder: `(path, text)`.

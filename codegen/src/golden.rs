@@ -13,6 +13,10 @@ use gyrofx_model::kf::{self, FixedKf};
 use gyrofx_model::mean_filter::{self, FixedMeanFilter};
 use gyrofx_model::sequencer::{self, Schedule, Slot};
 
+/// The blocks with a golden model here, by folder name: the ones that get cocotb and DPI-C
+/// testbenches.
+pub const BLOCKS: [&str; 5] = ["sequencer", "estimator", "kf", "top", "mean_filter"];
+
 /// A refused input: the message names the port, the value and what is allowed.
 pub type PortResult<T> = std::result::Result<T, String>;
 

@@ -73,12 +73,22 @@ class Scoreboard:
         self.mismatches = []
         self.flip = int(os.environ.get("GYROFX_COCOTB_FLIP_EXPECTED", "-1"))
 
-    def expect(self, values):
+    def _next(self, values):
+        """The next expected value, bit 0 of its first field flipped when it is the
+        GYROFX_COCOTB_FLIP_EXPECTED-th."""
         values = tuple(values)
         if self.expected_count == self.flip:
             values = (values[0] ^ 1,) + values[1:]
         self.expected_count += 1
-        self.pending.append(values)
+        return values
+
+    def expect(self, values):
+        """An output the DUT will give under its valid flag, in order."""
+        self.pending.append(self._next(values))
+
+    def check(self, expected, actual, where):
+        """An output the DUT gives at a known clock (no valid flag): compared at once."""
+        self.compare(self._next(expected), actual, where)
 
     def compare(self, expected, actual, where):
         self.compared += 1
