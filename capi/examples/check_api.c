@@ -1,6 +1,7 @@
 /* A C program against gyrofx.h (the test in tests/dpi.rs builds and runs it): a plan from
- * TOML text, a refused config and a refused input with their messages, and a KF run whose
- * outputs the test compares with the Rust model. Prints one line per result. */
+ * TOML text, a refused config and a refused input with their messages, a KF run, and gyro B's
+ * loop and the system on a few samples, whose outputs the test compares with the Rust model.
+ * Prints one line per result. */
 #include <stdint.h>
 #include <stdio.h>
 
@@ -16,7 +17,40 @@ int main(void) {
         return 1;
     }
     GyrofxKf *kf = gyrofx_kf_new(plan);
-    gyrofx_plan_free(plan); /* the KF keeps its own copy */
+    GyrofxGyroLoop *no_loop = gyrofx_gyro_loop_new(plan, 2);
+    printf("bad gyro %s: %s\n", no_loop == NULL ? "NULL" : "made", gyrofx_last_error());
+    GyrofxGyroLoop *loop = gyrofx_gyro_loop_new(plan, 1);
+    GyrofxSystem *system = gyrofx_system_new(plan);
+    gyrofx_plan_free(plan); /* the blocks keep their own copies */
+    int64_t dac_x, dac_y, loop_rate, quadrature;
+    int locked, valid;
+    printf("refused mode: %d ", gyrofx_gyro_loop_step(loop, 0, 0, 2, &dac_x, &dac_y, &locked, &valid,
+                                                       &loop_rate, &quadrature));
+    printf("%s\n", gyrofx_last_error());
+    for (int64_t k = 0; k < 20; ++k) {
+        if (gyrofx_gyro_loop_step(loop, k * 40009 % 1000003, -k * 7, (int)(k < 10), &dac_x, &dac_y,
+                                  &locked, &valid, &loop_rate, &quadrature) != 0)
+            return 1;
+        printf("loop %lld %lld %d %d\n", (long long)dac_x, (long long)dac_y, locked, valid);
+    }
+    int64_t dac[4], rate_out, bias_a, bias_b;
+    int flags[2], modes[2], estimated;
+    for (int64_t k = 0; k < 20; ++k) {
+        int next[2];
+        if (gyrofx_system_next_modes(system, &next[0], &next[1]) != 0) return 1;
+        if (gyrofx_system_step(system, (int)(k >= 5), 0, k * 1000, -k * 1000, k * 77, 3 - k, &dac[0],
+                               &dac[1], &dac[2], &dac[3], &flags[0], &flags[1], &modes[0], &modes[1],
+                               &valid, &rate_out, &bias_a, &bias_b, &estimated) != 0)
+            return 1;
+        printf("system %d %d %lld %lld %lld %lld %d %d\n", next[0], next[1], (long long)dac[0],
+               (long long)dac[1], (long long)dac[2], (long long)dac[3], modes[0], modes[1]);
+    }
+    gyrofx_gyro_loop_free(loop);
+    gyrofx_system_free(system);
+    GyrofxPlan *rate_plant = gyrofx_plan_from_toml("[plant]\nmodel = \"rate\"\n");
+    GyrofxSystem *no_system = gyrofx_system_new(rate_plant);
+    printf("no system for the rate plant, %s: %s\n", no_system == NULL ? "NULL" : "made", gyrofx_last_error());
+    gyrofx_plan_free(rate_plant);
     int64_t rate = 0;
     int status = gyrofx_kf_step(kf, INT64_C(1) << 40, 0, &rate);
     printf("refused z: %d %s\n", status, gyrofx_last_error());

@@ -13,6 +13,9 @@ typedef struct GyrofxChain GyrofxChain;
 // The least-squares bias estimator (`gyrofx_bias_estimator`).
 typedef struct GyrofxEstimator GyrofxEstimator;
 
+// One gyro's digital loop (`gyrofx_gyro_loop`).
+typedef struct GyrofxGyroLoop GyrofxGyroLoop;
+
 // The steady-state KF (`gyrofx_kf`).
 typedef struct GyrofxKf GyrofxKf;
 
@@ -25,6 +28,9 @@ typedef struct GyrofxPlan GyrofxPlan;
 
 // The mode-reversal sequencer (`gyrofx_sequencer`).
 typedef struct GyrofxSequencer GyrofxSequencer;
+
+// The whole gyro (`gyrofx_system`): both loops and the chain.
+typedef struct GyrofxSystem GyrofxSystem;
 
 #ifdef __cplusplus
 extern "C" {
@@ -233,6 +239,98 @@ int32_t gyrofx_chain_step(struct GyrofxChain *chain,
                           int64_t *bias_a,
                           int64_t *bias_b,
                           int32_t *estimated);
+
+// Gyro `gyro`'s loop (0: A, whose plan the block's vectors and RTL parameters use; 1: B) from
+// reset; NULL when `plan` is NULL or `gyro` is neither.
+//
+// # Safety
+// `plan` is NULL or a live plan.
+struct GyrofxGyroLoop *gyrofx_gyro_loop_new(const struct GyrofxPlan *plan,
+                                            int32_t gyro);
+
+// Frees a loop.
+//
+// # Safety
+// `gyro_loop` is NULL or from `gyrofx_gyro_loop_new`, not freed before.
+void gyrofx_gyro_loop_free(struct GyrofxGyroLoop *gyro_loop);
+
+// The synchronous reset. Returns 0, or -1 for a NULL handle.
+//
+// # Safety
+// `gyro_loop` is NULL or live.
+int32_t gyrofx_gyro_loop_reset(struct GyrofxGyroLoop *gyro_loop);
+
+// One ADC sample: both axes' ADC codes and `mode` (1 normal, 0 reverse); writes the output
+// ports (`rate` and `quadrature` hold their last values where `out_valid` is 0, as the RTL's
+// do). Returns 0, or -1 for a refused input.
+//
+// # Safety
+// `gyro_loop` is NULL or live; each output NULL or writable.
+int32_t gyrofx_gyro_loop_step(struct GyrofxGyroLoop *gyro_loop,
+                              int64_t adc_x,
+                              int64_t adc_y,
+                              int32_t mode,
+                              int64_t *dac_x,
+                              int64_t *dac_y,
+                              int32_t *locked,
+                              int32_t *out_valid,
+                              int64_t *rate,
+                              int64_t *quadrature);
+
+// The system from reset; NULL when `plan` is NULL or its plant has no system (the rate
+// plant).
+//
+// # Safety
+// `plan` is NULL or a live plan.
+struct GyrofxSystem *gyrofx_system_new(const struct GyrofxPlan *plan);
+
+// Frees a system.
+//
+// # Safety
+// `system` is NULL or from `gyrofx_system_new`, not freed before.
+void gyrofx_system_free(struct GyrofxSystem *system);
+
+// The synchronous reset. Returns 0, or -1 for a NULL handle.
+//
+// # Safety
+// `system` is NULL or live.
+int32_t gyrofx_system_reset(struct GyrofxSystem *system);
+
+// The modes (1 normal, 0 reverse) the loops take at the next sample if `enable` is 1 there.
+// Returns 0, or -1 for NULL.
+//
+// # Safety
+// `system` is NULL or live; each output NULL or writable.
+int32_t gyrofx_system_next_modes(struct GyrofxSystem *system,
+                                 int32_t *mode_a,
+                                 int32_t *mode_b);
+
+// One ADC sample: `enable`, `bw_sel` and both gyros' ADC codes; writes the output ports
+// (`mode_a`, `mode_b` the next sample's modes; `rate_out` holds its last value where
+// `out_valid` is 0, as the RTL's does). Returns 0, or -1 for a refused input.
+//
+// # Safety
+// `system` is NULL or live; each output NULL or writable.
+int32_t gyrofx_system_step(struct GyrofxSystem *system,
+                           int32_t enable,
+                           int32_t bw_sel,
+                           int64_t adc_a_x,
+                           int64_t adc_a_y,
+                           int64_t adc_b_x,
+                           int64_t adc_b_y,
+                           int64_t *dac_a_x,
+                           int64_t *dac_a_y,
+                           int64_t *dac_b_x,
+                           int64_t *dac_b_y,
+                           int32_t *locked_a,
+                           int32_t *locked_b,
+                           int32_t *mode_a,
+                           int32_t *mode_b,
+                           int32_t *out_valid,
+                           int64_t *rate_out,
+                           int64_t *bias_a,
+                           int64_t *bias_b,
+                           int32_t *estimated);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -588,3 +588,218 @@ pub unsafe extern "C" fn gyrofx_chain_step(
         })
     }
 }
+
+/// One gyro's digital loop (`gyrofx_gyro_loop`).
+pub struct GyrofxGyroLoop(golden::GyroLoop);
+
+/// Gyro `gyro`'s loop (0: A, whose plan the block's vectors and RTL parameters use; 1: B) from
+/// reset; NULL when `plan` is NULL or `gyro` is neither.
+///
+/// # Safety
+/// `plan` is NULL or a live plan.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_gyro_loop_new(
+    plan: *const GyrofxPlan,
+    gyro: i32,
+) -> *mut GyrofxGyroLoop {
+    let Ok(index @ 0..=1) = usize::try_from(gyro) else {
+        fail(format!("gyro = {gyro}: allowed 0 (A) or 1 (B)"));
+        return std::ptr::null_mut();
+    };
+    // SAFETY: forwarded contract.
+    unsafe {
+        new(plan, |job| {
+            GyrofxGyroLoop(golden::GyroLoop::new(&job.gyro_loops[index].plan))
+        })
+    }
+}
+
+/// Frees a loop.
+///
+/// # Safety
+/// `gyro_loop` is NULL or from `gyrofx_gyro_loop_new`, not freed before.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_gyro_loop_free(gyro_loop: *mut GyrofxGyroLoop) {
+    // SAFETY: forwarded contract.
+    unsafe { free(gyro_loop) }
+}
+
+/// The synchronous reset. Returns 0, or -1 for a NULL handle.
+///
+/// # Safety
+/// `gyro_loop` is NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_gyro_loop_reset(gyro_loop: *mut GyrofxGyroLoop) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe {
+        with(gyro_loop, |g| {
+            g.0.reset();
+            Ok(())
+        })
+    }
+}
+
+/// One ADC sample: both axes' ADC codes and `mode` (1 normal, 0 reverse); writes the output
+/// ports (`rate` and `quadrature` hold their last values where `out_valid` is 0, as the RTL's
+/// do). Returns 0, or -1 for a refused input.
+///
+/// # Safety
+/// `gyro_loop` is NULL or live; each output NULL or writable.
+#[no_mangle]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn gyrofx_gyro_loop_step(
+    gyro_loop: *mut GyrofxGyroLoop,
+    adc_x: i64,
+    adc_y: i64,
+    mode: i32,
+    dac_x: *mut i64,
+    dac_y: *mut i64,
+    locked: *mut i32,
+    out_valid: *mut i32,
+    rate: *mut i64,
+    quadrature: *mut i64,
+) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe {
+        with(gyro_loop, |g| {
+            let [x, y, lock, valid, r, q] = g.0.step(adc_x, adc_y, i64::from(mode))?;
+            put(dac_x, x);
+            put(dac_y, y);
+            put(locked, lock as i32);
+            put(out_valid, valid as i32);
+            put(rate, r);
+            put(quadrature, q);
+            Ok(())
+        })
+    }
+}
+
+/// The whole gyro (`gyrofx_system`): both loops and the chain.
+pub struct GyrofxSystem(golden::System);
+
+/// The system from reset; NULL when `plan` is NULL or its plant has no system (the rate
+/// plant).
+///
+/// # Safety
+/// `plan` is NULL or a live plan.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_system_new(plan: *const GyrofxPlan) -> *mut GyrofxSystem {
+    // SAFETY: NULL or live, by contract.
+    if let Some(plan) = unsafe { plan.as_ref() } {
+        if plan.job.system_chain.is_none() {
+            fail(golden::NO_SYSTEM);
+            return std::ptr::null_mut();
+        }
+    }
+    // SAFETY: forwarded contract.
+    unsafe {
+        new(plan, |job| {
+            let [a, b] = &job.gyro_loops;
+            let chain = job.system_chain.as_ref().expect("checked above");
+            GyrofxSystem(golden::System::new([&a.plan, &b.plan], chain))
+        })
+    }
+}
+
+/// Frees a system.
+///
+/// # Safety
+/// `system` is NULL or from `gyrofx_system_new`, not freed before.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_system_free(system: *mut GyrofxSystem) {
+    // SAFETY: forwarded contract.
+    unsafe { free(system) }
+}
+
+/// The synchronous reset. Returns 0, or -1 for a NULL handle.
+///
+/// # Safety
+/// `system` is NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_system_reset(system: *mut GyrofxSystem) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe {
+        with(system, |s| {
+            s.0.reset();
+            Ok(())
+        })
+    }
+}
+
+/// The modes (1 normal, 0 reverse) the loops take at the next sample if `enable` is 1 there.
+/// Returns 0, or -1 for NULL.
+///
+/// # Safety
+/// `system` is NULL or live; each output NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_system_next_modes(
+    system: *mut GyrofxSystem,
+    mode_a: *mut i32,
+    mode_b: *mut i32,
+) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe {
+        with(system, |s| {
+            let [a, b] = s.0.next_modes();
+            put(mode_a, a as i32);
+            put(mode_b, b as i32);
+            Ok(())
+        })
+    }
+}
+
+/// One ADC sample: `enable`, `bw_sel` and both gyros' ADC codes; writes the output ports
+/// (`mode_a`, `mode_b` the next sample's modes; `rate_out` holds its last value where
+/// `out_valid` is 0, as the RTL's does). Returns 0, or -1 for a refused input.
+///
+/// # Safety
+/// `system` is NULL or live; each output NULL or writable.
+#[no_mangle]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn gyrofx_system_step(
+    system: *mut GyrofxSystem,
+    enable: i32,
+    bw_sel: i32,
+    adc_a_x: i64,
+    adc_a_y: i64,
+    adc_b_x: i64,
+    adc_b_y: i64,
+    dac_a_x: *mut i64,
+    dac_a_y: *mut i64,
+    dac_b_x: *mut i64,
+    dac_b_y: *mut i64,
+    locked_a: *mut i32,
+    locked_b: *mut i32,
+    mode_a: *mut i32,
+    mode_b: *mut i32,
+    out_valid: *mut i32,
+    rate_out: *mut i64,
+    bias_a: *mut i64,
+    bias_b: *mut i64,
+    estimated: *mut i32,
+) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe {
+        with(system, |s| {
+            let [ax, ay, bx, by, la, lb, ma, mb, valid, rate, ba, bb, done] = s.0.step(
+                i64::from(enable),
+                i64::from(bw_sel),
+                [adc_a_x, adc_a_y, adc_b_x, adc_b_y],
+            )?;
+            put(dac_a_x, ax);
+            put(dac_a_y, ay);
+            put(dac_b_x, bx);
+            put(dac_b_y, by);
+            put(locked_a, la as i32);
+            put(locked_b, lb as i32);
+            put(mode_a, ma as i32);
+            put(mode_b, mb as i32);
+            put(out_valid, valid as i32);
+            put(rate_out, rate);
+            put(bias_a, ba);
+            put(bias_b, bb);
+            put(estimated, done as i32);
+            Ok(())
+        })
+    }
+}

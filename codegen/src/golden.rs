@@ -9,13 +9,24 @@
 use gyrofx_model::chain::{self, FixedChain};
 use gyrofx_model::estimator::{self, FixedEstimator};
 use gyrofx_model::fx::Format;
+use gyrofx_model::gyro_loop::gyro::{self as gyro_loop, FixedGyroLoop};
 use gyrofx_model::kf::{self, FixedKf};
 use gyrofx_model::mean_filter::{self, FixedMeanFilter};
+use gyrofx_model::resonator::Mode;
 use gyrofx_model::sequencer::{self, Schedule, Slot};
+use gyrofx_model::system::FixedSystem;
 
 /// The blocks with a golden model here, by folder name: the ones that get cocotb and DPI-C
 /// testbenches.
-pub const BLOCKS: [&str; 5] = ["sequencer", "estimator", "kf", "top", "mean_filter"];
+pub const BLOCKS: [&str; 7] = [
+    "sequencer",
+    "estimator",
+    "kf",
+    "top",
+    "mean_filter",
+    "gyro_loop",
+    "system",
+];
 
 /// A refused input: the message names the port, the value and what is allowed.
 pub type PortResult<T> = std::result::Result<T, String>;
@@ -47,6 +58,26 @@ pub fn check_codes(codes: &[i64], format: Format, port: &str) -> PortResult<()> 
         check_code(codes[index], format, &format!("{port}[{index}]"))?;
     }
     Ok(())
+}
+
+/// A flag port's value (0 or 1).
+pub fn check_flag(value: i64, port: &str) -> PortResult<bool> {
+    match value {
+        0 => Ok(false),
+        1 => Ok(true),
+        other => Err(format!("{port} = {other}: a flag is 0 or 1")),
+    }
+}
+
+/// A mode port (1 normal, 0 reverse) as the loop's mode.
+pub fn check_mode(value: i64, port: &str) -> PortResult<Mode> {
+    match value {
+        1 => Ok(Mode::Normal),
+        0 => Ok(Mode::Reverse),
+        other => Err(format!(
+            "{port} = {other}: a mode is 1 (normal) or 0 (reverse)"
+        )),
+    }
 }
 
 /// A `bw_sel` that addresses a ROM of `depth` entries.
@@ -183,13 +214,7 @@ pub fn slot_from_ports(
     ports: [i64; 7],
     suffix: &str,
 ) -> PortResult<Slot> {
-    let flag = |value: i64, name: &str| -> PortResult<bool> {
-        match value {
-            0 => Ok(false),
-            1 => Ok(true),
-            other => Err(format!("{name}{suffix} = {other}: a flag is 0 or 1")),
-        }
-    };
+    let flag = |value: i64, name: &str| check_flag(value, &format!("{name}{suffix}"));
     let interval = |value: i64, name: &str| -> PortResult<usize> {
         usize::try_from(value)
             .ok()
@@ -391,6 +416,213 @@ impl Chain {
             bias_a as i64,
             bias_b as i64,
             i64::from(self.model.estimator().estimated()),
+        ]
+    }
+}
+
+/// The gyro loop's output ports (`gyrofx_gyro_loop`), in the RTL's order.
+pub const GYRO_LOOP_OUTPUTS: [&str; 6] = [
+    "dac_x",
+    "dac_y",
+    "locked",
+    "out_valid",
+    "rate",
+    "quadrature",
+];
+
+/// One gyro's loop (`gyrofx_gyro_loop`): the ADC codes of both axes and the mode in, the DAC
+/// codes, the lock flag and, every `DECIMATION`-th sample, the rate and quadrature out.
+#[derive(Clone, Debug)]
+pub struct GyroLoop {
+    plan: gyro_loop::Plan,
+    model: FixedGyroLoop,
+    /// `(rate, quadrature)` of the last decimated output: the RTL holds them between pulses.
+    held: [i64; 2],
+}
+
+impl GyroLoop {
+    /// From reset.
+    pub fn new(plan: &gyro_loop::Plan) -> GyroLoop {
+        GyroLoop {
+            plan: plan.clone(),
+            model: FixedGyroLoop::new(plan),
+            held: [0; 2],
+        }
+    }
+
+    /// The plan.
+    pub fn plan(&self) -> &gyro_loop::Plan {
+        &self.plan
+    }
+
+    /// The synchronous reset.
+    pub fn reset(&mut self) {
+        self.model.reset();
+        self.held = [0; 2];
+    }
+
+    /// The checked inputs of one sample.
+    ///
+    /// # Errors
+    /// An ADC code outside the ADC format or a mode other than 0/1.
+    pub fn check(&self, adc_x: i64, adc_y: i64, mode: i64, suffix: &str) -> PortResult<Mode> {
+        check_code(adc_x, self.plan.adc, &format!("adc_x{suffix}"))?;
+        check_code(adc_y, self.plan.adc, &format!("adc_y{suffix}"))?;
+        check_mode(mode, &format!("mode{suffix}"))
+    }
+
+    /// One ADC sample: the output ports ([`GYRO_LOOP_OUTPUTS`] order) after it; `rate` and
+    /// `quadrature` hold their last decimated values where `out_valid` is 0, as the RTL's do.
+    ///
+    /// # Errors
+    /// As [`GyroLoop::check`].
+    pub fn step(&mut self, adc_x: i64, adc_y: i64, mode: i64) -> PortResult<[i64; 6]> {
+        let mode = self.check(adc_x, adc_y, mode, "")?;
+        Ok(self.step_checked([adc_x, adc_y], mode))
+    }
+
+    /// [`GyroLoop::step`] on checked inputs.
+    pub fn step_checked(&mut self, adc: [i64; 2], mode: Mode) -> [i64; 6] {
+        let step = self.model.step(adc, mode);
+        if let Some(c) = step.chain {
+            self.held = [c.rate, c.quadrature];
+        }
+        [
+            step.dac[0],
+            step.dac[1],
+            i64::from(self.model.locked()),
+            i64::from(step.chain.is_some()),
+            self.held[0],
+            self.held[1],
+        ]
+    }
+}
+
+/// The system's output ports (`gyrofx_system`), in the RTL's order.
+pub const SYSTEM_OUTPUTS: [&str; 13] = [
+    "dac_a_x",
+    "dac_a_y",
+    "dac_b_x",
+    "dac_b_y",
+    "locked_a",
+    "locked_b",
+    "mode_a",
+    "mode_b",
+    "out_valid",
+    "rate_out",
+    "bias_a",
+    "bias_b",
+    "estimated",
+];
+
+/// The system's input ports after `enable` and `bw_sel`, in the RTL's order.
+pub const SYSTEM_ADC_PORTS: [&str; 4] = ["adc_a_x", "adc_a_y", "adc_b_x", "adc_b_y"];
+
+/// Why a plan has no system: the rate plant's loops do not feed its chain.
+pub const NO_SYSTEM: &str = "plant.model = \"rate\" has no system block (its loops do not feed the chain): allowed with plant.model = \"resonator\"";
+
+/// The whole gyro (`gyrofx_system`): both gyros' loops feeding the chain, whose sequencer
+/// commands their modes.
+#[derive(Clone, Debug)]
+pub struct System {
+    loops: [gyro_loop::Plan; 2],
+    chain: chain::Plan,
+    model: FixedSystem,
+    /// `rate_out` of the chain's last output: the RTL holds it between pulses.
+    held: i64,
+}
+
+impl System {
+    /// From reset: gyro A's and B's loop plans and the system's chain plan.
+    pub fn new(loops: [&gyro_loop::Plan; 2], chain: &chain::Plan) -> System {
+        System {
+            loops: loops.map(Clone::clone),
+            chain: chain.clone(),
+            model: FixedSystem::new(loops, chain),
+            held: 0,
+        }
+    }
+
+    /// Gyro A's and B's loop plans.
+    pub fn loops(&self) -> &[gyro_loop::Plan; 2] {
+        &self.loops
+    }
+
+    /// The chain's plan (its short schedule).
+    pub fn chain_plan(&self) -> &chain::Plan {
+        &self.chain
+    }
+
+    /// The synchronous reset.
+    pub fn reset(&mut self) {
+        self.model = FixedSystem::new([&self.loops[0], &self.loops[1]], &self.chain);
+        self.held = 0;
+    }
+
+    /// The modes `[mode_a, mode_b]` (1 normal, 0 reverse) the loops take at the next sample if
+    /// `enable` is high there: what a plant needs before it produces that sample.
+    pub fn next_modes(&self) -> [i64; 2] {
+        self.model
+            .upcoming_modes()
+            .map(|m| i64::from(m == Mode::Normal))
+    }
+
+    /// The checked inputs of one sample: `(enable, bw_sel)`.
+    ///
+    /// # Errors
+    /// A flag other than 0/1, `bw_sel` beyond the ROM or an ADC code outside its format.
+    pub fn check(
+        &self,
+        enable: i64,
+        bw_sel: i64,
+        adc: [i64; 4],
+        suffix: &str,
+    ) -> PortResult<(bool, usize)> {
+        let enable = check_flag(enable, &format!("enable{suffix}"))?;
+        let bw_sel = check_bw_sel(bw_sel, self.chain.kf.rom.len(), &format!("bw_sel{suffix}"))?;
+        for (code, port) in adc.into_iter().zip(SYSTEM_ADC_PORTS) {
+            check_code(code, self.loops[0].adc, &format!("{port}{suffix}"))?;
+        }
+        Ok((enable, bw_sel))
+    }
+
+    /// One ADC sample: the output ports ([`SYSTEM_OUTPUTS`] order) after it, `mode_a`/`mode_b`
+    /// the modes of the next sample when `enable` is high; `rate_out` holds its last value
+    /// where `out_valid` is 0, as the RTL's does.
+    ///
+    /// # Errors
+    /// As [`System::check`].
+    pub fn step(&mut self, enable: i64, bw_sel: i64, adc: [i64; 4]) -> PortResult<[i64; 13]> {
+        let (enable, bw_sel) = self.check(enable, bw_sel, adc, "")?;
+        Ok(self.step_checked(enable, bw_sel, adc))
+    }
+
+    /// [`System::step`] on checked inputs.
+    pub fn step_checked(&mut self, enable: bool, bw_sel: usize, adc: [i64; 4]) -> [i64; 13] {
+        let step = self
+            .model
+            .step([[adc[0], adc[1]], [adc[2], adc[3]]], enable, bw_sel);
+        let rate = step.chain.and_then(|c| c.rate);
+        if let Some(rate) = rate {
+            self.held = rate;
+        }
+        let upcoming = self.model.upcoming_modes();
+        let estimator = self.model.chain().estimator();
+        let [bias_a, bias_b] = estimator.bias();
+        [
+            step.dac[0][0],
+            step.dac[0][1],
+            step.dac[1][0],
+            step.dac[1][1],
+            i64::from(step.locked[0]),
+            i64::from(step.locked[1]),
+            i64::from(upcoming[0] == Mode::Normal),
+            i64::from(upcoming[1] == Mode::Normal),
+            i64::from(rate.is_some()),
+            self.held,
+            bias_a as i64,
+            bias_b as i64,
+            i64::from(estimator.estimated()),
         ]
     }
 }
