@@ -64,6 +64,13 @@ class Plan:
     def mean_filter_float(self) -> MeanFilterFloat: ...
     def chain(self) -> Chain: ...
     def chain_float(self, ideal: bool = False) -> ChainFloat: ...
+    def gyro_loop(self, gyro: str = "a") -> GyroLoop:
+        """Gyro "a"'s (the block's vectors) or "b"'s digital loop."""
+    def gyro_loop_float(self, gyro: str = "a") -> GyroLoopFloat: ...
+    def system(self) -> System:
+        """Both loops and the chain (resonator plants only)."""
+    def resonator(self, gyro: str = "a", seed: Optional[int] = None, noise: bool = True) -> Resonator:
+        """The simulated resonator; seed defaults to generate's (2·seed, 2·seed + 1)."""
 
 class Kf:
     """The bit-accurate steady-state KF (gyrofx_kf); rate_out follows z by one clock in the RTL."""
@@ -181,3 +188,63 @@ class ChainFloat:
     def reset(self) -> None: ...
     def step(self, y_a: float, y_b: float, bw_sel: int = 0) -> Dict[str, Optional[float]]:
         """out_valid, rate (None when the KF did not step), bias_a, bias_b."""
+
+PerSample = Union[int, npt.ArrayLike]
+
+class GyroLoop:
+    """One gyro's digital loop (gyrofx_gyro_loop), one step per ADC sample: ADC codes of both
+    axes and the mode (1 normal, 0 reverse) in; DAC codes, locked, and every decimation-th
+    sample the rate and quadrature (°/s codes, held between out_valid pulses) out."""
+
+    adc_rate_hz: float
+    decimation: int
+    adc_format: str
+    dac_format: str
+    output_format: str
+    def reset(self) -> None: ...
+    def step(self, adc_x: int, adc_y: int, mode: int = 1) -> Dict[str, int]:
+        """dac_x, dac_y, locked, out_valid, rate, quadrature."""
+    def process(
+        self, adc_x: npt.ArrayLike, adc_y: npt.ArrayLike, mode: PerSample = 1
+    ) -> Dict[str, Codes]: ...
+
+class GyroLoopFloat:
+    """The loop's float twin: ADC in full-scale units, DAC in LSB (unquantized), rate in °/s."""
+
+    def reset(self) -> None: ...
+    def step(self, adc_x: float, adc_y: float, mode: int = 1) -> Dict[str, Optional[float]]:
+        """dac_x, dac_y, locked, out_valid, rate and quadrature (None between outputs)."""
+
+class System:
+    """The whole gyro at the ADC rate (gyrofx_system): both loops and the chain, whose
+    sequencer commands the loops' modes. enable 0 holds the chain (start-up)."""
+
+    decimation: int
+    window: int
+    def reset(self) -> None: ...
+    def next_modes(self) -> Tuple[int, int]:
+        """The modes the loops take at the next step if enable is 1."""
+    def step(
+        self, adc_a_x: int, adc_a_y: int, adc_b_x: int, adc_b_y: int, enable: int = 1, bw_sel: int = 0
+    ) -> Dict[str, int]:
+        """dac_a_x, dac_a_y, dac_b_x, dac_b_y, locked_a, locked_b, mode_a, mode_b (the next
+        sample's), out_valid, rate_out (held), bias_a, bias_b, estimated."""
+    def process(
+        self,
+        adc_a_x: npt.ArrayLike,
+        adc_a_y: npt.ArrayLike,
+        adc_b_x: npt.ArrayLike,
+        adc_b_y: npt.ArrayLike,
+        enable: PerSample = 1,
+        bw_sel: BandwidthSelect = 0,
+    ) -> Dict[str, Codes]: ...
+
+class Resonator:
+    """A simulated resonator with its front end: DAC codes in, the next ADC codes out."""
+
+    sample_rate_hz: float
+    adc_saturations: int
+    def set_rate_dps(self, rate_dps: float) -> None: ...
+    def set_mode(self, mode: int) -> None:
+        """The pick-offs follow the loop's mode (1 normal, 0 reverse) from this sample on."""
+    def step(self, dac_x: int, dac_y: int) -> Tuple[int, int]: ...

@@ -31,7 +31,7 @@ fn int_array(py: Python<'_>, values: Vec<i64>) -> Array<'_, i64> {
 
 /// The codes of a numpy array (read in place when contiguous), each checked against `format`
 /// (`port` names it in errors).
-fn port_codes<'a>(
+pub(crate) fn port_codes<'a>(
     codes: &'a PyReadonlyArray1<'_, i64>,
     format: Format,
     port: &str,
@@ -45,7 +45,7 @@ fn port_codes<'a>(
 }
 
 /// Checks that every array has `length` samples.
-fn same_length(lengths: &[(&str, usize)]) -> PyResult<usize> {
+pub(crate) fn same_length(lengths: &[(&str, usize)]) -> PyResult<usize> {
     let (first, length) = lengths[0];
     for (name, other) in &lengths[1..] {
         if *other != length {
@@ -65,7 +65,7 @@ pub(crate) enum BandwidthSelect<'py> {
 }
 
 impl BandwidthSelect<'_> {
-    fn per_sample(&self, samples: usize, rom_depth: usize) -> PyResult<Vec<usize>> {
+    pub(crate) fn per_sample(&self, samples: usize, rom_depth: usize) -> PyResult<Vec<usize>> {
         match self {
             BandwidthSelect::One(b) => Ok(vec![
                 check_bw_sel(*b, rom_depth, "bw_sel")
@@ -245,7 +245,7 @@ impl KfFloat {
 }
 
 /// A dict of one int64 array per port.
-fn port_dict<'py, const N: usize>(
+pub(crate) fn port_dict<'py, const N: usize>(
     py: Python<'py>,
     names: [&str; N],
     columns: [Vec<i64>; N],

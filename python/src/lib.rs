@@ -12,6 +12,7 @@ use pyo3::prelude::*;
 
 mod blocks;
 mod codes;
+mod loops;
 mod plan;
 
 create_exception!(
@@ -41,6 +42,10 @@ fn _gyrofx(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<blocks::MeanFilterFloat>()?;
     module.add_class::<blocks::Chain>()?;
     module.add_class::<blocks::ChainFloat>()?;
+    module.add_class::<loops::GyroLoop>()?;
+    module.add_class::<loops::GyroLoopFloat>()?;
+    module.add_class::<loops::System>()?;
+    module.add_class::<loops::Resonator>()?;
     module.add_function(wrap_pyfunction!(codes::quantize, module)?)?;
     module.add_function(wrap_pyfunction!(codes::to_real, module)?)?;
     Ok(())

@@ -14,6 +14,7 @@ use crate::blocks::{
     Chain, ChainFloat, Estimator, EstimatorFloat, Kf, KfFloat, MeanFilter, MeanFilterFloat,
     Sequencer,
 };
+use crate::loops::{GyroLoop, GyroLoopFloat, Resonator, System};
 use crate::refused;
 
 /// A resolved gyrofx config: the embedded default overlaid by a preset, a TOML text or a file,
@@ -140,6 +141,48 @@ impl Plan {
         ChainFloat::new(&self.job.chain, ideal)
     }
 
+    /// One gyro's digital loop (`gyrofx_gyro_loop`): gyro `"a"` (the block's vectors and RTL
+    /// parameters) or `"b"`.
+    #[pyo3(signature = (gyro = "a"))]
+    fn gyro_loop(&self, gyro: &str) -> PyResult<GyroLoop> {
+        Ok(GyroLoop::new(&self.gyro(gyro)?.plan))
+    }
+
+    /// The loop's float twin, gyro `"a"` or `"b"`.
+    #[pyo3(signature = (gyro = "a"))]
+    fn gyro_loop_float(&self, gyro: &str) -> PyResult<GyroLoopFloat> {
+        Ok(GyroLoopFloat::new(&self.gyro(gyro)?.plan))
+    }
+
+    /// The whole gyro at the ADC rate (`gyrofx_system`): both loops and the chain on the
+    /// system's short schedule. Only resonator plants have it.
+    fn system(&self) -> PyResult<System> {
+        let chain = self
+            .job
+            .system_chain
+            .as_ref()
+            .ok_or_else(|| refused(gyrofx_codegen::golden::NO_SYSTEM))?;
+        let [a, b] = &self.job.gyro_loops;
+        Ok(System::new([&a.plan, &b.plan], chain))
+    }
+
+    /// The simulated resonator of gyro `"a"` or `"b"` with its front end: DAC codes in, ADC
+    /// codes out. `seed` defaults to the one `generate` uses for that gyro (2·seed, 2·seed + 1),
+    /// so a loop closed around it from reset retraces the vectors' run; `noise=False` switches
+    /// its noise and drift off.
+    #[pyo3(signature = (gyro = "a", seed = None, noise = true))]
+    fn resonator(&self, gyro: &str, seed: Option<u64>, noise: bool) -> PyResult<Resonator> {
+        let index = gyro_index(gyro)?;
+        let seed = seed.unwrap_or_else(|| {
+            self.job
+                .config
+                .seed
+                .wrapping_mul(2)
+                .wrapping_add(index as u64)
+        });
+        Resonator::new(&self.job.gyro_loops[index], seed, noise)
+    }
+
     fn __repr__(&self) -> String {
         let kf = self.job.kf();
         format!(
@@ -149,12 +192,27 @@ impl Plan {
     }
 }
 
+impl Plan {
+    fn gyro(&self, gyro: &str) -> PyResult<&gyrofx_codegen::config::GyroLoop> {
+        Ok(&self.job.gyro_loops[gyro_index(gyro)?])
+    }
+}
+
+/// `"a"` 0, `"b"` 1.
+fn gyro_index(gyro: &str) -> PyResult<usize> {
+    match gyro {
+        "a" | "A" => Ok(0),
+        "b" | "B" => Ok(1),
+        other => Err(refused(format!("gyro = {other:?}: allowed \"a\" or \"b\""))),
+    }
+}
+
 /// The formats of every block's quantization points, in a fixed order.
 fn formats(job: &Job) -> Vec<(String, String)> {
     let kf = job.kf();
     let estimator = &job.chain.estimator;
     let mean = &job.mean_filter;
-    let out: Vec<(&str, gyrofx_model::fx::Format)> = vec![
+    let mut out: Vec<(&str, gyrofx_model::fx::Format)> = vec![
         ("kf.input", kf.input),
         ("kf.state", kf.state),
         ("kf.output", kf.output),
@@ -180,6 +238,24 @@ fn formats(job: &Job) -> Vec<(String, String)> {
         ("mean_filter.reciprocal", mean.reciprocal),
         ("mean_filter.product", mean.product),
     ];
+    let gyro = &job.gyro_loops[0].plan;
+    out.extend([
+        ("gyro_loop.adc", gyro.adc),
+        ("gyro_loop.nco_phase", gyro.nco.phase),
+        ("gyro_loop.nco_sine", gyro.nco.output),
+        ("gyro_loop.demod_product", gyro.demodulator.product.to),
+        ("gyro_loop.demod_state", gyro.demodulator.state.to),
+        ("gyro_loop.demod_output", gyro.demodulator.output.to),
+        ("gyro_loop.pll_integrator", gyro.pll.integrator),
+        ("gyro_loop.pll_output", gyro.pll.output.to),
+        ("gyro_loop.agc_error", gyro.agc_error.to),
+        ("gyro_loop.agc_integrator", gyro.agc.integrator),
+        ("gyro_loop.agc_output", gyro.agc.output.to),
+        ("gyro_loop.dac", gyro.dac.to),
+        ("gyro_loop.cic_internal", gyro.cic.cic.to),
+        ("gyro_loop.cic_output", gyro.cic.output.to),
+        ("gyro_loop.output", gyro.output.to),
+    ]);
     out.into_iter()
         .map(|(name, format)| (name.to_string(), format.to_string()))
         .collect()
