@@ -83,6 +83,49 @@ fn a_c_program_gets_the_models_results_and_its_errors() {
         .collect();
     let got: Vec<&str> = out.lines().filter(|l| l.starts_with("rate ")).collect();
     assert_eq!(got, want);
+    // Gyro B's loop and the system: the same codes as the Rust golden blocks.
+    assert!(
+        out.contains("bad gyro NULL: gyro = 2: allowed 0 (A) or 1 (B)"),
+        "{out}"
+    );
+    assert!(
+        out.contains("refused mode: -1 mode = 2: a mode is 1 (normal) or 0 (reverse)"),
+        "{out}"
+    );
+    assert!(
+        out.contains(
+            "no system for the rate plant, NULL: plant.model = \"rate\" has no system block"
+        ),
+        "{out}"
+    );
+    let mut gyro_loop = golden::GyroLoop::new(&job.gyro_loops[1].plan);
+    let want: Vec<String> = (0..20i64)
+        .map(|k| {
+            let [x, y, locked, valid, ..] = gyro_loop
+                .step(k * 40009 % 1000003, -k * 7, i64::from(k < 10))
+                .unwrap();
+            format!("loop {x} {y} {locked} {valid}")
+        })
+        .collect();
+    let got: Vec<&str> = out.lines().filter(|l| l.starts_with("loop ")).collect();
+    assert_eq!(got, want);
+    let [a, b] = &job.gyro_loops;
+    let mut system = golden::System::new([&a.plan, &b.plan], job.system_chain.as_ref().unwrap());
+    let want: Vec<String> = (0..20i64)
+        .map(|k| {
+            let [next_a, next_b] = system.next_modes();
+            let o = system
+                .step(i64::from(k >= 5), 0, [k * 1000, -k * 1000, k * 77, 3 - k])
+                .unwrap();
+            format!(
+                "system {next_a} {next_b} {} {} {} {} {} {}",
+                o[0], o[1], o[2], o[3], o[6], o[7]
+            )
+        })
+        .collect();
+    let got: Vec<&str> = out.lines().filter(|l| l.starts_with("system ")).collect();
+    assert_eq!(got, want);
+    assert!(want.iter().any(|l| !l.ends_with(" 0 0 0 0 1 0")));
 }
 
 #[test]
@@ -99,7 +142,7 @@ fn the_dpi_testbenches_pass_fail_on_a_flipped_bit_and_on_a_mutated_line() {
     let log = text(&output);
     assert!(output.status.success(), "{log}");
     assert!(log.contains("dpi: passed"), "{log}");
-    for block in ["sequencer", "estimator", "kf", "top", "mean_filter"] {
+    for block in gyrofx_codegen::golden::BLOCKS {
         assert!(log.contains(&format!("== {block}")), "{block}: {log}");
     }
     // One flipped expected bit fails it with exactly one mismatch.
@@ -113,11 +156,11 @@ fn the_dpi_testbenches_pass_fail_on_a_flipped_bit_and_on_a_mutated_line() {
         let refs: Vec<&str> = args.iter().map(String::as_str).collect();
         run_tool("make", &refs, folder)
     };
-    for block in ["kf", "estimator"] {
+    for block in ["kf", "estimator", "gyro_loop", "system"] {
         let (passed, log) = make(
             &package,
             &format!("dpi-{block}"),
-            &["DPI_PLUSARGS=+flip=30"],
+            &["DPI_PLUSARGS=+flip=30 +samples=1500"],
         );
         assert!(!passed, "{block}: {log}");
         assert!(log.contains("FAIL mismatches=1 "), "{block}: {log}");

@@ -20,12 +20,14 @@ const SHARED: &str = include_str!("cocotb/gyrofx_cocotb.py");
 
 /// Blocks with a cocotb test (those with a golden model, [`crate::golden::BLOCKS`]), with the
 /// test module.
-pub const TESTS: [(&str, &str); 5] = [
+pub const TESTS: [(&str, &str); 7] = [
     ("sequencer", include_str!("cocotb/test_sequencer.py")),
     ("estimator", include_str!("cocotb/test_estimator.py")),
     ("kf", include_str!("cocotb/test_kf.py")),
     ("top", include_str!("cocotb/test_top.py")),
     ("mean_filter", include_str!("cocotb/test_mean_filter.py")),
+    ("gyro_loop", include_str!("cocotb/test_gyro_loop.py")),
+    ("system", include_str!("cocotb/test_system.py")),
 ];
 
 /// Folder of the cocotb files in a package.

@@ -71,6 +71,22 @@ import \"DPI-C\" function int gyrofx_chain_step(input chandle chain, input longi
     output int mode_a, output int mode_b, output int out_valid, output longint rate_out,
     output longint bias_a, output longint bias_b, output int estimated);"
         }
+        "gyro_loop" => {
+            "import \"DPI-C\" function chandle gyrofx_gyro_loop_new(input chandle plan, input int gyro);
+import \"DPI-C\" function int gyrofx_gyro_loop_reset(input chandle gyro_loop);
+import \"DPI-C\" function int gyrofx_gyro_loop_step(input chandle gyro_loop, input longint adc_x, input longint adc_y,
+    input int mode, output longint dac_x, output longint dac_y, output int locked, output int out_valid,
+    output longint rate, output longint quadrature);"
+        }
+        "system" => {
+            "import \"DPI-C\" function chandle gyrofx_system_new(input chandle plan);
+import \"DPI-C\" function int gyrofx_system_reset(input chandle system);
+import \"DPI-C\" function int gyrofx_system_step(input chandle system, input int enable, input int bw_sel,
+    input longint adc_a_x, input longint adc_a_y, input longint adc_b_x, input longint adc_b_y,
+    output longint dac_a_x, output longint dac_a_y, output longint dac_b_x, output longint dac_b_y,
+    output int locked_a, output int locked_b, output int mode_a, output int mode_b, output int out_valid,
+    output longint rate_out, output longint bias_a, output longint bias_b, output int estimated);"
+        }
         _ => {
             "import \"DPI-C\" function chandle gyrofx_sequencer_new(input chandle plan);
 import \"DPI-C\" function int gyrofx_sequencer_reset(input chandle sequencer);
@@ -95,16 +111,16 @@ fn body(block: &Block) -> (&'static str, String) {
             "kf = gyrofx_kf_new(plan);",
             "            bw_sel = (k % 97 == 0) ? $urandom_range(P_ROM_DEPTH - 1, 0) : bw_sel;
             z = random_code(P_IN_W, k);
-            check_call(gyrofx_kf_step(kf, longint'(z), int'(bw_sel), rate));
-            expect_stream(rate, 0);
+            check_call(gyrofx_kf_step(kf, longint'(z), int'(bw_sel), stream_model));
+            expect_stream(stream_model, 0);
             @(posedge clk);"
                 .to_string(),
         ),
         "mean_filter" => (
             "filter = gyrofx_mean_filter_new(plan);",
             "            x = random_code(P_IN_W, k);
-            check_call(gyrofx_mean_filter_step(filter, longint'(x), valid, rate, model_kept));
-            if (valid == 1) expect_stream(rate, model_kept);
+            check_call(gyrofx_mean_filter_step(filter, longint'(x), valid, stream_model, model_kept));
+            if (valid == 1) expect_stream(stream_model, model_kept);
             @(posedge clk);"
                 .to_string(),
         ),
@@ -114,11 +130,11 @@ fn body(block: &Block) -> (&'static str, String) {
             y_a = random_code(P_IN_W, k);
             y_b = random_code(P_IN_W, k + 1);
             check_call(gyrofx_chain_step(chain, longint'(y_a), longint'(y_b), int'(bw_sel),
-                model_mode_a, model_mode_b, valid, rate, bias_a_model, bias_b_model, estimated_model));
+                model_mode_a, model_mode_b, valid, stream_model, bias_a_model, bias_b_model, estimated_model));
             #1;
             compare(longint'(mode_a), longint'(model_mode_a), \"mode_a\");
             compare(longint'(mode_b), longint'(model_mode_b), \"mode_b\");
-            if (valid == 1) expect_stream(rate, 0);
+            if (valid == 1) expect_stream(stream_model, 0);
             @(posedge clk);
             #1;
             compare(longint'(bias_a), flip_next(bias_a_model), \"bias_a\");
@@ -142,6 +158,60 @@ fn body(block: &Block) -> (&'static str, String) {
             compare(longint'(done_b), longint'(model_done_b), \"done_b\");
             compare(longint'(window_done), longint'(model_window_done), \"window_done\");
             @(posedge clk);"
+                .to_string(),
+        ),
+        "gyro_loop" => (
+            "gyro_loop = gyrofx_gyro_loop_new(plan, 0);",
+            "            // A mode switch every 701 samples: the loop's presets and re-acquisition.
+            if (k == 0) mode = 1'b1;
+            else if (k % 701 == 0) mode = ~mode;
+            adc_x = random_code(P_DEMOD_ADC_W, k);
+            adc_y = random_code(P_DEMOD_ADC_W, k + 1);
+            check_call(gyrofx_gyro_loop_step(gyro_loop, longint'(adc_x), longint'(adc_y), int'(mode),
+                dac_x_model, dac_y_model, locked_model, valid, stream_model, quadrature_model));
+            if (valid == 1) expect_stream(stream_model, quadrature_model);
+            // The outputs show 3 clocks after the edge that takes the sample (ce every 4th clock).
+            @(posedge clk);
+            @(negedge clk);
+            ce = 1'b0;
+            repeat (3) @(posedge clk);
+            #1;
+            compare(longint'(dac_x), flip_next(dac_x_model), \"dac_x\");
+            compare(longint'(dac_y), dac_y_model, \"dac_y\");
+            compare(longint'(locked), longint'(locked_model), \"locked\");"
+                .to_string(),
+        ),
+        "system" => (
+            "system = gyrofx_system_new(plan);",
+            "            // enable low for the first 500 samples (the start-up), then high.
+            enable = (k >= 500) ? 1'b1 : 1'b0;
+            bw_sel = (k % 997 == 0) ? $urandom_range(P_ROM_DEPTH - 1, 0) : bw_sel;
+            adc_a_x = random_code(P_DEMOD_ADC_W, k);
+            adc_a_y = random_code(P_DEMOD_ADC_W, k + 1);
+            adc_b_x = random_code(P_DEMOD_ADC_W, k + 2);
+            adc_b_y = random_code(P_DEMOD_ADC_W, k + 3);
+            check_call(gyrofx_system_step(system, int'(enable), int'(bw_sel), longint'(adc_a_x),
+                longint'(adc_a_y), longint'(adc_b_x), longint'(adc_b_y), dac_a_x_model, dac_a_y_model,
+                dac_b_x_model, dac_b_y_model, locked_a_model, locked_b_model, model_mode_a, model_mode_b,
+                valid, stream_model, bias_a_model, bias_b_model, estimated_model));
+            if (valid == 1) expect_stream(stream_model, 0);
+            // Every output shows 4 clocks after the edge that takes the sample (ce every 5th clock).
+            @(posedge clk);
+            @(negedge clk);
+            ce = 1'b0;
+            repeat (4) @(posedge clk);
+            #1;
+            compare(longint'(dac_a_x), flip_next(dac_a_x_model), \"dac_a_x\");
+            compare(longint'(dac_a_y), dac_a_y_model, \"dac_a_y\");
+            compare(longint'(dac_b_x), dac_b_x_model, \"dac_b_x\");
+            compare(longint'(dac_b_y), dac_b_y_model, \"dac_b_y\");
+            compare(longint'(locked_a), longint'(locked_a_model), \"locked_a\");
+            compare(longint'(locked_b), longint'(locked_b_model), \"locked_b\");
+            compare(longint'(mode_a), longint'(model_mode_a), \"mode_a\");
+            compare(longint'(mode_b), longint'(model_mode_b), \"mode_b\");
+            compare(longint'(bias_a), bias_a_model, \"bias_a\");
+            compare(longint'(bias_b), bias_b_model, \"bias_b\");
+            compare(longint'(estimated), longint'(estimated_model), \"estimated\");"
                 .to_string(),
         ),
         _ => (
@@ -175,7 +245,8 @@ fn body(block: &Block) -> (&'static str, String) {
 /// The valid flag and the ports of the block's stream outputs (`None`: no stream).
 fn stream(block: &str) -> Option<(&'static str, &'static str, Option<&'static str>)> {
     match block {
-        "kf" | "top" => Some(("out_valid", "rate_out", None)),
+        "kf" | "top" | "system" => Some(("out_valid", "rate_out", None)),
+        "gyro_loop" => Some(("out_valid", "rate", Some("quadrature"))),
         "mean_filter" => Some(("y_valid", "y", Some("kept"))),
         _ => None,
     }
@@ -233,7 +304,7 @@ end
  * {tb}: {module} ({title}) against gyrofx's golden model through DPI-C (see the package
  * README): random codes over the input range (every other stretch of 64 samples at 1/256 of
  * it), the model of this package's manifest stepped beside the DUT. PASS n=<N> or
- * FAIL mismatches=<M> n=<N>; plusargs +samples=<n> (default 4000), +seed=<n>, +flip=<k>.
+ * FAIL mismatches=<M> n=<N>; plusargs +samples=<n> (default {samples}), +seed=<n>, +flip=<k>.
  */
 module {tb};
 
@@ -252,9 +323,10 @@ logic ce = 1'b0;
 {declarations}
 
 {instance}
-chandle plan, kf, filter, chain, sequencer, estimator;
-longint rate, model_kept, bias_a_model, bias_b_model;
-int valid, model_mode_a, model_mode_b, estimated_model;
+chandle plan, kf, filter, chain, sequencer, estimator, gyro_loop, system;
+longint stream_model, model_kept, bias_a_model, bias_b_model, quadrature_model;
+longint dac_x_model, dac_y_model, dac_a_x_model, dac_a_y_model, dac_b_x_model, dac_b_y_model;
+int valid, model_mode_a, model_mode_b, estimated_model, locked_model, locked_a_model, locked_b_model;
 int model_blank_a, model_blank_b, model_interval_a, model_interval_b;
 int model_done_a, model_done_b, model_window_done;
 longint expected_first[$];
@@ -263,7 +335,7 @@ int compared = 0;
 int mismatches = 0;
 int expected_count = 0;
 int flip = -1;
-int samples = 4000;
+int samples = {samples};
 int seed = 1;
 int k;
 
@@ -350,6 +422,18 @@ endmodule
         imports = imports(block.name),
         declarations = declarations.join("\n"),
         instance = instance(block),
+        samples = default_samples(block.name),
     );
     out
+}
+
+/// Samples a testbench runs by default: enough for the system's chain to finish an estimator
+/// window (`enable` high from sample 500 on; a window of the system's short schedule is 12
+/// chain samples of 1000 ADC samples each by default) and for the loop to give a dozen rates.
+fn default_samples(block: &str) -> usize {
+    match block {
+        "gyro_loop" => 12_000,
+        "system" => 14_000,
+        _ => 4000,
+    }
 }

@@ -84,9 +84,10 @@ gyrofx_bias_estimator #(
     .estimated(estimated)
 );
 
-chandle plan, kf, filter, chain, sequencer, estimator;
-longint rate, model_kept, bias_a_model, bias_b_model;
-int valid, model_mode_a, model_mode_b, estimated_model;
+chandle plan, kf, filter, chain, sequencer, estimator, gyro_loop, system;
+longint stream_model, model_kept, bias_a_model, bias_b_model, quadrature_model;
+longint dac_x_model, dac_y_model, dac_a_x_model, dac_a_y_model, dac_b_x_model, dac_b_y_model;
+int valid, model_mode_a, model_mode_b, estimated_model, locked_model, locked_a_model, locked_b_model;
 int model_blank_a, model_blank_b, model_interval_a, model_interval_b;
 int model_done_a, model_done_b, model_window_done;
 longint expected_first[$];

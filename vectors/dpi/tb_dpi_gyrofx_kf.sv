@@ -56,9 +56,10 @@ gyrofx_kf #(
     .rate_out(rate_out)
 );
 
-chandle plan, kf, filter, chain, sequencer, estimator;
-longint rate, model_kept, bias_a_model, bias_b_model;
-int valid, model_mode_a, model_mode_b, estimated_model;
+chandle plan, kf, filter, chain, sequencer, estimator, gyro_loop, system;
+longint stream_model, model_kept, bias_a_model, bias_b_model, quadrature_model;
+longint dac_x_model, dac_y_model, dac_a_x_model, dac_a_y_model, dac_b_x_model, dac_b_y_model;
+int valid, model_mode_a, model_mode_b, estimated_model, locked_model, locked_a_model, locked_b_model;
 int model_blank_a, model_blank_b, model_interval_a, model_interval_b;
 int model_done_a, model_done_b, model_window_done;
 longint expected_first[$];
@@ -135,8 +136,8 @@ initial begin
         ce = 1'b1;
             bw_sel = (k % 97 == 0) ? $urandom_range(P_ROM_DEPTH - 1, 0) : bw_sel;
             z = random_code(P_IN_W, k);
-            check_call(gyrofx_kf_step(kf, longint'(z), int'(bw_sel), rate));
-            expect_stream(rate, 0);
+            check_call(gyrofx_kf_step(kf, longint'(z), int'(bw_sel), stream_model));
+            expect_stream(stream_model, 0);
             @(posedge clk);
         if ($urandom_range(3, 0) == 0) begin
             @(negedge clk);

@@ -55,9 +55,10 @@ gyrofx_mean_filter #(
     .kept(kept)
 );
 
-chandle plan, kf, filter, chain, sequencer, estimator;
-longint rate, model_kept, bias_a_model, bias_b_model;
-int valid, model_mode_a, model_mode_b, estimated_model;
+chandle plan, kf, filter, chain, sequencer, estimator, gyro_loop, system;
+longint stream_model, model_kept, bias_a_model, bias_b_model, quadrature_model;
+longint dac_x_model, dac_y_model, dac_a_x_model, dac_a_y_model, dac_b_x_model, dac_b_y_model;
+int valid, model_mode_a, model_mode_b, estimated_model, locked_model, locked_a_model, locked_b_model;
 int model_blank_a, model_blank_b, model_interval_a, model_interval_b;
 int model_done_a, model_done_b, model_window_done;
 longint expected_first[$];
@@ -133,8 +134,8 @@ initial begin
         @(negedge clk);
         ce = 1'b1;
             x = random_code(P_IN_W, k);
-            check_call(gyrofx_mean_filter_step(filter, longint'(x), valid, rate, model_kept));
-            if (valid == 1) expect_stream(rate, model_kept);
+            check_call(gyrofx_mean_filter_step(filter, longint'(x), valid, stream_model, model_kept));
+            if (valid == 1) expect_stream(stream_model, model_kept);
             @(posedge clk);
         if ($urandom_range(3, 0) == 0) begin
             @(negedge clk);

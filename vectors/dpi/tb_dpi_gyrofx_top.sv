@@ -90,9 +90,10 @@ gyrofx_top #(
     .estimated(estimated)
 );
 
-chandle plan, kf, filter, chain, sequencer, estimator;
-longint rate, model_kept, bias_a_model, bias_b_model;
-int valid, model_mode_a, model_mode_b, estimated_model;
+chandle plan, kf, filter, chain, sequencer, estimator, gyro_loop, system;
+longint stream_model, model_kept, bias_a_model, bias_b_model, quadrature_model;
+longint dac_x_model, dac_y_model, dac_a_x_model, dac_a_y_model, dac_b_x_model, dac_b_y_model;
+int valid, model_mode_a, model_mode_b, estimated_model, locked_model, locked_a_model, locked_b_model;
 int model_blank_a, model_blank_b, model_interval_a, model_interval_b;
 int model_done_a, model_done_b, model_window_done;
 longint expected_first[$];
@@ -171,11 +172,11 @@ initial begin
             y_a = random_code(P_IN_W, k);
             y_b = random_code(P_IN_W, k + 1);
             check_call(gyrofx_chain_step(chain, longint'(y_a), longint'(y_b), int'(bw_sel),
-                model_mode_a, model_mode_b, valid, rate, bias_a_model, bias_b_model, estimated_model));
+                model_mode_a, model_mode_b, valid, stream_model, bias_a_model, bias_b_model, estimated_model));
             #1;
             compare(longint'(mode_a), longint'(model_mode_a), "mode_a");
             compare(longint'(mode_b), longint'(model_mode_b), "mode_b");
-            if (valid == 1) expect_stream(rate, 0);
+            if (valid == 1) expect_stream(stream_model, 0);
             @(posedge clk);
             #1;
             compare(longint'(bias_a), flip_next(bias_a_model), "bias_a");

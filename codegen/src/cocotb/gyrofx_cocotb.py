@@ -167,6 +167,15 @@ async def take(dut, idle_clocks):
     await idle(dut, idle_clocks)
 
 
+async def take_and_wait(dut, clocks):
+    """The clock edge that takes the sample, then `clocks` more with ce low, settled: where a
+    block whose registered outputs come `clocks` clocks after that edge (the gyro loop's 3, the
+    system's 4) shows the sample's outputs."""
+    await RisingEdge(dut.clk)
+    await idle(dut, clocks)
+    await ReadOnly()
+
+
 async def idle(dut, clocks):
     """`clocks` clocks with ce low."""
     for _ in range(clocks):
