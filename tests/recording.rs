@@ -166,7 +166,7 @@ fn recordings_out_of_step_at_another_rate_or_without_a_column_are_refused() {
     };
     let message = run(base(shifted.to_str().unwrap(), "200", "a,b"));
     assert!(
-        message.contains("column mode, value ")
+        message.contains("line 151 (row 149), column \"mode\"")
             && message.contains("the configured sequencer runs it"),
         "{message}"
     );
@@ -192,5 +192,27 @@ fn recordings_out_of_step_at_another_rate_or_without_a_column_are_refused() {
         recording.clone(),
     ]);
     assert!(message.contains("--recording-rate"), "{message}");
+    // A bad cell deep in the file and a mode that is no mode: the line and column named
+    // before anything is written (the file is checked whole before the run).
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let last = lines.len() - 1;
+    lines[last] = lines[last].replacen(',', ",NaN-ish,", 1);
+    let broken = dir.path().join("broken.csv");
+    std::fs::write(&broken, lines.join("\n") + "\n").unwrap();
+    let message = run(base(broken.to_str().unwrap(), "200", "a,b"));
+    assert!(
+        message.contains(&format!("line {}", last + 1)) && message.contains("is not a number"),
+        "{message}"
+    );
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let mode = lines[500].rsplit_once(',').unwrap().0.to_string();
+    lines[500] = format!("{mode},2");
+    let bad_mode = dir.path().join("bad_mode.csv");
+    std::fs::write(&bad_mode, lines.join("\n") + "\n").unwrap();
+    let message = run(base(bad_mode.to_str().unwrap(), "200", "a,b"));
+    assert!(
+        message.contains("line 501, column \"mode\": 2 is not a mode"),
+        "{message}"
+    );
     assert!(!out.exists(), "nothing written after a refusal");
 }

@@ -1,6 +1,7 @@
-//! Reading recorded rate data: one numeric column of a CSV file, streamed.
+//! Reading recorded rate data: one numeric column of a CSV file, or several columns row by
+//! row ([`Columns`]), streamed.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
 
@@ -58,6 +59,158 @@ fn read(path: &Path, column: &str, gaps: bool) -> Result<(Vec<f64>, usize)> {
     match read_plain(path, column, gaps)? {
         Some(result) => Ok(result),
         None => read_csv(path, column, gaps),
+    }
+}
+
+/// Chosen columns of a CSV file, row by row, without holding the file: for inputs that name
+/// several columns at once (a recording's two gyros and its mode). The same rules as
+/// [`read_header`] and [`read_column`]: the first line that is neither blank nor a `#` comment
+/// is the header, blank and comment lines are skipped, cells are split at commas and trimmed
+/// of spaces and surrounding quotes, and a missing, non-numeric or non-finite cell is an error
+/// naming its line (as an editor counts it) and column. At most 8 columns at a time.
+pub struct Columns<R: std::io::BufRead> {
+    path: PathBuf,
+    names: Vec<String>,
+    indices: Vec<usize>,
+    reader: R,
+    line: Vec<u8>,
+    /// Lines read so far.
+    line_number: u64,
+}
+
+impl Columns<std::io::BufReader<std::fs::File>> {
+    /// The columns `names` (header names) of the CSV file at `path`.
+    ///
+    /// # Errors
+    /// [`Error::Io`] when the file cannot be opened; [`Error::Input`] for an empty file or a
+    /// missing column (listing those present).
+    pub fn open(path: &Path, names: &[&str]) -> Result<Self> {
+        let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+        Columns::from_reader(path, std::io::BufReader::new(file), names)
+    }
+}
+
+/// The cells of a line without its line end.
+fn cells(line: &[u8]) -> impl Iterator<Item = &[u8]> {
+    line.split(|b| *b == b',').map(|cell| {
+        let cell = cell.trim_ascii();
+        cell.strip_prefix(b"\"")
+            .and_then(|c| c.strip_suffix(b"\""))
+            .unwrap_or(cell)
+    })
+}
+
+impl<R: std::io::BufRead> Columns<R> {
+    /// As [`Columns::open`] on the bytes of `reader`; `path` names them in errors.
+    ///
+    /// # Errors
+    /// As [`Columns::open`].
+    pub fn from_reader(path: &Path, reader: R, names: &[&str]) -> Result<Self> {
+        assert!(names.len() <= 8, "at most 8 columns at a time");
+        let mut columns = Columns {
+            path: path.to_path_buf(),
+            names: names.iter().map(|n| n.to_string()).collect(),
+            indices: Vec::new(),
+            reader,
+            line: Vec::new(),
+            line_number: 0,
+        };
+        if !columns.next_line()? {
+            return Err(Error::Input {
+                path: path.to_path_buf(),
+                message: "the file is empty: expected a header line naming the columns".into(),
+            });
+        }
+        let header: Vec<String> = cells(&columns.line)
+            .map(|c| String::from_utf8_lossy(c).into_owned())
+            .collect();
+        columns.indices = names
+            .iter()
+            .map(|name| {
+                header
+                    .iter()
+                    .position(|h| h == name)
+                    .ok_or_else(|| Error::Input {
+                        path: path.to_path_buf(),
+                        message: no_column(
+                            name,
+                            &header.iter().map(String::as_str).collect::<Vec<_>>(),
+                        ),
+                    })
+            })
+            .collect::<Result<Vec<usize>>>()?;
+        Ok(columns)
+    }
+
+    /// Reads up to the next line that is neither blank nor a comment (into `self.line`, its
+    /// line end and a leading byte-order mark removed); false at the end of the file.
+    fn next_line(&mut self) -> Result<bool> {
+        loop {
+            self.line.clear();
+            let read = self
+                .reader
+                .read_until(b'\n', &mut self.line)
+                .map_err(|e| Error::io(&self.path, e))?;
+            if read == 0 {
+                return Ok(false);
+            }
+            self.line_number += 1;
+            while matches!(self.line.last(), Some(b'\n' | b'\r')) {
+                self.line.pop();
+            }
+            if self.line_number == 1 && self.line.starts_with("\u{feff}".as_bytes()) {
+                self.line.drain(..3);
+            }
+            let text = self.line.trim_ascii();
+            if !text.is_empty() && !text.starts_with(b"#") && cells(text).any(|c| !c.is_empty()) {
+                return Ok(true);
+            }
+        }
+    }
+
+    /// The next data row's values into `values` (one per column, in the order named); its line
+    /// number, or `None` at the end of the file.
+    ///
+    /// # Errors
+    /// A bad cell or an unreadable file, naming the line and column.
+    pub fn next_row(&mut self, values: &mut [f64]) -> Result<Option<u64>> {
+        if !self.next_line()? {
+            return Ok(None);
+        }
+        let line = self.line_number;
+        let bad = |message: String| Error::Input {
+            path: self.path.clone(),
+            message,
+        };
+        let mut wanted = [&b""[..]; 8];
+        let last = self.indices.iter().max().copied().unwrap_or(0);
+        for (i, cell) in cells(&self.line).enumerate().take(last + 1) {
+            for (slot, index) in wanted.iter_mut().zip(&self.indices) {
+                if *index == i {
+                    *slot = cell;
+                }
+            }
+        }
+        for (((value, bytes), name), _) in values
+            .iter_mut()
+            .zip(wanted)
+            .zip(&self.names)
+            .zip(&self.indices)
+        {
+            let cell = std::str::from_utf8(bytes).map_err(|_| {
+                bad(format!(
+                    "line {line}, column {name:?}: the cell is not UTF-8 text"
+                ))
+            })?;
+            *value = cell_value(cell, line, name, false, &bad)?
+                .expect("a cell without gaps has a value");
+        }
+        Ok(Some(line))
+    }
+
+    /// The reader underneath.
+    pub fn into_inner(self) -> R {
+        self.reader
     }
 }
 
@@ -558,6 +711,44 @@ mod tests {
             (vec![1.0, 3.0], 1)
         );
         assert!(read_column(f.path(), "rate_dps").is_err());
+    }
+
+    #[test]
+    fn columns_stream_the_named_columns_row_by_row_as_read_column_reads_each() {
+        let text = "# made by hand\nt,a,\"b\",mode\r\n0,1.5,2,1\n\n1,-2e-3,4,0\n2,3,5e1,1\n";
+        let f = file(text);
+        let mut columns = Columns::open(f.path(), &["mode", "a", "b"]).unwrap();
+        let mut rows = Vec::new();
+        let mut values = [0.0; 3];
+        while let Some(line) = columns.next_row(&mut values).unwrap() {
+            rows.push((line, values));
+        }
+        let lines: Vec<u64> = rows.iter().map(|(l, _)| *l).collect();
+        assert_eq!(lines, vec![3, 5, 6]);
+        for (i, name) in ["mode", "a", "b"].iter().enumerate() {
+            let column: Vec<f64> = rows.iter().map(|(_, v)| v[i]).collect();
+            assert_eq!(column, read_column(f.path(), name).unwrap(), "{name}");
+        }
+        let missing = Columns::open(f.path(), &["a", "c"])
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(missing.contains("no column named \"c\"") && missing.contains("t, a, b, mode"));
+        let f = file("a,b\n1,2\n3,x\n");
+        let mut columns = Columns::open(f.path(), &["a", "b"]).unwrap();
+        assert_eq!(columns.next_row(&mut values[..2]).unwrap(), Some(2));
+        let bad = columns.next_row(&mut values[..2]).unwrap_err().to_string();
+        assert!(
+            bad.contains("line 3, column \"b\": \"x\" is not a number"),
+            "{bad}"
+        );
+        let f = file("a,b\n1\n");
+        let mut columns = Columns::open(f.path(), &["a", "b"]).unwrap();
+        let short = columns.next_row(&mut values[..2]).unwrap_err().to_string();
+        assert!(
+            short.contains("line 2, column \"b\": the cell is empty"),
+            "{short}"
+        );
     }
 
     /// Errors name the line as an editor shows it, comment lines counted.

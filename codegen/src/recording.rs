@@ -8,6 +8,10 @@
 //! sequencer row by row, so a recording out of step with the config is refused, not
 //! mis-calibrated. The values become the chain's input codes as the rate plant's ADC makes
 //! them (nearest, saturating, counted).
+//!
+//! Nothing holds the record: [`Recording::read`] streams the file once (every cell checked,
+//! the rows counted, the SHA-256 taken from the same bytes), [`Recording::check`] streams the
+//! mode column, and the run streams the rates ([`Recording::rows`]).
 
 use std::path::{Path, PathBuf};
 
@@ -15,9 +19,11 @@ use serde_json::json;
 
 use gyrofx_model::sequencer::{Schedule, Sequencer};
 
+use sha2::{Digest, Sha256};
+
 use crate::error::{Error, Result};
-use crate::input::{read_column, read_header};
-use crate::package::file_sha256;
+use crate::input::{read_header, Columns};
+use crate::package::digest_hex;
 
 /// The unit of the recorded rates.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -57,10 +63,70 @@ pub struct Recording {
     rate_hz: f64,
     mode_column: Option<String>,
     sha256: String,
-    /// Gyro A's and B's rates, °/s, one per chain sample.
-    pub rates_dps: [Vec<f64>; 2],
-    /// Gyro A's mode per row (+1 normal, −1 reverse), when a column gives it.
-    modes: Option<Vec<i8>>,
+    /// °/s per recorded unit.
+    scale: f64,
+    /// Data rows.
+    rows: usize,
+}
+
+/// A reader that hashes the bytes it passes on.
+struct Hashing<R> {
+    inner: R,
+    hasher: Sha256,
+}
+
+impl<R: std::io::Read> std::io::Read for Hashing<R> {
+    fn read(&mut self, buffer: &mut [u8]) -> std::io::Result<usize> {
+        let read = self.inner.read(buffer)?;
+        self.hasher.update(&buffer[..read]);
+        Ok(read)
+    }
+}
+
+/// A mode cell: +1 normal, −1 reverse.
+fn mode_of(path: &Path, name: &str, line: u64, value: f64) -> Result<i8> {
+    match value {
+        1.0 => Ok(1),
+        0.0 | -1.0 => Ok(-1),
+        v => Err(Error::Input {
+            path: path.to_path_buf(),
+            message: format!(
+                "line {line}, column {name:?}: {v} is not a mode: 1 (normal) or 0 / -1 (reverse)"
+            ),
+        }),
+    }
+}
+
+/// Gyro A's and B's recorded rates, °/s, row by row ([`Recording::rows`]).
+pub struct Rows {
+    path: PathBuf,
+    columns: Columns<std::io::BufReader<std::fs::File>>,
+    scale: f64,
+    read: usize,
+}
+
+impl Rows {
+    /// Appends the next `count` rows' rates `[A, B]` (°/s) to `out`.
+    ///
+    /// # Errors
+    /// A bad cell, or the file ending early (it changed since it was read).
+    pub fn read_into(&mut self, count: usize, out: &mut Vec<[f64; 2]>) -> Result<()> {
+        let mut values = [0.0; 2];
+        for _ in 0..count {
+            if self.columns.next_row(&mut values)?.is_none() {
+                return Err(Error::Input {
+                    path: self.path.clone(),
+                    message: format!(
+                        "the file ended after {} rows, fewer than when it was first read: it changed while gyrofx read it",
+                        self.read
+                    ),
+                });
+            }
+            self.read += 1;
+            out.push(values.map(|v| v * self.scale));
+        }
+        Ok(())
+    }
 }
 
 /// A column named, or numbered from 0 when no header cell has that name.
@@ -100,65 +166,59 @@ impl Recording {
             column_name(path, &header, columns[0])?,
             column_name(path, &header, columns[1])?,
         ];
+        let mode_column = mode_column
+            .map(|spec| column_name(path, &header, spec))
+            .transpose()?;
         let scale = match units {
             Units::DegreesPerSecond => 1.0,
             Units::RadiansPerSecond => 180.0 / std::f64::consts::PI,
         };
-        let mut rates_dps = [read_column(path, &names[0])?, read_column(path, &names[1])?];
-        if rates_dps[0].len() != rates_dps[1].len() {
-            return Err(Error::Input {
-                path: path.to_path_buf(),
-                message: format!(
-                    "columns {} and {} hold {} and {} values: each row needs both gyros",
-                    names[0],
-                    names[1],
-                    rates_dps[0].len(),
-                    rates_dps[1].len()
-                ),
-            });
-        }
-        for rates in &mut rates_dps {
-            for value in rates.iter_mut() {
-                *value *= scale;
+        let mut wanted: Vec<&str> = names.iter().map(String::as_str).collect();
+        wanted.extend(mode_column.as_deref());
+        let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+        let hashing = std::io::BufReader::new(Hashing {
+            inner: file,
+            hasher: Sha256::new(),
+        });
+        let mut reader = Columns::from_reader(path, hashing, &wanted)?;
+        let mut values = [0.0; 3];
+        let mut rows = 0;
+        while let Some(line) = reader.next_row(&mut values[..wanted.len()])? {
+            if let Some(name) = &mode_column {
+                mode_of(path, name, line, values[2])?;
             }
+            rows += 1;
         }
-        let (mode_column, modes) = match mode_column {
-            None => (None, None),
-            Some(spec) => {
-                let name = column_name(path, &header, spec)?;
-                let values = read_column(path, &name)?;
-                let modes = values
-                    .iter()
-                    .enumerate()
-                    .map(|(row, value)| match *value {
-                        1.0 => Ok(1),
-                        0.0 | -1.0 => Ok(-1),
-                        v => Err(Error::Input {
-                            path: path.to_path_buf(),
-                            message: format!(
-                                "column {name}, value {row} = {v}: a mode is 1 (normal) or 0 / -1 (reverse)"
-                            ),
-                        }),
-                    })
-                    .collect::<Result<Vec<i8>>>()?;
-                (Some(name), Some(modes))
-            }
-        };
+        let sha256 = digest_hex(&reader.into_inner().into_inner().hasher.finalize());
         Ok(Recording {
             path: path.to_path_buf(),
             columns: names,
             units,
             rate_hz,
             mode_column,
-            sha256: file_sha256(path)?,
-            rates_dps,
-            modes,
+            sha256,
+            scale,
+            rows,
+        })
+    }
+
+    /// The rates from the first row on.
+    ///
+    /// # Errors
+    /// The file cannot be opened again.
+    pub fn rows(&self) -> Result<Rows> {
+        let names = [self.columns[0].as_str(), self.columns[1].as_str()];
+        Ok(Rows {
+            path: self.path.clone(),
+            columns: Columns::open(&self.path, &names)?,
+            scale: self.scale,
+            read: 0,
         })
     }
 
     /// Rows (chain samples).
     pub fn len(&self) -> usize {
-        self.rates_dps[0].len()
+        self.rows
     }
 
     /// Whether it has no rows.
@@ -182,15 +242,21 @@ impl Recording {
                 self.rate_hz
             )));
         }
-        if let (Some(name), Some(modes)) = (&self.mode_column, &self.modes) {
+        if let Some(name) = &self.mode_column {
             let mut sequencer = Sequencer::new(schedule);
-            for (row, mode) in modes.iter().take(samples).enumerate() {
+            let mut modes = Columns::open(&self.path, &[name.as_str()])?;
+            let mut value = [0.0];
+            for row in 0..samples {
+                let Some(line) = modes.next_row(&mut value)? else {
+                    break;
+                };
+                let mode = mode_of(&self.path, name, line, value[0])?;
                 let expected = sequencer.advance().mode_a;
-                if *mode != expected {
+                if mode != expected {
                     let word = |m: i8| if m > 0 { "normal" } else { "reverse" };
                     return Err(bad(format!(
-                        "column {name}, value {row}: the recording has gyro A in {} mode but the configured sequencer runs it {} there; align the recording with [sequencer] (interval_length, intervals, pattern, blank, stagger)",
-                        word(*mode),
+                        "line {line} (row {row}), column {name:?}: the recording has gyro A in {} mode but the configured sequencer runs it {} there; align the recording with [sequencer] (interval_length, intervals, pattern, blank, stagger)",
+                        word(mode),
                         word(expected)
                     )));
                 }

@@ -306,7 +306,7 @@ fn run_with(
             batch.modes.push([slot.mode_a, slot.mode_b]);
             batch.rates.push(rate.at(k));
         }
-        gyros.simulate(&mut batch, progress);
+        gyros.simulate(&mut batch, progress)?;
         for (i, k) in (first..last).enumerate() {
             if k % PROGRESS_STEP == PROGRESS_STEP - 1 {
                 progress.advance(PROGRESS_STEP as u64);
@@ -416,8 +416,9 @@ enum Gyros {
     /// Recorded outputs (`generate --recording`): already in the sequencer's modes; the
     /// report's "without reversal" rows show the same record.
     Recorded {
-        recording: std::sync::Arc<crate::recording::Recording>,
-        next: usize,
+        rows: crate::recording::Rows,
+        /// This batch's rates `[A, B]`, °/s.
+        rates: Vec<[f64; 2]>,
         input: Format,
         saturations: [u64; 2],
     },
@@ -439,8 +440,8 @@ impl Gyros {
         let input = job.chain.estimator.input;
         if let Some(recording) = &job.recording {
             return Ok(Gyros::Recorded {
-                recording: recording.clone(),
-                next: 0,
+                rows: recording.rows()?,
+                rates: Vec::with_capacity(GYRO_BATCH),
                 input,
                 saturations: [0; 2],
             });
@@ -486,7 +487,10 @@ impl Gyros {
     }
 
     /// Fills `batch.codes` and `batch.raw` for its rates and modes.
-    fn simulate(&mut self, batch: &mut GyroBatch, progress: &Progress) {
+    ///
+    /// # Errors
+    /// A recording that cannot be read to the batch's end.
+    fn simulate(&mut self, batch: &mut GyroBatch, progress: &Progress) -> Result<()> {
         let len = batch.rates.len();
         batch.codes.clear();
         batch.raw.clear();
@@ -549,26 +553,26 @@ impl Gyros {
                 }
             }
             Gyros::Recorded {
-                recording,
-                next,
+                rows,
+                rates,
                 input,
                 saturations,
             } => {
-                let rows = *next..*next + len;
-                let [(a, sat_a), (b, sat_b)] =
-                    [0, 1].map(|g| adc(&recording.rates_dps[g][rows.clone()], *input));
+                rates.clear();
+                rows.read_into(len, rates)?;
+                let [(a, sat_a), (b, sat_b)] = [0, 1].map(|g| {
+                    let column: Vec<f64> = rates.iter().map(|r| r[g]).collect();
+                    adc(&column, *input)
+                });
                 saturations[0] += sat_a;
                 saturations[1] += sat_b;
                 batch
                     .codes
                     .extend(a.into_iter().zip(b).map(|(a, b)| [a, b]));
-                batch.raw.extend(
-                    rows.clone()
-                        .map(|k| [recording.rates_dps[0][k], recording.rates_dps[1][k]]),
-                );
-                *next += len;
+                batch.raw.extend_from_slice(rates);
             }
         }
+        Ok(())
     }
 
     /// ADC saturations of gyro A and B so far (the pick-offs' for resonator-level gyros).
