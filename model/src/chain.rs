@@ -234,6 +234,12 @@ impl FloatChain {
         self.kf.reset();
     }
 
+    /// The modes the next sample will be taken in (`[p_A, p_B]`), without advancing.
+    pub fn upcoming_modes(&self) -> [i8; 2] {
+        let slot = self.sequencer.clone().advance();
+        [slot.mode_a, slot.mode_b]
+    }
+
     /// One sample, `y` in °/s.
     pub fn step(&mut self, y: [f64; 2], bw_sel: usize) -> FloatSample {
         let slot = self.sequencer.advance();

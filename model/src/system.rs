@@ -17,8 +17,11 @@
 //! (no step) and runs both loops in normal mode: the start-up while the loops lock. Both loops
 //! share the decimation, so their outputs come at the same sample; gyro A's marks the period.
 
-use crate::chain::{FixedChain, Plan as ChainPlan, Sample as ChainSample};
-use crate::gyro_loop::gyro::{FixedGyroLoop, Plan as LoopPlan};
+use crate::chain::{
+    FixedChain, FloatChain, FloatSample as FloatChainSample, Plan as ChainPlan,
+    Sample as ChainSample,
+};
+use crate::gyro_loop::gyro::{FixedGyroLoop, FloatGyroLoop, Plan as LoopPlan};
 use crate::resonator::{Mode, ParamError, PhysicsSettings, Resonator, ResonatorParams};
 
 /// A chain mode (`+1` normal, `−1` reverse) as the loop's mode.
@@ -101,6 +104,72 @@ impl FixedSystem {
     /// The chain (its estimator's registers and overflow counts).
     pub fn chain(&self) -> &FixedChain {
         &self.chain
+    }
+}
+
+/// What one ADC sample of the float system gives.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FloatSystemStep {
+    /// The modes the loops took this sample in (`[A, B]`).
+    pub modes: [Mode; 2],
+    /// DAC values `[[A x, A y], [B x, B y]]`, DAC LSB (unquantized).
+    pub dac: [[f64; 2]; 2],
+    /// The loops' lock flags after the sample.
+    pub locked: [bool; 2],
+    /// The loops' decimated rates, °/s, when they produced one this sample.
+    pub rates: Option<[f64; 2]>,
+    /// The chain's sample, °/s, when it stepped.
+    pub chain: Option<FloatChainSample>,
+}
+
+/// The float golden twin of [`FixedSystem`]: both loops' twins ([`FloatGyroLoop`]) feeding the
+/// chain's twin with the quantized coefficients ([`FloatChain::quantized`]), the same sequence
+/// of modes and chain steps.
+#[derive(Clone, Debug)]
+pub struct FloatSystem {
+    loops: [FloatGyroLoop; 2],
+    chain: FloatChain,
+}
+
+impl FloatSystem {
+    /// The twins of `loops` and `chain`, reset.
+    pub fn new(loops: [&LoopPlan; 2], chain: &ChainPlan) -> Self {
+        FloatSystem {
+            loops: loops.map(FloatGyroLoop::new),
+            chain: FloatChain::quantized(chain),
+        }
+    }
+
+    /// The modes the loops take at the next sample if `enable` is high there.
+    pub fn upcoming_modes(&self) -> [Mode; 2] {
+        self.chain.upcoming_modes().map(loop_mode)
+    }
+
+    /// One ADC sample: each gyro's `[x, y]` in full-scale units, `enable` and `bw_sel`.
+    pub fn step(&mut self, adc: [[f64; 2]; 2], enable: bool, bw_sel: usize) -> FloatSystemStep {
+        let modes = if enable {
+            self.upcoming_modes()
+        } else {
+            [Mode::Normal; 2]
+        };
+        let a = self.loops[0].step(adc[0], modes[0]);
+        let b = self.loops[1].step(adc[1], modes[1]);
+        let rates = match (a.chain, b.chain) {
+            (Some(a), Some(b)) => Some([a.rate_dps, b.rate_dps]),
+            (None, None) => None,
+            _ => unreachable!("both loops decimate by the same factor from the same reset"),
+        };
+        let chain = match rates {
+            Some(y) if enable => Some(self.chain.step(y, bw_sel)),
+            _ => None,
+        };
+        FloatSystemStep {
+            modes,
+            dac: [a.dac, b.dac],
+            locked: [self.loops[0].locked(), self.loops[1].locked()],
+            rates,
+            chain,
+        }
     }
 }
 

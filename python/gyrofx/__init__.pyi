@@ -69,6 +69,7 @@ class Plan:
     def gyro_loop_float(self, gyro: str = "a") -> GyroLoopFloat: ...
     def system(self) -> System:
         """Both loops and the chain (resonator plants only)."""
+    def system_float(self) -> SystemFloat: ...
     def resonator(self, gyro: str = "a", seed: Optional[int] = None, noise: bool = True) -> Resonator:
         """The simulated resonator; seed defaults to generate's (2·seed, 2·seed + 1)."""
 
@@ -238,6 +239,17 @@ class System:
         enable: PerSample = 1,
         bw_sel: BandwidthSelect = 0,
     ) -> Dict[str, Codes]: ...
+
+class SystemFloat:
+    """The system's float twin: ADC in full-scale units, DAC in LSB, rates and biases in °/s."""
+
+    def reset(self) -> None: ...
+    def next_modes(self) -> Tuple[int, int]: ...
+    def step(
+        self, adc_a_x: float, adc_a_y: float, adc_b_x: float, adc_b_y: float, enable: int = 1, bw_sel: int = 0
+    ) -> Dict[str, Optional[float]]:
+        """dac_*, locked_*, mode_a, mode_b, out_valid, and rate_out, bias_a, bias_b (None
+        where the chain gave none)."""
 
 class Resonator:
     """A simulated resonator with its front end: DAC codes in, the next ADC codes out."""

@@ -45,6 +45,7 @@ fn _gyrofx(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<loops::GyroLoop>()?;
     module.add_class::<loops::GyroLoopFloat>()?;
     module.add_class::<loops::System>()?;
+    module.add_class::<loops::SystemFloat>()?;
     module.add_class::<loops::Resonator>()?;
     module.add_function(wrap_pyfunction!(codes::quantize, module)?)?;
     module.add_function(wrap_pyfunction!(codes::to_real, module)?)?;

@@ -13,7 +13,8 @@ use gyrofx_codegen::config::GyroLoop as LoopConfig;
 use gyrofx_codegen::golden::{self, check_code, GYRO_LOOP_OUTPUTS, SYSTEM_OUTPUTS};
 use gyrofx_model::chain;
 use gyrofx_model::gyro_loop::gyro::{FloatGyroLoop, Plan as LoopPlan};
-use gyrofx_model::resonator::Resonator as PhysicalResonator;
+use gyrofx_model::resonator::{Mode, Resonator as PhysicalResonator};
+use gyrofx_model::system::FloatSystem;
 
 use crate::blocks::{port_codes, port_dict, same_length, BandwidthSelect};
 use crate::refused;
@@ -311,6 +312,85 @@ impl System {
     #[getter]
     fn window(&self) -> usize {
         self.ports.chain_plan().estimator.schedule.cycle_length()
+    }
+}
+
+/// The system's float twin: both loops' twins feeding the chain's twin (quantized
+/// coefficients), the same modes and chain steps.
+#[pyclass(module = "gyrofx")]
+pub(crate) struct SystemFloat {
+    loops: [LoopPlan; 2],
+    chain: chain::Plan,
+    model: FloatSystem,
+}
+
+impl SystemFloat {
+    pub(crate) fn new(loops: [&LoopPlan; 2], chain: &chain::Plan) -> SystemFloat {
+        SystemFloat {
+            loops: loops.map(Clone::clone),
+            chain: chain.clone(),
+            model: FloatSystem::new(loops, chain),
+        }
+    }
+}
+
+#[pymethods]
+impl SystemFloat {
+    /// Back to the state after construction.
+    fn reset(&mut self) {
+        self.model = FloatSystem::new([&self.loops[0], &self.loops[1]], &self.chain);
+    }
+
+    /// The modes `(mode_a, mode_b)` (1 normal, 0 reverse) the loops take at the next `step` if
+    /// its `enable` is 1.
+    fn next_modes(&self) -> (i64, i64) {
+        let [a, b] = self
+            .model
+            .upcoming_modes()
+            .map(|m| i64::from(m == Mode::Normal));
+        (a, b)
+    }
+
+    /// One ADC sample, both gyros' `[x, y]` in full-scale units. A dict: `dac_a_x` ...
+    /// `dac_b_y` (DAC LSB, unquantized), `locked_a`, `locked_b`, `mode_a`, `mode_b` (the next
+    /// sample's), `out_valid`, and `rate_out`, `bias_a`, `bias_b` (°/s; None where the chain did
+    /// not give them this sample).
+    #[pyo3(signature = (adc_a_x, adc_a_y, adc_b_x, adc_b_y, enable = 1, bw_sel = 0))]
+    #[allow(clippy::too_many_arguments)]
+    fn step<'py>(
+        &mut self,
+        py: Python<'py>,
+        adc_a_x: f64,
+        adc_a_y: f64,
+        adc_b_x: f64,
+        adc_b_y: f64,
+        enable: i64,
+        bw_sel: i64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let enable = golden::check_flag(enable, "enable").map_err(refused)?;
+        let bw_sel =
+            golden::check_bw_sel(bw_sel, self.chain.kf.rom.len(), "bw_sel").map_err(refused)?;
+        let step = self
+            .model
+            .step([[adc_a_x, adc_a_y], [adc_b_x, adc_b_y]], enable, bw_sel);
+        let (mode_a, mode_b) = self.next_modes();
+        let rate = step.chain.and_then(|c| c.rate);
+        let dict = PyDict::new(py);
+        for (name, value) in ["dac_a_x", "dac_a_y", "dac_b_x", "dac_b_y"]
+            .into_iter()
+            .zip(step.dac.as_flattened())
+        {
+            dict.set_item(name, *value)?;
+        }
+        dict.set_item("locked_a", i64::from(step.locked[0]))?;
+        dict.set_item("locked_b", i64::from(step.locked[1]))?;
+        dict.set_item("mode_a", mode_a)?;
+        dict.set_item("mode_b", mode_b)?;
+        dict.set_item("out_valid", i64::from(rate.is_some()))?;
+        dict.set_item("rate_out", rate)?;
+        dict.set_item("bias_a", step.chain.map(|c| c.estimator.bias[0]))?;
+        dict.set_item("bias_b", step.chain.map(|c| c.estimator.bias[1]))?;
+        Ok(dict)
     }
 }
 

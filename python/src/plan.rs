@@ -14,7 +14,7 @@ use crate::blocks::{
     Chain, ChainFloat, Estimator, EstimatorFloat, Kf, KfFloat, MeanFilter, MeanFilterFloat,
     Sequencer,
 };
-use crate::loops::{GyroLoop, GyroLoopFloat, Resonator, System};
+use crate::loops::{GyroLoop, GyroLoopFloat, Resonator, System, SystemFloat};
 use crate::refused;
 
 /// A resolved gyrofx config: the embedded default overlaid by a preset, a TOML text or a file,
@@ -164,6 +164,17 @@ impl Plan {
             .ok_or_else(|| refused(gyrofx_codegen::golden::NO_SYSTEM))?;
         let [a, b] = &self.job.gyro_loops;
         Ok(System::new([&a.plan, &b.plan], chain))
+    }
+
+    /// The system's float twin (quantized coefficients).
+    fn system_float(&self) -> PyResult<SystemFloat> {
+        let chain = self
+            .job
+            .system_chain
+            .as_ref()
+            .ok_or_else(|| refused(gyrofx_codegen::golden::NO_SYSTEM))?;
+        let [a, b] = &self.job.gyro_loops;
+        Ok(SystemFloat::new([&a.plan, &b.plan], chain))
     }
 
     /// The simulated resonator of gyro `"a"` or `"b"` with its front end: DAC codes in, ADC

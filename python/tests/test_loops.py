@@ -178,3 +178,28 @@ def test_the_rate_plant_has_no_system():
     with pytest.raises(gyrofx.GyrofxError, match="no system block"):
         plan.system()
     assert plan.gyro_loop().decimation > 0
+
+
+def test_the_systems_float_twin_takes_the_same_modes_and_chain_steps(package):
+    """Fed the system record's ADC codes as full-scale values, the float twin commands the same
+    modes and gives chain outputs at the same samples; its first output agrees with the fixed
+    one within 0.01 °/s. (The model's Rust test bounds the rest, and says why saturated loop
+    rates after a switch end the comparison: model/src/system/tests.rs.)"""
+    plan = gyrofx.Plan.from_package(package)
+    stimulus = hex_rows(package / "system" / "system_stimulus.hex")
+    expected = hex_rows(package / "system" / "system_expected.hex")
+    twin = plan.system_float()
+    adc_lsb = 2.0 ** -int(plan.gyro_loop().adc_format.split(".")[1])
+    out_frac = int(plan.formats()["kf.output"].split(".")[1])
+    assert twin.next_modes() == plan.system().next_modes()
+    outputs = []
+    for k, (s, want) in enumerate(zip(stimulus, expected)):
+        real = [s[p] * adc_lsb for p in ["adc_a_x", "adc_a_y", "adc_b_x", "adc_b_y"]]
+        got = twin.step(*real, enable=s["enable"], bw_sel=s["bw_sel"])
+        assert (got["mode_a"], got["mode_b"], got["out_valid"]) == (
+            want["mode_a"], want["mode_b"], want["out_valid"]), f"sample {k}"
+        if want["out_valid"]:
+            outputs.append((want["rate_out"] * 2.0**-out_frac, got["rate_out"]))
+    assert len(outputs) >= 10
+    fixed, real = outputs[0]
+    assert abs(fixed - real) < 0.01, outputs[0]

@@ -139,3 +139,57 @@ fn the_system_is_the_chain_over_the_two_closed_loops() {
     assert_eq!(got, expected);
     assert!(got.iter().any(|c| c.rate.is_some()));
 }
+
+/// The float twin fed the fixed system's ADC record takes the same modes at every sample and
+/// steps the chain at the same samples. Its loops' rates follow the fixed ones within 0.01 °/s
+/// (the loop's settling criterion) plus 10⁻⁴ of the rate (the re-acquisition after a switch,
+/// where the two PLLs' phase errors differ by the fixed one's quantization) wherever the fixed
+/// rate is not saturated, and its chain output within the same until the first saturated loop
+/// rate (which the chain then carries in its state; this short schedule blanks too little).
+#[test]
+fn the_float_twin_follows_the_fixed_system_on_its_record() {
+    let chain = chain_plan(3, 1, 1, 0, Rounding::Nearest);
+    let samples = run(&chain);
+    let (loops, _, _) = plans();
+    let mut twin = FloatSystem::new([&loops[0], &loops[1]], &chain);
+    let adc = loops[0].adc;
+    let output = chain.kf.output;
+    let close = |fixed: f64, float: f64| (fixed - float).abs() < 0.01 + 1e-4 * fixed.abs();
+    let unsaturated =
+        |code: i64| i128::from(code) > output.min_code() && i128::from(code) < output.max_code();
+    let (mut loop_rates, mut chain_rates, mut saturated) = (0, 0, false);
+    for (k, s) in samples.iter().enumerate() {
+        let real = s.adc.map(|g| g.map(|c| adc.to_f64(i128::from(c))));
+        let t = twin.step(real, s.enable, 1);
+        assert_eq!(t.modes, s.step.modes, "sample {k}");
+        assert_eq!(t.rates.is_some(), s.step.rates.is_some(), "sample {k}");
+        assert_eq!(t.chain.is_some(), s.step.chain.is_some(), "sample {k}");
+        if let (Some(fixed), Some(float)) = (s.step.rates, t.rates) {
+            for g in 0..2 {
+                if unsaturated(fixed[g]) {
+                    let fixed_dps = output.to_f64(i128::from(fixed[g]));
+                    assert!(
+                        close(fixed_dps, float[g]),
+                        "sample {k} gyro {g}: {fixed_dps} {}",
+                        float[g]
+                    );
+                    loop_rates += 1;
+                } else {
+                    saturated = true;
+                }
+            }
+        }
+        if let (Some(fixed), Some(float), false) = (s.step.chain, t.chain, saturated) {
+            assert_eq!(fixed.rate.is_some(), float.rate.is_some(), "sample {k}");
+            if let (Some(code), Some(rate)) = (fixed.rate, float.rate) {
+                let fixed_dps = output.to_f64(i128::from(code));
+                assert!(close(fixed_dps, rate), "sample {k}: {fixed_dps} {rate}");
+                chain_rates += 1;
+            }
+        }
+    }
+    assert!(
+        loop_rates >= 10 && chain_rates >= 3,
+        "{loop_rates} {chain_rates}"
+    );
+}
