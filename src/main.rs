@@ -8,7 +8,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use commands::{
-    allan, ar, davar, design, filter, generate, gyro_loop, init, reproduce, synth, verify,
+    allan, ar, davar, design, filter, formats, generate, gyro_loop, init, reproduce, synth, verify,
 };
 
 #[derive(Parser)]
@@ -30,6 +30,7 @@ enum Command {
     Davar(davar::Args),
     Init(init::Args),
     Design(design::Args),
+    Formats(formats::Args),
     Generate(generate::Args),
     Synth(synth::Args),
     Loop(gyro_loop::Args),
@@ -53,6 +54,7 @@ fn main() -> ExitCode {
         Command::Davar(args) => davar::run(args),
         Command::Init(args) => init::run(args),
         Command::Design(args) => design::run(args),
+        Command::Formats(args) => formats::run(args),
         Command::Generate(args) => generate::run(args),
         Command::Synth(args) => synth::run(args),
         Command::Loop(args) => gyro_loop::run(args),

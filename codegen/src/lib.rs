@@ -15,6 +15,7 @@ pub mod config;
 pub mod dpi;
 pub mod error;
 pub mod filter_package;
+pub mod formats;
 pub mod generate;
 pub mod golden;
 pub mod hdl;

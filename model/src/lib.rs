@@ -15,6 +15,7 @@ pub mod gyro_loop;
 pub mod kf;
 pub mod mean_filter;
 pub mod plant;
+pub mod range;
 pub mod resonator;
 pub mod sequencer;
 pub mod stimulus;

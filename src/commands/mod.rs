@@ -5,6 +5,7 @@ pub mod ar;
 pub mod davar;
 pub mod design;
 pub mod filter;
+pub mod formats;
 pub mod generate;
 pub mod gyro_loop;
 pub mod init;

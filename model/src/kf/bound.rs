@@ -41,40 +41,93 @@ use super::plan::Plan;
 /// at most `switches` changes of `bw_sel` (see the module doc). Both models use the plan's
 /// quantized gains. Valid while no quantizer overflows.
 pub fn rate_error_bound_lsb(plan: &Plan, samples: u64, switches: u64) -> f64 {
-    let gains = plan.quantized_gains();
-    let q_x = plan.state.lsb();
-    let q_out = plan.output.lsb();
-    let u = plan.rounding.max_error_lsb();
-    let n = samples as f64;
-    let m = switches as f64;
-
-    let mut rho: f64 = 0.0;
-    let mut alpha_per_unit: f64 = 0.0;
-    let mut largest_gain: f64 = 0.0;
-    let ratios: Vec<f64> = gains.iter().map(|g| g[0] / (g[0] + g[1])).collect();
-    for g in &gains {
-        let s = g[0] + g[1];
-        rho = rho.max((1.0 - s).abs());
-        alpha_per_unit = alpha_per_unit.max((g[0].abs() + g[1].abs()) / s.abs());
-        largest_gain = largest_gain.max(g[0].abs()).max(g[1].abs());
-    }
-    if rho >= 1.0 {
+    let terms = Terms::of(plan);
+    if terms.rho >= 1.0 {
         return f64::INFINITY;
     }
-    let largest_ratio = ratios.iter().fold(0.0f64, |a, r| a.max(r.abs()));
-    let ratio_jump = ratios
-        .iter()
-        .flat_map(|a| ratios.iter().map(move |b| (a - b).abs()))
-        .fold(0.0f64, f64::max);
-
-    let epsilon_one = |per_sample: f64| {
-        let h_max = 2.0 * per_sample / (1.0 - rho);
-        n * per_sample * alpha_per_unit + m * h_max * ratio_jump + largest_ratio * h_max
-    };
-    let fixed = epsilon_one(u * q_x);
+    let q_out = plan.output.lsb();
+    let u = plan.rounding.max_error_lsb();
+    let fixed = terms.epsilon(
+        u * plan.state.lsb(),
+        samples,
+        switches,
+        terms.largest_ratio[0],
+    );
     let magnitude = 4.0 * plan.state.max_value().max(plan.input.max_value());
-    let float = epsilon_one(crate::fx::pow2(-52) * magnitude * (1.0 + 9.0 * largest_gain));
+    let float = terms.epsilon(
+        crate::fx::pow2(-52) * magnitude * (1.0 + 9.0 * terms.largest_gain),
+        samples,
+        switches,
+        terms.largest_ratio[0],
+    );
     (fixed + float) / q_out + plan.rounding.max_error_lsb()
+}
+
+/// Worst-case `|x_fixed − x_exact|` of the two state registers `[x1, x2]` (real units, °/s)
+/// after `samples` samples with at most `switches` changes of `bw_sel`: the fixed model's
+/// rounding against exact arithmetic on the same quantized gains (the module doc's `ε1`, and
+/// `ε2 = −a + (g2/S) h` alike). Infinite when a ROM entry's pole is not inside the unit circle.
+pub fn state_error_bounds(plan: &Plan, samples: u64, switches: u64) -> [f64; 2] {
+    let terms = Terms::of(plan);
+    if terms.rho >= 1.0 {
+        return [f64::INFINITY; 2];
+    }
+    let per_sample = plan.rounding.max_error_lsb() * plan.state.lsb();
+    terms
+        .largest_ratio
+        .map(|ratio| terms.epsilon(per_sample, samples, switches, ratio))
+}
+
+/// The quantities of the module doc over the plan's quantized ROM.
+struct Terms {
+    /// `max |1 − S|`.
+    rho: f64,
+    /// `max (|g1| + |g2|)/|S|`.
+    alpha_per_unit: f64,
+    /// `max |g|`.
+    largest_gain: f64,
+    /// `max |g1/S|`, `max |g2/S|`.
+    largest_ratio: [f64; 2],
+    /// `max |g1/S − g1'/S'|` over pairs of entries.
+    ratio_jump: f64,
+}
+
+impl Terms {
+    fn of(plan: &Plan) -> Terms {
+        let gains = plan.quantized_gains();
+        let mut terms = Terms {
+            rho: 0.0,
+            alpha_per_unit: 0.0,
+            largest_gain: 0.0,
+            largest_ratio: [0.0; 2],
+            ratio_jump: 0.0,
+        };
+        let ratios: Vec<f64> = gains.iter().map(|g| g[0] / (g[0] + g[1])).collect();
+        for g in &gains {
+            let s = g[0] + g[1];
+            terms.rho = terms.rho.max((1.0 - s).abs());
+            terms.alpha_per_unit = terms
+                .alpha_per_unit
+                .max((g[0].abs() + g[1].abs()) / s.abs());
+            terms.largest_gain = terms.largest_gain.max(g[0].abs()).max(g[1].abs());
+            for (largest, gain) in terms.largest_ratio.iter_mut().zip(g) {
+                *largest = largest.max((gain / s).abs());
+            }
+        }
+        terms.ratio_jump = ratios
+            .iter()
+            .flat_map(|a| ratios.iter().map(move |b| (a - b).abs()))
+            .fold(0.0f64, f64::max);
+        terms
+    }
+
+    /// `n·δ·α + m·H_max·jump + ratio·H_max` for a per-sample error `δ` per component.
+    fn epsilon(&self, per_sample: f64, samples: u64, switches: u64, ratio: f64) -> f64 {
+        let h_max = 2.0 * per_sample / (1.0 - self.rho);
+        samples as f64 * per_sample * self.alpha_per_unit
+            + switches as f64 * h_max * self.ratio_jump
+            + ratio * h_max
+    }
 }
 
 /// Expected rms of the unobservable random walk after `samples` samples with

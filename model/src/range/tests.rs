@@ -1,0 +1,240 @@
+//! The proven ranges hold for every input (proptest over random KF plans and inputs) and are
+//! tight: the input with every tap's sign at full scale reaches at least 90 % of them, and the
+//! node one integer bit narrower overflows on it.
+
+use proptest::prelude::*;
+
+use super::*;
+use crate::estimator::FixedEstimator;
+use crate::examples::{chain_plan, kf_spec};
+use crate::fx::{Overflow, Rounding};
+use crate::kf::{CoefficientFormat, FixedKf, Plan, Spec};
+use crate::sequencer::Sequencer;
+
+fn format(text: &str) -> Format {
+    text.parse().unwrap()
+}
+
+#[test]
+fn integer_bits_are_exact_at_powers_of_two() {
+    let full = Interval::of_format(format("s24.14"));
+    assert_eq!(full.signed_integer_bits(14), 10);
+    // One LSB beyond the top, or the bottom one below, needs another bit.
+    assert_eq!(full.widen(pow2(-14)).signed_integer_bits(14), 11);
+    assert_eq!(Interval::new(-512.0, 0.0).signed_integer_bits(14), 10);
+    assert_eq!(
+        Interval::new(-512.0 - pow2(-14), 0.0).signed_integer_bits(14),
+        11
+    );
+    assert_eq!(Interval::new(0.0, 512.0).signed_integer_bits(14), 11);
+    assert_eq!(Interval::new(-0.25, 0.2).signed_integer_bits(20), -1);
+    assert!(full.fits(format("s24.14")) && !full.fits(format("s23.14")));
+}
+
+/// The fixed KF from reset at a constant `bw_sel`, fed `z`: the extremes `[x1, x2]` reached
+/// (°/s) and whether the states ever saturated.
+fn extremes(plan: &Plan, bw_sel: usize, z: impl Iterator<Item = i64>) -> [Interval; 2] {
+    let mut kf = FixedKf::new(plan);
+    let mut seen = [Interval::new(0.0, 0.0); 2];
+    for code in z {
+        kf.step(code, bw_sel);
+        for (range, x) in seen.iter_mut().zip(kf.state()) {
+            let value = plan.state.to_f64(x);
+            *range = range.union(Interval::new(value, value));
+        }
+    }
+    seen
+}
+
+fn node<'a>(ranges: &'a KfRanges, name: &str) -> &'a NodeRange {
+    ranges.nodes.iter().find(|n| n.name == name).unwrap()
+}
+
+#[test]
+fn the_kf_state_bound_is_reached_by_full_scale_input_and_one_bit_less_overflows() {
+    let plan = Plan::new(&kf_spec()).unwrap();
+    let input = Interval::of_format(plan.input);
+    // Worst-case rounding drifts x1 by up to 2^-27 °/s a sample (all errors one way): the
+    // default's state format is proven for records this short; longer ones need a guard bit
+    // more, or round-to-nearest's statistics (kf::bound's module doc).
+    let samples = 2000;
+    let ranges = kf(&plan, input, samples, 0);
+    let state = node(&ranges, "kf.state");
+    assert!(state.fits(), "{state:?}");
+    assert_eq!(state.needed_integer_bits(), state.integer_bits());
+    for bw_sel in 0..plan.rom.len() {
+        // Every tap of y is positive (0 < S < 1): z at full scale takes x1 to its bound.
+        let high = extremes(
+            &plan,
+            bw_sel,
+            (0..samples).map(|_| plan.input.max_code() as i64),
+        );
+        let low = extremes(
+            &plan,
+            bw_sel,
+            (0..samples).map(|_| plan.input.min_code() as i64),
+        );
+        let reached = high[0].union(low[0]);
+        assert!(reached.hi >= 0.9 * state.range.hi, "{reached:?} {state:?}");
+        assert!(reached.lo <= 0.9 * state.range.lo, "{reached:?} {state:?}");
+        // One integer bit fewer cannot hold what the input reached.
+        let narrower = Format::signed(plan.state.width - 1, plan.state.frac).unwrap();
+        assert!(!reached.fits(narrower), "{reached:?} fits {narrower}");
+        assert!(reached.lo >= state.range.lo && reached.hi <= state.range.hi);
+    }
+}
+
+#[test]
+fn the_innovation_bound_is_reached_after_a_full_scale_step() {
+    let plan = Plan::new(&kf_spec()).unwrap();
+    let input = Interval::of_format(plan.input);
+    let ranges = kf(&plan, input, 10_000, 0);
+    let error = node(&ranges, "kf.error");
+    for bw_sel in 0..plan.rom.len() {
+        let mut kf = FixedKf::new(&plan);
+        for _ in 0..2000 {
+            kf.step(plan.input.min_code() as i64, bw_sel);
+        }
+        let [x1, x2] = kf.state().map(|x| plan.state.to_f64(x));
+        let e = plan.input.max_value() - x1 - x2;
+        assert!(
+            e >= 0.9 * error.range.hi && e <= error.range.hi,
+            "{e} {error:?}"
+        );
+    }
+    assert!(
+        error.fits(),
+        "the plan's exact e format holds it: {error:?}"
+    );
+}
+
+#[test]
+fn switching_bw_sel_grows_the_state_range_and_the_analysis_says_by_how_much() {
+    let plan = Plan::new(&kf_spec()).unwrap();
+    let input = Interval::of_format(plan.input);
+    let still = kf(&plan, input, 1000, 0);
+    let switching = kf(&plan, input, 1000, 1000);
+    assert!(still.per_switch > 0.0);
+    let grown = node(&switching, "kf.state").range.hi - node(&still, "kf.state").range.hi;
+    assert!(grown >= 1000.0 * still.per_switch, "{grown}");
+}
+
+/// A random KF plan: gains with `0 < S < 2`, formats with a few guard bits, any rounding.
+fn random_plan() -> impl Strategy<Value = Plan> {
+    (
+        prop::collection::vec((0.01f64..1.9, 0.0001f64..0.5), 1..4),
+        8u32..16,
+        0i32..8,
+        0i32..12,
+        prop::sample::select(vec![
+            Rounding::Nearest,
+            Rounding::Floor,
+            Rounding::Convergent,
+        ]),
+    )
+        .prop_filter_map("plannable", |(sums, in_width, in_frac, guard, rounding)| {
+            let gains: Vec<[f64; 2]> = sums
+                .iter()
+                .map(|(s, split)| [s * (1.0 - split), s * split])
+                .collect();
+            let input = Format::signed(in_width, in_frac).ok()?;
+            let spec = Spec {
+                input,
+                // Two integer bits of headroom over the input: the range check decides.
+                state: Format::signed(in_width + 2 + guard as u32, in_frac + guard).ok()?,
+                output: input,
+                coefficients: [CoefficientFormat::Auto { width: 18 }; 2],
+                rounding,
+                overflow: Overflow::Saturate,
+                labels: (0..gains.len()).map(|i| i.to_string()).collect(),
+                gains,
+            };
+            Plan::new(&spec).ok()
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// No input inside the range, at any bw_sel sequence, takes a state outside its proven
+    /// range (so a format chosen from it cannot overflow).
+    #[test]
+    fn no_input_leaves_the_proven_kf_ranges(
+        plan in random_plan(),
+        inputs in prop::collection::vec((any::<u32>(), 0u8..4, any::<bool>()), 1..600),
+    ) {
+        let input = Interval::of_format(plan.input);
+        let switches = inputs.windows(2).filter(|w| w[0].1 != w[1].1).count() as u64;
+        let ranges = kf(&plan, input, inputs.len() as u64, switches);
+        let state = node(&ranges, "kf.state").range;
+        let mut fixed = FixedKf::new(&plan);
+        let (min, max) = (plan.input.min_code(), plan.input.max_code());
+        for (raw, select, extreme) in inputs {
+            // Half the samples at a full-scale extreme, the rest anywhere in the range.
+            let code = if extreme {
+                if raw % 2 == 0 { max } else { min }
+            } else {
+                min + i128::from(raw) % (max - min + 1)
+            };
+            fixed.step(code as i64, usize::from(select) % plan.rom.len());
+            for x in fixed.state() {
+                let value = plan.state.to_f64(x);
+                prop_assert!(value >= state.lo && value <= state.hi, "{} outside {:?}", value, state);
+            }
+        }
+    }
+}
+
+#[test]
+fn the_bias_bound_is_reached_by_means_with_the_gains_signs() {
+    let plan = chain_plan(20, 2, 0, 0, Rounding::Nearest).estimator;
+    let input = Interval::of_format(plan.input);
+    let nodes = estimator(&plan, input);
+    let bias = nodes.iter().find(|n| n.name == "estimator.bias").unwrap();
+    let calibrated = nodes
+        .iter()
+        .find(|n| n.name == "estimator.calibrated")
+        .unwrap();
+    assert!(bias.fits(), "{bias:?}");
+    // The calibrated sample can reach about twice full scale: the KF's input format cannot
+    // hold it, and the analysis says so (the calibration saturates).
+    assert!(
+        !calibrated.fits() && calibrated.needed_integer_bits() == calibrated.integer_bits() + 1
+    );
+    // Gyro A's samples at full scale with the sign of A's gain for each interval's mean.
+    let mut sequencer = Sequencer::new(&plan.schedule);
+    let mut fixed = FixedEstimator::new(&plan);
+    let (max, min) = (plan.input.max_code() as i64, plan.input.min_code() as i64);
+    for _ in 0..plan.schedule.cycle_length() {
+        let slot = sequencer.advance();
+        // m = [mA0, mB0, mA1, mB1, ...]: A's gain for interval i is entry 2i of row A.
+        let gain = plan.rom[0][2 * slot.interval_a];
+        let y_a = if gain >= 0 { max } else { min };
+        fixed.step(&slot, [y_a, 0]);
+    }
+    assert!(fixed.estimated());
+    let reached = plan.bias.to_f64(fixed.bias()[0]);
+    assert!(
+        reached >= 0.9 * bias.range.hi && reached <= bias.range.hi,
+        "{reached} {bias:?}"
+    );
+    let narrower = Format::signed(plan.bias.width - 1, plan.bias.frac).unwrap();
+    assert!(reached > narrower.max_value(), "one bit fewer overflows");
+}
+
+#[test]
+fn quantizing_an_interval_rounds_its_endpoints_by_the_mode() {
+    let q = |lo: f64, hi: f64, rounding| {
+        let i = Interval::new(lo, hi).quantized(1, rounding);
+        (i.lo, i.hi)
+    };
+    assert_eq!(q(-0.3, 0.3, Rounding::Floor), (-0.5, 0.0));
+    assert_eq!(q(-0.3, 0.3, Rounding::Ceil), (0.0, 0.5));
+    assert_eq!(q(-0.3, 0.3, Rounding::Zero), (0.0, 0.0));
+    assert_eq!(q(-0.25, 0.75, Rounding::Nearest), (0.0, 1.0));
+    assert_eq!(q(-0.25, 0.75, Rounding::Round), (-0.5, 1.0));
+    assert_eq!(q(0.25, 0.75, Rounding::Convergent), (0.0, 1.0));
+    // The output of the default KF rounds back onto the format's last code.
+    let near = Interval::new(-512.000_002, 511.999_941).quantized(14, Rounding::Nearest);
+    assert!(near.fits("s24.14".parse().unwrap()));
+}

@@ -1,0 +1,162 @@
+//! `gyrofx formats`: the table and JSON name every analysed node with its proven range, a
+//! too-narrow format is reported (and `--strict` fails on it), `--write` gives a config whose
+//! configured nodes are proven and which `generate --strict` accepts, and an existing file is
+//! not replaced without `--force`.
+
+mod common;
+
+use common::{fails, gyrofx, ok, run_tool, text};
+
+fn nodes(json: &serde_json::Value) -> Vec<serde_json::Value> {
+    json["nodes"].as_array().unwrap().clone()
+}
+
+fn node<'a>(nodes: &'a [serde_json::Value], name: &str) -> &'a serde_json::Value {
+    nodes
+        .iter()
+        .find(|n| n["node"] == name)
+        .unwrap_or_else(|| panic!("{name} in {nodes:?}"))
+}
+
+#[test]
+fn the_default_is_analysed_node_by_node() {
+    let table = ok(&["formats", "--switches", "0"]);
+    for name in [
+        "estimator.accumulator",
+        "estimator.mean",
+        "estimator.bias",
+        "estimator.calibrated",
+        "kf.error",
+        "kf.state",
+        "kf.output",
+    ] {
+        assert!(table.contains(name), "{name}: {table}");
+    }
+    assert!(
+        table.contains("hand-set, not analysed: [mean_filter]"),
+        "{table}"
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&ok(&["formats", "--json", "--switches", "0"])).unwrap();
+    let nodes = nodes(&json);
+    let input = json["input_range_dps"].as_array().unwrap();
+    let (low, high) = (input[0].as_f64().unwrap(), input[1].as_f64().unwrap());
+    // The calibrated sample is y ∓ b with both at full scale: about twice the input range,
+    // one integer bit more than the KF's input format has.
+    let calibrated = node(&nodes, "estimator.calibrated");
+    assert_eq!(calibrated["fits"], false);
+    assert_eq!(
+        calibrated["needed_integer_bits"].as_i64().unwrap(),
+        calibrated["integer_bits"].as_i64().unwrap() + 1
+    );
+    let range = calibrated["range_dps"].as_array().unwrap();
+    assert!(range[1].as_f64().unwrap() > 1.9 * high && range[0].as_f64().unwrap() < 1.9 * low);
+    // Every node whose format is derived by bit growth holds its range.
+    for n in &nodes {
+        if n["exact"] == true {
+            assert_eq!(n["fits"], true, "{n}");
+        }
+    }
+    // The KF's state reaches about the input range (its DC gain is about 1).
+    let state = node(&nodes, "kf.state")["range_dps"]
+        .as_array()
+        .unwrap()
+        .clone();
+    assert!(state[1].as_f64().unwrap() > 0.99 * high);
+}
+
+/// The record length the table gives for the KF's state is the edge: proven at it, not one
+/// sample later.
+#[test]
+fn the_state_limit_is_where_the_proof_ends() {
+    let json: serde_json::Value =
+        serde_json::from_str(&ok(&["formats", "--json", "--switches", "0"])).unwrap();
+    let limit = json["kf"]["state_proven_up_to_samples"].as_u64().unwrap();
+    let fits = |samples: u64| {
+        let json: serde_json::Value = serde_json::from_str(&ok(&[
+            "formats",
+            "--json",
+            "--switches",
+            "0",
+            "--samples",
+            &samples.to_string(),
+        ]))
+        .unwrap();
+        node(&nodes(&json), "kf.state")["fits"] == true
+    };
+    assert!(fits(limit) && !fits(limit + 1), "{limit}");
+}
+
+#[test]
+fn a_narrow_format_is_reported_and_strict_fails_on_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("narrow.toml");
+    std::fs::write(&config, "[kf]\nstate_format = \"s32.26\"\n").unwrap();
+    let config = config.to_str().unwrap();
+    // A short record without switches: the state needs the ADC's 10 integer bits (±512 °/s).
+    let table = ok(&[
+        "formats",
+        "--config",
+        config,
+        "--samples",
+        "1000",
+        "--switches",
+        "0",
+    ]);
+    let line = table.lines().find(|l| l.starts_with("kf.state")).unwrap();
+    assert!(
+        line.contains("OVERFLOW POSSIBLE: needs 4 more integer bits (set kf.state_format)"),
+        "{line}"
+    );
+    let message = fails(&["formats", "--config", config, "--strict"]);
+    assert!(message.contains("kf.state"), "{message}");
+    let output = gyrofx(&["formats", "--config", config, "--strict"]);
+    assert_eq!(output.status.code(), Some(1), "{}", text(&output));
+}
+
+#[test]
+fn write_gives_a_proven_config_that_generate_accepts_and_keeps_existing_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let derived = dir.path().join("derived.toml");
+    let derived_text = derived.to_str().unwrap();
+    ok(&["formats", "--switches", "100", "--write", derived_text]);
+    let json: serde_json::Value = serde_json::from_str(&ok(&[
+        "formats",
+        "--config",
+        derived_text,
+        "--switches",
+        "100",
+        "--json",
+    ]))
+    .unwrap();
+    for n in nodes(&json) {
+        // Every node --write sets is now proven; the shared input format is left as it was.
+        if n["config_key"].is_string() && n["not_written"].is_null() {
+            assert_eq!(n["fits"], true, "{n}");
+        }
+    }
+    let out = dir.path().join("pkg");
+    ok(&[
+        "generate",
+        "--config",
+        derived_text,
+        "--out",
+        out.to_str().unwrap(),
+        "--samples",
+        "2000",
+        "--strict",
+        "--quiet",
+    ]);
+    let (passed, log) = run_tool("make", &["--no-print-directory", "iverilog-kf"], &out);
+    assert!(passed && log.contains("PASS"), "{log}");
+    // An existing file: refused (exit 2), unchanged; --force replaces it.
+    std::fs::write(&derived, "mine").unwrap();
+    let output = gyrofx(&["formats", "--write", derived_text]);
+    assert_eq!(output.status.code(), Some(2), "{}", text(&output));
+    assert!(text(&output).contains("give --force"), "{}", text(&output));
+    assert_eq!(std::fs::read_to_string(&derived).unwrap(), "mine");
+    ok(&["formats", "--write", derived_text, "--force"]);
+    assert!(std::fs::read_to_string(&derived)
+        .unwrap()
+        .starts_with("# written by gyrofx formats"));
+}
