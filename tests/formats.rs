@@ -160,3 +160,28 @@ fn write_gives_a_proven_config_that_generate_accepts_and_keeps_existing_files() 
         .unwrap()
         .starts_with("# written by gyrofx formats"));
 }
+
+/// A package's manifest says, per node, whether its format is proven for the run, as
+/// `gyrofx formats` says for the same record length and switches.
+#[test]
+fn the_manifest_records_which_formats_are_proven() {
+    let dir = tempfile::tempdir().unwrap();
+    let package = common::generate_default(dir.path(), "1000");
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(package.join("manifest.json")).unwrap()).unwrap();
+    let formats = &manifest["formats"];
+    assert_eq!(formats["samples"], 1000);
+    let switches = formats["switches"].as_u64().unwrap();
+    assert!(switches >= 2, "the run cycles bw_sel: {switches}");
+    let json: serde_json::Value = serde_json::from_str(&ok(&[
+        "formats",
+        "--json",
+        "--samples",
+        "1000",
+        "--switches",
+        &switches.to_string(),
+    ]))
+    .unwrap();
+    assert_eq!(formats["nodes"], json["nodes"]);
+    assert!(formats["hand_set"].as_array().unwrap().len() >= 2);
+}

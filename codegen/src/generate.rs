@@ -222,6 +222,12 @@ pub fn build_package(
             sections.insert(key.to_string(), section);
         }
     }
+    // Which formats are proven for this run's length and bw_sel switches, and which hand-set.
+    let switches = crate::vectors::bw_sel_switches(run.samples, job.kf().rom.len());
+    sections.insert(
+        "formats".into(),
+        crate::formats::analyse(job, run.samples as u64, switches).json(),
+    );
     sections.insert("files".to_string(), json!(package.entries()));
     let mut text = serde_json::to_string_pretty(&manifest).expect("manifest serializes");
     text.push('\n');

@@ -164,6 +164,20 @@ pub struct Results {
     pub system_record: Option<crate::blocks::system::SystemSummary>,
 }
 
+/// Samples the run keeps each `bw_sel` for: it cycles through the ROM twice.
+fn bw_sel_chunk(samples: usize, entries: usize) -> usize {
+    (samples / (2 * entries)).max(1)
+}
+
+/// Changes of `bw_sel` in a run of `samples` samples over `entries` ROM entries.
+pub fn bw_sel_switches(samples: usize, entries: usize) -> u64 {
+    if entries < 2 || samples == 0 {
+        0
+    } else {
+        ((samples - 1) / bw_sel_chunk(samples, entries)) as u64
+    }
+}
+
 /// Everything the run produced.
 #[derive(Debug)]
 pub struct Run {
@@ -252,7 +266,7 @@ fn run_with(
     };
     progress.plan((simulations + 1) * n as u64);
     let entries = kf.rom.len();
-    let chunk = (n / (2 * entries)).max(1);
+    let chunk = bw_sel_chunk(n, entries);
     // One reset of the whole chain, late in the run, so that the report has a long stretch of
     // calibrated output before it.
     // A recording runs without it: its rows follow the sequencer from the first on.
@@ -679,6 +693,29 @@ impl ReportStream {
 mod tests {
     use super::*;
     use crate::blocks::mean_filter::GROSS_ERROR_PERIOD;
+
+    #[test]
+    fn the_switch_count_is_the_runs_bw_sel_changes() {
+        for (samples, entries) in [
+            (0, 3),
+            (1, 3),
+            (5, 3),
+            (10_000, 3),
+            (10_001, 2),
+            (7, 1),
+            (999, 4),
+        ] {
+            let chunk = bw_sel_chunk(samples, entries);
+            let changes = (1..samples)
+                .filter(|k| (k / chunk) % entries != ((k - 1) / chunk) % entries)
+                .count() as u64;
+            assert_eq!(
+                bw_sel_switches(samples, entries),
+                changes,
+                "{samples} {entries}"
+            );
+        }
+    }
     use crate::config::Config;
     use crate::writers::Provenance;
     use gyrofx_model::kf::FixedKf;
