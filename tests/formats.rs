@@ -185,3 +185,59 @@ fn the_manifest_records_which_formats_are_proven() {
     assert_eq!(formats["nodes"], json["nodes"]);
     assert!(formats["hand_set"].as_array().unwrap().len() >= 2);
 }
+
+/// `--output-error` chooses fraction bits whose chain bound, in the package generated from the
+/// written config, is within the budget and whose measured error is below it; a budget under
+/// the fixed roundings is a usage error naming the least one, and °/s budgets convert.
+#[test]
+fn an_output_error_budget_is_met_by_the_written_config() {
+    let dir = tempfile::tempdir().unwrap();
+    let derived = dir.path().join("budget.toml");
+    let derived_text = derived.to_str().unwrap();
+    let table = ok(&[
+        "formats",
+        "--output-error",
+        "2",
+        "--samples",
+        "3000",
+        "--switches",
+        "20",
+        "--write",
+        derived_text,
+    ]);
+    assert!(
+        table.contains("for an output error of at most 2.000 LSB"),
+        "{table}"
+    );
+    let out = dir.path().join("pkg");
+    ok(&[
+        "generate",
+        "--config",
+        derived_text,
+        "--out",
+        out.to_str().unwrap(),
+        "--samples",
+        "3000",
+        "--strict",
+        "--quiet",
+    ]);
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("manifest.json")).unwrap()).unwrap();
+    let chain = &manifest["chain"]["fixed_vs_float"];
+    assert!(manifest["formats"]["switches"].as_u64().unwrap() <= 20);
+    assert!(chain["bound_lsb"].as_f64().unwrap() <= 2.0, "{chain}");
+    assert!(chain["max_lsb"].as_f64().unwrap() <= chain["bound_lsb"].as_f64().unwrap());
+    let output = gyrofx(&["formats", "--output-error", "1"]);
+    assert_eq!(output.status.code(), Some(2), "{}", text(&output));
+    assert!(
+        text(&output).contains("--output-error 1 LSB is not allowed: more than 1.5"),
+        "{}",
+        text(&output)
+    );
+    // 2^-13 °/s is two output LSB of s24.14.
+    let dps = ok(&["formats", "--output-error", "0.0001220703125dps"]);
+    let lsb = ok(&["formats", "--output-error", "2"]);
+    let last = |t: &str| t.lines().last().unwrap().to_string();
+    assert_eq!(last(&dps), last(&lsb));
+    assert!(last(&lsb).contains("at most 2.000 LSB"), "{lsb}");
+}

@@ -15,9 +15,12 @@ use gyrofx_model::kf::bound::rate_error_bound_lsb;
 use gyrofx_model::range::{self, Interval, NodeRange};
 use serde_json::json;
 
+use gyrofx_model::chain;
+use gyrofx_model::estimator;
+
 use crate::config::Config;
 use crate::error::{Error, Result};
-use crate::job::Job;
+use crate::job::{plan_for, Job};
 
 /// One analysed node.
 #[derive(Clone, Debug)]
@@ -63,6 +66,136 @@ pub struct Analysis {
     /// The longest record (samples, with `switches`) for which the configured KF state format
     /// is proven; `None` when not even a record of 0 samples is (the switches alone overflow).
     pub kf_state_limit: Option<u64>,
+}
+
+/// Fraction bits chosen for an error budget on the chain's output.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Budget {
+    /// The budget: `|rate_hat_fixed − rate_hat_float|`, KF output LSB.
+    pub budget_lsb: f64,
+    /// The least any fraction bits can give: the output's and the calibrated samples' own
+    /// roundings, whose formats are the ADC's and the output's.
+    pub floor_lsb: f64,
+    /// The interval means' and bias estimates' formats.
+    pub mean: Format,
+    /// The bias estimates' format.
+    pub bias: Format,
+    /// The KF state's format.
+    pub state: Format,
+    /// The chain's bound with them, output LSB.
+    pub bound_lsb: f64,
+}
+
+/// The most guard bits the budget search tries per block.
+const MAX_GUARD_BITS: i32 = 40;
+
+/// A signed format of `frac` fraction bits with the integer bits `range` needs.
+fn holding(range: Interval, frac: i32) -> Format {
+    Format {
+        signed: true,
+        width: (range.signed_integer_bits(frac) + frac).max(1) as u32,
+        frac,
+    }
+}
+
+/// The estimator of `job` with interval means and bias estimates at `frac` fraction bits
+/// (integer bits as their proven ranges need).
+fn estimator_at(job: &Job, frac: i32) -> Option<estimator::Plan> {
+    let mut spec = job.settings.estimator.clone();
+    // Provisional formats wide enough for the analysis, then the proven ones.
+    spec.mean = Format::signed(64, frac).ok()?;
+    spec.bias = spec.mean;
+    let wide = estimator::Plan::new(&spec).ok()?;
+    let input = Interval::of_format(wide.input);
+    let nodes = range::estimator(&wide, input);
+    let range_of = |name: &str| nodes.iter().find(|n| n.name == name).map(|n| n.range);
+    spec.mean = holding(range_of("estimator.mean")?, frac);
+    spec.bias = holding(range_of("estimator.bias")?, frac);
+    estimator::Plan::new(&spec).ok()
+}
+
+/// The KF of `job` with its state at `frac` fraction bits (integer bits as the proven range
+/// needs for the record).
+fn kf_at(job: &Job, frac: i32, samples: u64, switches: u64) -> Option<gyrofx_model::kf::Plan> {
+    let mut settings = job.settings.kf.clone();
+    settings.state = Format::signed(64, frac).ok()?;
+    let wide = plan_for(&settings, &job.designs).ok()?;
+    let ranges = range::kf(&wide, Interval::of_format(wide.input), samples, switches);
+    let state = ranges.nodes.iter().find(|n| n.name == "kf.state")?.range;
+    settings.state = holding(state, frac);
+    plan_for(&settings, &job.designs).ok()
+}
+
+/// The fewest guard bits (estimator first, then the KF's state) that keep the chain's output
+/// within `budget_lsb` of its float model over the record.
+///
+/// # Errors
+/// Why the budget is refused: at or below what the fixed roundings give, or not met by any
+/// format up to [`MAX_GUARD_BITS`] guard bits.
+pub fn fractions_for(
+    job: &Job,
+    samples: u64,
+    switches: u64,
+    budget_lsb: f64,
+) -> std::result::Result<Budget, String> {
+    let chain = &job.chain;
+    let u = chain.estimator.rounding.max_error_lsb();
+    let gain = chain
+        .kf
+        .quantized_gains()
+        .iter()
+        .map(|g| g[0].abs() / (1.0 - (1.0 - g[0] - g[1]).abs()))
+        .fold(0.0, f64::max);
+    let floor_lsb = u + gain * 2.0 * u * chain.estimator.calibrated.lsb() / chain.kf.output.lsb();
+    let refuse =
+        |allowed: String| format!("--output-error {budget_lsb} LSB is not allowed: {allowed}");
+    if !(budget_lsb.is_finite() && budget_lsb > floor_lsb) {
+        return Err(refuse(format!(
+            "more than {floor_lsb:.3} LSB: the output's rounding and the calibrated samples' (their formats are kf.output_format and kf.input_format) give that much with any guard bits"
+        )));
+    }
+    let input_frac = chain.estimator.input.frac;
+    let output_frac = chain.kf.output.frac;
+    let mut best: Option<(i32, Budget)> = None;
+    for estimator_guard in 0..=MAX_GUARD_BITS {
+        let Some(est) = estimator_at(job, input_frac + estimator_guard) else {
+            continue;
+        };
+        for state_guard in 0..=MAX_GUARD_BITS {
+            if best
+                .as_ref()
+                .is_some_and(|(bits, _)| estimator_guard + state_guard >= *bits)
+            {
+                break;
+            }
+            let Some(kf) = kf_at(job, output_frac + state_guard, samples, switches) else {
+                continue;
+            };
+            let Ok(plan) = chain::Plan::new(est.clone(), kf.clone()) else {
+                continue;
+            };
+            let bound_lsb = plan.rate_error_bound_lsb(samples, switches);
+            if bound_lsb <= budget_lsb {
+                best = Some((
+                    estimator_guard + state_guard,
+                    Budget {
+                        budget_lsb,
+                        floor_lsb,
+                        mean: est.mean,
+                        bias: est.bias,
+                        state: kf.state,
+                        bound_lsb,
+                    },
+                ));
+                break;
+            }
+        }
+    }
+    best.map(|(_, b)| b).ok_or_else(|| {
+        refuse(format!(
+            "a budget that {MAX_GUARD_BITS} guard bits in the estimator and the KF's state can meet for {samples} samples and {switches} switches"
+        ))
+    })
 }
 
 /// Blocks whose formats the analysis does not cover yet: they are reported as hand-set.
@@ -266,12 +399,13 @@ impl Analysis {
         })
     }
 
-    /// `config` with every configured node's proven format (those a key sets alone), checked
-    /// by resolving it as `generate` would.
+    /// `config` with every configured node's proven format (those a key sets alone), and the
+    /// fraction bits of `budget` when one is given, checked by resolving it as `generate`
+    /// would.
     ///
     /// # Errors
     /// The derived config does not resolve (a format the blocks refuse).
-    pub fn derived_config(&self, config: &Config) -> Result<Config> {
+    pub fn derived_config(&self, config: &Config, budget: Option<&Budget>) -> Result<Config> {
         let mut derived = config.clone();
         for row in &self.rows {
             if row.shared.is_some() {
@@ -286,11 +420,66 @@ impl Analysis {
                 _ => {}
             }
         }
+        if let Some(budget) = budget {
+            derived.estimator.mean_format = budget.mean.to_string();
+            derived.estimator.bias_format = budget.bias.to_string();
+            derived.kf.state_format = budget.state.to_string();
+        }
         Job::new(derived.clone()).map_err(|e| Error::Config {
             field: "derived formats".into(),
             value: String::new(),
             allowed: format!("a config the blocks accept: {e}"),
         })?;
         Ok(derived)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn default_job() -> Job {
+        Job::new(Config::embedded()).unwrap()
+    }
+
+    /// The budget search meets the budget with the fewest state guard bits for its estimator
+    /// formats: one fraction bit fewer in the state misses it.
+    #[test]
+    fn the_chosen_fractions_meet_the_budget_and_one_bit_less_does_not() {
+        let job = default_job();
+        for budget_lsb in [1.6, 2.0, 3.0, 10.0] {
+            let budget = fractions_for(&job, 10_000, 10, budget_lsb).unwrap();
+            assert!(budget.bound_lsb <= budget_lsb, "{budget:?}");
+            let est = estimator_at(&job, budget.mean.frac).unwrap();
+            assert_eq!(est.mean, budget.mean);
+            if budget.state.frac > job.chain.kf.output.frac {
+                let kf = kf_at(&job, budget.state.frac - 1, 10_000, 10).unwrap();
+                let plan = chain::Plan::new(est, kf).unwrap();
+                assert!(
+                    plan.rate_error_bound_lsb(10_000, 10) > budget_lsb,
+                    "{budget:?}"
+                );
+            }
+            // Every chosen format holds its proven range.
+            let kf = kf_at(&job, budget.state.frac, 10_000, 10).unwrap();
+            let ranges = range::kf(&kf, Interval::of_format(kf.input), 10_000, 10);
+            assert!(ranges
+                .nodes
+                .iter()
+                .find(|n| n.name == "kf.state")
+                .unwrap()
+                .fits());
+        }
+    }
+
+    #[test]
+    fn budgets_below_the_fixed_roundings_are_refused_naming_the_floor() {
+        let job = default_job();
+        let message = fractions_for(&job, 1000, 0, 1.0).unwrap_err();
+        assert!(
+            message.contains("--output-error 1 LSB is not allowed: more than 1.5"),
+            "{message}"
+        );
+        assert!(fractions_for(&job, 1000, 0, f64::NAN).is_err());
     }
 }

@@ -10,7 +10,7 @@ use anyhow::{Context, Result};
 use super::options::{count, ConfigSource};
 use super::usage;
 
-use gyrofx_codegen::formats::analyse;
+use gyrofx_codegen::formats::{analyse, fractions_for};
 use gyrofx_codegen::job::Job;
 use gyrofx_codegen::output_folder;
 
@@ -28,6 +28,11 @@ pub struct Args {
     /// Changes of `bw_sel` the bounds must allow for (each can move the KF's states).
     #[arg(long, value_parser = count, default_value = "100")]
     switches: usize,
+    /// Error budget on the chain's output against its float model, in KF output LSB (`1.5`)
+    /// or °/s (`0.0001dps`): also choose the fewest fraction bits of the interval means, bias
+    /// estimates and KF state that meet it over the record (for --write and the table).
+    #[arg(long)]
+    output_error: Option<String>,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -57,8 +62,25 @@ pub fn run(args: Args) -> Result<ExitCode> {
     let samples = args.samples.unwrap_or(config.samples) as u64;
     let job = Job::new(config.clone())?;
     let analysis = analyse(&job, samples, args.switches as u64);
+    let budget = match &args.output_error {
+        None => None,
+        Some(text) => {
+            let lsb = job.kf().output.lsb();
+            let value = match text.strip_suffix("dps") {
+                Some(dps) => dps.trim().parse::<f64>().map(|v| v / lsb),
+                None => text.trim().parse::<f64>(),
+            };
+            let Ok(budget) = value else {
+                usage!("--output-error {text} is not a budget: a number of output LSB (1.5) or of °/s ending in dps (0.0001dps)");
+            };
+            match fractions_for(&job, samples, args.switches as u64, budget) {
+                Ok(budget) => Some(budget),
+                Err(message) => usage!("{message}"),
+            }
+        }
+    };
     if let Some(path) = &args.write {
-        let derived = analysis.derived_config(&config)?;
+        let derived = analysis.derived_config(&config, budget.as_ref())?;
         let folder = match path.parent() {
             Some(p) if !p.as_os_str().is_empty() => p,
             _ => std::path::Path::new("."),
@@ -83,9 +105,26 @@ pub fn run(args: Args) -> Result<ExitCode> {
             .with_context(|| format!("--write {}: cannot move into place", path.display()))?;
     }
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&analysis.json())?);
+        let mut json = analysis.json();
+        if let Some(b) = &budget {
+            json["output_error"] = serde_json::json!({
+                "budget_lsb": b.budget_lsb,
+                "floor_lsb": b.floor_lsb,
+                "bound_lsb": b.bound_lsb,
+                "estimator.mean_format": b.mean.to_string(),
+                "estimator.bias_format": b.bias.to_string(),
+                "kf.state_format": b.state.to_string(),
+            });
+        }
+        println!("{}", serde_json::to_string_pretty(&json)?);
     } else {
         print!("{}", analysis.text());
+        if let Some(b) = &budget {
+            println!(
+                "for an output error of at most {:.3} LSB (at least {:.3}: the output's and calibrated samples' roundings): mean_format = {}, bias_format = {}, state_format = {}; bound {:.3} LSB",
+                b.budget_lsb, b.floor_lsb, b.mean, b.bias, b.state, b.bound_lsb
+            );
+        }
     }
     Ok(if args.strict && analysis.overflows().next().is_some() {
         ExitCode::FAILURE
