@@ -140,12 +140,7 @@ pub fn fractions_for(
 ) -> std::result::Result<Budget, String> {
     let chain = &job.chain;
     let u = chain.estimator.rounding.max_error_lsb();
-    let gain = chain
-        .kf
-        .quantized_gains()
-        .iter()
-        .map(|g| g[0].abs() / (1.0 - (1.0 - g[0] - g[1]).abs()))
-        .fold(0.0, f64::max);
+    let gain = chain.kf_input_gain();
     let floor_lsb = u + gain * 2.0 * u * chain.estimator.calibrated.lsb() / chain.kf.output.lsb();
     let refuse =
         |allowed: String| format!("--output-error {budget_lsb} LSB is not allowed: {allowed}");

@@ -64,14 +64,18 @@ impl Plan {
         let u = self.estimator.rounding.max_error_lsb();
         let input_error =
             self.estimator.bias_error_bound() + 2.0 * u * self.estimator.calibrated.lsb();
-        let gain = self
-            .kf
+        kf::bound::rate_error_bound_lsb(&self.kf, samples, switches)
+            + self.kf_input_gain() * input_error / self.kf.output.lsb()
+    }
+
+    /// The ℓ1 norm `max |g1| / (1 − |1 − S|)` over the ROM of the KF's response from its input
+    /// to `x1`: how much an input error can move the output.
+    pub fn kf_input_gain(&self) -> f64 {
+        self.kf
             .quantized_gains()
             .iter()
             .map(|g| g[0].abs() / (1.0 - (1.0 - g[0] - g[1]).abs()))
-            .fold(0.0, f64::max);
-        kf::bound::rate_error_bound_lsb(&self.kf, samples, switches)
-            + gain * input_error / self.kf.output.lsb()
+            .fold(0.0, f64::max)
     }
 }
 

@@ -33,6 +33,24 @@ pub fn loop_mode(p: i8) -> Mode {
     }
 }
 
+/// The modes the loops take: the chain's upcoming ones while `enable` is high, else normal.
+fn modes_taken(enable: bool, upcoming: [Mode; 2]) -> [Mode; 2] {
+    if enable {
+        upcoming
+    } else {
+        [Mode::Normal; 2]
+    }
+}
+
+/// Both loops' decimated outputs, which come at the same sample.
+fn both<T>(a: Option<T>, b: Option<T>) -> Option<[T; 2]> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some([a, b]),
+        (None, None) => None,
+        _ => unreachable!("both loops decimate by the same factor from the same reset"),
+    }
+}
+
 /// What one ADC sample of the system gives.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SystemStep {
@@ -76,18 +94,10 @@ impl FixedSystem {
     /// `bw_sel`.
     #[inline]
     pub fn step(&mut self, adc: [[i64; 2]; 2], enable: bool, bw_sel: usize) -> SystemStep {
-        let modes = if enable {
-            self.upcoming_modes()
-        } else {
-            [Mode::Normal; 2]
-        };
+        let modes = modes_taken(enable, self.upcoming_modes());
         let a = self.loops[0].step(adc[0], modes[0]);
         let b = self.loops[1].step(adc[1], modes[1]);
-        let rates = match (a.chain, b.chain) {
-            (Some(a), Some(b)) => Some([a.rate, b.rate]),
-            (None, None) => None,
-            _ => unreachable!("both loops decimate by the same factor from the same reset"),
-        };
+        let rates = both(a.chain.map(|c| c.rate), b.chain.map(|c| c.rate));
         let chain = match rates {
             Some(y) if enable => Some(self.chain.step(y, bw_sel)),
             _ => None,
@@ -147,18 +157,10 @@ impl FloatSystem {
 
     /// One ADC sample: each gyro's `[x, y]` in full-scale units, `enable` and `bw_sel`.
     pub fn step(&mut self, adc: [[f64; 2]; 2], enable: bool, bw_sel: usize) -> FloatSystemStep {
-        let modes = if enable {
-            self.upcoming_modes()
-        } else {
-            [Mode::Normal; 2]
-        };
+        let modes = modes_taken(enable, self.upcoming_modes());
         let a = self.loops[0].step(adc[0], modes[0]);
         let b = self.loops[1].step(adc[1], modes[1]);
-        let rates = match (a.chain, b.chain) {
-            (Some(a), Some(b)) => Some([a.rate_dps, b.rate_dps]),
-            (None, None) => None,
-            _ => unreachable!("both loops decimate by the same factor from the same reset"),
-        };
+        let rates = both(a.chain.map(|c| c.rate_dps), b.chain.map(|c| c.rate_dps));
         let chain = match rates {
             Some(y) if enable => Some(self.chain.step(y, bw_sel)),
             _ => None,

@@ -157,24 +157,14 @@ impl Plan {
     /// The whole gyro at the ADC rate (`gyrofx_system`): both loops and the chain on the
     /// system's short schedule. Only resonator plants have it.
     fn system(&self) -> PyResult<System> {
-        let chain = self
-            .job
-            .system_chain
-            .as_ref()
-            .ok_or_else(|| refused(gyrofx_codegen::golden::NO_SYSTEM))?;
-        let [a, b] = &self.job.gyro_loops;
-        Ok(System::new([&a.plan, &b.plan], chain))
+        let (loops, chain) = self.system_plans()?;
+        Ok(System::new(loops, chain))
     }
 
     /// The system's float twin (quantized coefficients).
     fn system_float(&self) -> PyResult<SystemFloat> {
-        let chain = self
-            .job
-            .system_chain
-            .as_ref()
-            .ok_or_else(|| refused(gyrofx_codegen::golden::NO_SYSTEM))?;
-        let [a, b] = &self.job.gyro_loops;
-        Ok(SystemFloat::new([&a.plan, &b.plan], chain))
+        let (loops, chain) = self.system_plans()?;
+        Ok(SystemFloat::new(loops, chain))
     }
 
     /// The simulated resonator of gyro `"a"` or `"b"` with its front end: DAC codes in, ADC
@@ -204,6 +194,22 @@ impl Plan {
 }
 
 impl Plan {
+    /// Both loops' plans and the system's chain (resonator plants only).
+    fn system_plans(
+        &self,
+    ) -> PyResult<(
+        [&gyrofx_model::gyro_loop::gyro::Plan; 2],
+        &gyrofx_model::chain::Plan,
+    )> {
+        let chain = self
+            .job
+            .system_chain
+            .as_ref()
+            .ok_or_else(|| refused(gyrofx_codegen::golden::NO_SYSTEM))?;
+        let [a, b] = &self.job.gyro_loops;
+        Ok(([&a.plan, &b.plan], chain))
+    }
+
     fn gyro(&self, gyro: &str) -> PyResult<&gyrofx_codegen::config::GyroLoop> {
         Ok(&self.job.gyro_loops[gyro_index(gyro)?])
     }
