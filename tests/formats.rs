@@ -29,11 +29,12 @@ fn the_default_is_analysed_node_by_node() {
         "kf.error",
         "kf.state",
         "kf.output",
+        "mean_filter.output",
     ] {
         assert!(table.contains(name), "{name}: {table}");
     }
     assert!(
-        table.contains("hand-set, not analysed: [mean_filter]"),
+        table.contains("hand-set, not analysed: [loop]"),
         "{table}"
     );
     let json: serde_json::Value =
@@ -147,8 +148,10 @@ fn write_gives_a_proven_config_that_generate_accepts_and_keeps_existing_files() 
         "--strict",
         "--quiet",
     ]);
-    let (passed, log) = run_tool("make", &["--no-print-directory", "iverilog-kf"], &out);
-    assert!(passed && log.contains("PASS"), "{log}");
+    for target in ["iverilog-kf", "iverilog-mean_filter"] {
+        let (passed, log) = run_tool("make", &["--no-print-directory", target], &out);
+        assert!(passed && log.contains("PASS"), "{target}: {log}");
+    }
     // An existing file: refused (exit 2), unchanged; --force replaces it.
     std::fs::write(&derived, "mine").unwrap();
     let output = gyrofx(&["formats", "--write", derived_text]);
@@ -183,7 +186,7 @@ fn the_manifest_records_which_formats_are_proven() {
     ]))
     .unwrap();
     assert_eq!(formats["nodes"], json["nodes"]);
-    assert!(formats["hand_set"].as_array().unwrap().len() >= 2);
+    assert!(!formats["hand_set"].as_array().unwrap().is_empty());
 }
 
 /// `--output-error` chooses fraction bits whose chain bound, in the package generated from the

@@ -194,16 +194,10 @@ pub fn fractions_for(
 }
 
 /// Blocks whose formats the analysis does not cover yet: they are reported as hand-set.
-pub const NOT_ANALYSED: [(&str, &str); 2] = [
-    (
-        "mean_filter",
-        "output_format, reciprocal_width (gross-error rejection: its kept subset is data-dependent)",
-    ),
-    (
-        "loop",
-        "demodulator, PLL, AGC, CIC and output formats of the resonator-level loop",
-    ),
-];
+pub const NOT_ANALYSED: [(&str, &str); 1] = [(
+    "loop",
+    "demodulator, PLL, AGC, CIC and output formats of the resonator-level loop",
+)];
 
 /// Analyses `job` for a record of `samples` samples with at most `switches` changes of
 /// `bw_sel`.
@@ -245,6 +239,19 @@ pub fn analyse(job: &Job, samples: u64, switches: u64) -> Analysis {
             shared: None,
         }
     }));
+    rows.extend(
+        range::mean_filter(&job.mean_filter)
+            .into_iter()
+            .map(|node| {
+                let key =
+                    (node.name == "mean_filter.output").then_some("mean_filter.output_format");
+                Row {
+                    node,
+                    key,
+                    shared: None,
+                }
+            }),
+    );
     let state_fits = |n: u64| {
         range::kf(&chain.kf, Interval::of_format(chain.kf.input), n, switches)
             .nodes
@@ -412,6 +419,7 @@ impl Analysis {
                 Some("estimator.bias_format") => derived.estimator.bias_format = proven,
                 Some("kf.state_format") => derived.kf.state_format = proven,
                 Some("kf.output_format") => derived.kf.output_format = proven,
+                Some("mean_filter.output_format") => derived.mean_filter.output_format = proven,
                 _ => {}
             }
         }

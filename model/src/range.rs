@@ -19,10 +19,18 @@
 //!   interval arithmetic is exact: the accumulator holds `n ≤ L − M` samples, the mean is
 //!   `Q(acc · recip)`, the bias `Q(Σ G_j m_j)` (with smoothing a convex update whose rounding
 //!   stays within `2ˢ` LSB), and the calibrated sample `Q(y ∓ b)` takes either sign of the bias.
+//! - **Mean filter** (gross-error rejection): the kept subset depends on the data, so its output
+//!   `Q(kept_sum · ROM[n])` is bounded over every count `n` of kept samples, in exact codes. A
+//!   kept subset of `n > L/2` samples can all sit at full scale (the rejected ones far enough
+//!   below the mean); one of `n ≤ L/2` cannot (the rejected ones would have to lie beyond the
+//!   mean on the far side of full scale), so at least one kept sample is an LSB inside it; no
+//!   sample kept (`n = 0`) outputs the plain mean. With `1/n` rounded up in the ROM, a count
+//!   other than `L` can give the largest output.
 
 use crate::estimator;
-use crate::fx::{pow2, Format, Rounding};
+use crate::fx::{pow2, requantize, Format, Overflow, Rounding};
 use crate::kf;
+use crate::mean_filter;
 
 /// A closed interval of real values (°/s for the chain's nodes).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -359,6 +367,79 @@ pub fn estimator(plan: &estimator::Plan, input: Interval) -> Vec<NodeRange> {
             what: "calibrated and combined sample Q(y ∓ b), the KF's input",
             range: calibrated,
             format: plan.calibrated,
+            exact: false,
+        },
+    ]
+}
+
+/// The mean filter's nodes for samples in its input format.
+pub fn mean_filter(plan: &mean_filter::Plan) -> Vec<NodeRange> {
+    let window = i128::from(plan.window);
+    let (min, max) = (plan.input.min_code(), plan.input.max_code());
+    // The output before saturation: a format wide enough for any product here.
+    let unsaturated = Format {
+        signed: true,
+        width: 64,
+        frac: plan.output.frac,
+    };
+    let output_code = |total: i128, n: usize| {
+        requantize(
+            total * plan.rom[n],
+            plan.product.frac,
+            unsaturated,
+            plan.rounding,
+            Overflow::Saturate,
+        )
+        .code
+    };
+    let mut product = Interval::new(0.0, 0.0);
+    let mut output = (i128::MAX, i128::MIN);
+    for n in 0..=plan.window as usize {
+        let count = n as i128;
+        // The extremes of the total that feeds ROM[n].
+        let (low, high) = match n {
+            0 => (window * min, window * max),
+            n if 2 * n > plan.window as usize => (count * min, count * max),
+            _ => (count * min + 1, count * max - 1),
+        };
+        for total in [low, high] {
+            let value = plan.product.to_f64(total * plan.rom[n]);
+            product = product.union(Interval::new(value, value));
+            let code = output_code(total, n);
+            output = (output.0.min(code), output.1.max(code));
+        }
+    }
+    let to_interval = |(lo, hi): (i128, i128), format: Format| {
+        Interval::new(format.to_f64(lo), format.to_f64(hi))
+    };
+    let deviation = (window - 1) as f64 * (plan.input.max_value() - plan.input.min_value());
+    vec![
+        NodeRange {
+            name: "mean_filter.sum",
+            what: "sum of a block's samples",
+            range: to_interval((window * min, window * max), plan.input),
+            format: plan.sum,
+            exact: true,
+        },
+        NodeRange {
+            name: "mean_filter.deviation",
+            what: "L · s_i − sum, compared with L · r",
+            range: Interval::new(-deviation, deviation),
+            format: plan.deviation,
+            exact: true,
+        },
+        NodeRange {
+            name: "mean_filter.product",
+            what: "(kept) sum · ROM[n]",
+            range: product,
+            format: plan.product,
+            exact: true,
+        },
+        NodeRange {
+            name: "mean_filter.output",
+            what: "block mean of the kept samples",
+            range: to_interval(output, plan.output),
+            format: plan.output,
             exact: false,
         },
     ]

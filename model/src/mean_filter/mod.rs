@@ -53,7 +53,7 @@ mod fixed;
 mod float;
 mod plan;
 
-pub use fixed::{BlockMean, FixedMeanFilter};
+pub use fixed::{block_mean, BlockMean, FixedMeanFilter};
 pub use float::FloatMeanFilter;
 pub use plan::{Plan, PlanError, Spec, MAX_WINDOW};
 

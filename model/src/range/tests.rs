@@ -238,3 +238,100 @@ fn quantizing_an_interval_rounds_its_endpoints_by_the_mode() {
     let near = Interval::new(-512.000_002, 511.999_941).quantized(14, Rounding::Nearest);
     assert!(near.fits("s24.14".parse().unwrap()));
 }
+
+/// The mean filter's output bound: the fixed filter on blocks built to reach each count's
+/// extreme never leaves it and reaches it; the format one integer bit narrower cannot hold
+/// that.
+#[test]
+fn the_mean_filter_output_bound_holds_and_is_reached() {
+    use crate::mean_filter::{block_mean, Plan as FilterPlan, Spec as FilterSpec};
+    let plan = FilterPlan::new(&FilterSpec {
+        input: format("s24.14"),
+        output: format("s24.14"),
+        window: 20,
+        threshold_dps: 0.3,
+        reciprocal_width: 25,
+        rounding: Rounding::Nearest,
+        overflow: Overflow::Saturate,
+    })
+    .unwrap();
+    let nodes = mean_filter(&plan);
+    let output = nodes
+        .iter()
+        .find(|n| n.name == "mean_filter.output")
+        .unwrap();
+    let (min, max) = (plan.input.min_code() as i64, plan.input.max_code() as i64);
+    let l = plan.window as usize;
+    let mut reached = Interval::new(0.0, 0.0);
+    let mut overflowed = false;
+    // n kept at full scale and the rest rejected just below the mean (n > L/2), every count.
+    for n in (l / 2 + 1)..=l {
+        for (edge, sign) in [(max, -1i64), (min, 1)] {
+            let mut block = vec![edge; n];
+            // The kept stay within L·r of the block sum ((L − n)·step ≤ L·r), the rejected
+            // leave it (n·step > L·r): possible exactly when n > L/2.
+            let step = (plan.scaled_threshold as i64) / (l - n).max(1) as i64;
+            block.extend(std::iter::repeat_n(edge + sign * step, l - n));
+            let result = block_mean(&plan, &block);
+            assert_eq!(
+                result.kept as usize, n,
+                "the block keeps what it was built to"
+            );
+            overflowed |= result.overflowed;
+            let value = plan.output.to_f64(i128::from(result.y));
+            reached = reached.union(Interval::new(value, value));
+            assert!(
+                value >= output.range.lo && value <= output.range.hi,
+                "n = {n}: {value} outside {:?} (kept {})",
+                output.range,
+                result.kept
+            );
+        }
+    }
+    assert!(reached.hi >= 0.9 * output.range.hi && reached.lo <= 0.9 * output.range.lo);
+    let narrower = Format::signed(plan.output.width - 1, plan.output.frac).unwrap();
+    assert!(!reached.fits(narrower));
+    // 1/n rounds up in the ROM for some n > L/2: those blocks' means pass full scale by a few
+    // LSB. The analysis says the output can overflow, and such a block does (it saturates).
+    assert!(!output.fits() && overflowed, "{output:?}");
+    for node in nodes.iter().filter(|n| n.exact) {
+        assert!(node.fits(), "{node:?}");
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    /// Random blocks (clusters and outliers anywhere in the range) stay within the proven
+    /// output range.
+    #[test]
+    fn no_block_leaves_the_proven_mean_filter_range(
+        center in any::<i32>(),
+        spread in 0u32..20_000,
+        outliers in prop::collection::vec((0usize..20, any::<i32>()), 0..12),
+        threshold in 0.01f64..5.0,
+    ) {
+        use crate::mean_filter::{block_mean, Plan as FilterPlan, Spec as FilterSpec};
+        let plan = FilterPlan::new(&FilterSpec {
+            input: format("s24.14"),
+            output: format("s24.14"),
+            window: 20,
+            threshold_dps: threshold,
+            reciprocal_width: 25,
+            rounding: Rounding::Nearest,
+            overflow: Overflow::Saturate,
+        })
+        .unwrap();
+        let output = mean_filter(&plan).into_iter().find(|n| n.name == "mean_filter.output").unwrap();
+        let (min, max) = (plan.input.min_code() as i64, plan.input.max_code() as i64);
+        let center = i64::from(center) >> 8;
+        let mut block: Vec<i64> = (0..20)
+            .map(|i| (center + (i as i64 * 7919 % (2 * i64::from(spread) + 1)) - i64::from(spread)).clamp(min, max))
+            .collect();
+        for (i, value) in outliers {
+            block[i] = (i64::from(value) >> 8).clamp(min, max);
+        }
+        let value = plan.output.to_f64(i128::from(block_mean(&plan, &block).y));
+        prop_assert!(value >= output.range.lo && value <= output.range.hi);
+    }
+}
