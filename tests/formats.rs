@@ -33,10 +33,7 @@ fn the_default_is_analysed_node_by_node() {
     ] {
         assert!(table.contains(name), "{name}: {table}");
     }
-    assert!(
-        table.contains("hand-set, not analysed: [loop]"),
-        "{table}"
-    );
+    assert!(table.contains("hand-set, not analysed: [loop]"), "{table}");
     let json: serde_json::Value =
         serde_json::from_str(&ok(&["formats", "--json", "--switches", "0"])).unwrap();
     let nodes = nodes(&json);

@@ -335,3 +335,40 @@ proptest! {
         prop_assert!(value >= output.range.lo && value <= output.range.hi);
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    /// Random samples over whole windows of random schedules and smoothing keep the bias
+    /// estimates within their proven range. Each interval's samples are all at full scale
+    /// (either sign) or anywhere in the range, so some windows take the gains' sign pattern
+    /// and reach the bound (cutting the bound by a tenth fails this).
+    #[test]
+    fn no_input_leaves_the_proven_bias_range(
+        interval_length in 3usize..12,
+        blank in 0usize..2,
+        smoothing in 0u32..3,
+        choices in prop::collection::vec(0u8..3, 64),
+        noise in prop::collection::vec(any::<u32>(), 64),
+    ) {
+        let plan = chain_plan(interval_length, blank, 0, smoothing, Rounding::Nearest).estimator;
+        let nodes = estimator(&plan, Interval::of_format(plan.input));
+        let bias = nodes.iter().find(|n| n.name == "estimator.bias").unwrap().range;
+        let mut sequencer = Sequencer::new(&plan.schedule);
+        let mut fixed = FixedEstimator::new(&plan);
+        let (min, max) = (plan.input.min_code(), plan.input.max_code());
+        for k in 0..64 * interval_length {
+            let interval = k / interval_length;
+            let code = |salt: u32| match choices[interval] {
+                0 => min,
+                1 => max,
+                _ => min + i128::from(noise[interval].rotate_left(salt)) % (max - min + 1),
+            } as i64;
+            fixed.step(&sequencer.advance(), [code(0), code(7)]);
+            for b in fixed.bias() {
+                let value = plan.bias.to_f64(b);
+                prop_assert!(value >= bias.lo && value <= bias.hi, "{} outside {:?}", value, bias);
+            }
+        }
+    }
+}
