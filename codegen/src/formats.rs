@@ -4,9 +4,9 @@
 //!
 //! The analysis is [`gyrofx_model::range`] (worst-case peak gain of each linear block, interval
 //! arithmetic for the estimator and calibration); here it is applied to the job's plans, named
-//! by config key, and printed. Covered: the estimator, the calibration and the KF (the chain
-//! from the gyros' samples to the KF's output). Not yet: the mean filter and the gyro loop's
-//! points (their formats stay hand-set; the table says so).
+//! by config key, and printed. Covered: the estimator, the calibration, the KF (the chain from
+//! the gyros' samples to the KF's output) and the mean filter. Not yet: the gyro loop's points
+//! (their formats stay hand-set; the table says so).
 
 use std::fmt::Write as _;
 
@@ -36,13 +36,7 @@ pub struct Row {
 impl Row {
     /// The proven format: the configured fraction bits and the integer bits the range needs.
     pub fn proven(&self) -> Format {
-        let frac = self.node.format.frac;
-        let integer = self.node.needed_integer_bits();
-        Format {
-            signed: true,
-            width: (integer + frac).max(1) as u32,
-            frac,
-        }
+        holding(self.node.range, self.node.format.frac)
     }
 }
 
@@ -76,7 +70,7 @@ pub struct Budget {
     /// The least any fraction bits can give: the output's and the calibrated samples' own
     /// roundings, whose formats are the ADC's and the output's.
     pub floor_lsb: f64,
-    /// The interval means' and bias estimates' formats.
+    /// The interval means' format.
     pub mean: Format,
     /// The bias estimates' format.
     pub bias: Format,
@@ -108,7 +102,7 @@ fn estimator_at(job: &Job, frac: i32) -> Option<estimator::Plan> {
     let wide = estimator::Plan::new(&spec).ok()?;
     let input = Interval::of_format(wide.input);
     let nodes = range::estimator(&wide, input);
-    let range_of = |name: &str| nodes.iter().find(|n| n.name == name).map(|n| n.range);
+    let range_of = |name: &str| range::find(&nodes, name).map(|n| n.range);
     spec.mean = holding(range_of("estimator.mean")?, frac);
     spec.bias = holding(range_of("estimator.bias")?, frac);
     estimator::Plan::new(&spec).ok()
@@ -121,7 +115,7 @@ fn kf_at(job: &Job, frac: i32, samples: u64, switches: u64) -> Option<gyrofx_mod
     settings.state = Format::signed(64, frac).ok()?;
     let wide = plan_for(&settings, &job.designs).ok()?;
     let ranges = range::kf(&wide, Interval::of_format(wide.input), samples, switches);
-    let state = ranges.nodes.iter().find(|n| n.name == "kf.state")?.range;
+    let state = range::find(&ranges.nodes, "kf.state")?.range;
     settings.state = holding(state, frac);
     plan_for(&settings, &job.designs).ok()
 }
@@ -139,9 +133,7 @@ pub fn fractions_for(
     budget_lsb: f64,
 ) -> std::result::Result<Budget, String> {
     let chain = &job.chain;
-    let u = chain.estimator.rounding.max_error_lsb();
-    let gain = chain.kf_input_gain();
-    let floor_lsb = u + gain * 2.0 * u * chain.estimator.calibrated.lsb() / chain.kf.output.lsb();
+    let floor_lsb = chain.rate_error_floor_lsb();
     let refuse =
         |allowed: String| format!("--output-error {budget_lsb} LSB is not allowed: {allowed}");
     if !(budget_lsb.is_finite() && budget_lsb > floor_lsb) {
@@ -253,11 +245,8 @@ pub fn analyse(job: &Job, samples: u64, switches: u64) -> Analysis {
             }),
     );
     let state_fits = |n: u64| {
-        range::kf(&chain.kf, Interval::of_format(chain.kf.input), n, switches)
-            .nodes
-            .iter()
-            .find(|node| node.name == "kf.state")
-            .is_some_and(NodeRange::fits)
+        let ranges = range::kf(&chain.kf, Interval::of_format(chain.kf.input), n, switches);
+        range::find(&ranges.nodes, "kf.state").is_some_and(NodeRange::fits)
     };
     let kf_state_limit = state_fits(0).then(|| longest(state_fits));
     Analysis {

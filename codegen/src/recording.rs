@@ -106,11 +106,12 @@ pub struct Rows {
 }
 
 impl Rows {
-    /// Appends the next `count` rows' rates `[A, B]` (°/s) to `out`.
+    /// Appends the next `count` rows' rates (°/s) to `out`: gyro A's to `out[0]`, B's to
+    /// `out[1]`.
     ///
     /// # Errors
     /// A bad cell, or the file ending early (it changed since it was read).
-    pub fn read_into(&mut self, count: usize, out: &mut Vec<[f64; 2]>) -> Result<()> {
+    pub fn read_into(&mut self, count: usize, out: &mut [Vec<f64>; 2]) -> Result<()> {
         let mut values = [0.0; 2];
         for _ in 0..count {
             if self.columns.next_row(&mut values)?.is_none() {
@@ -123,7 +124,9 @@ impl Rows {
                 });
             }
             self.read += 1;
-            out.push(values.map(|v| v * self.scale));
+            for (column, value) in out.iter_mut().zip(values) {
+                column.push(value * self.scale);
+            }
         }
         Ok(())
     }

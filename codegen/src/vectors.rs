@@ -430,9 +430,9 @@ enum Gyros {
     /// Recorded outputs (`generate --recording`): already in the sequencer's modes; the
     /// report's "without reversal" rows show the same record.
     Recorded {
-        rows: crate::recording::Rows,
-        /// This batch's rates `[A, B]`, °/s.
-        rates: Vec<[f64; 2]>,
+        rows: Box<crate::recording::Rows>,
+        /// This batch's rates of gyro A and B, °/s.
+        rates: [Vec<f64>; 2],
         input: Format,
         saturations: [u64; 2],
     },
@@ -454,8 +454,11 @@ impl Gyros {
         let input = job.chain.estimator.input;
         if let Some(recording) = &job.recording {
             return Ok(Gyros::Recorded {
-                rows: recording.rows()?,
-                rates: Vec::with_capacity(GYRO_BATCH),
+                rows: Box::new(recording.rows()?),
+                rates: [
+                    Vec::with_capacity(GYRO_BATCH),
+                    Vec::with_capacity(GYRO_BATCH),
+                ],
                 input,
                 saturations: [0; 2],
             });
@@ -572,18 +575,17 @@ impl Gyros {
                 input,
                 saturations,
             } => {
-                rates.clear();
+                rates.iter_mut().for_each(Vec::clear);
                 rows.read_into(len, rates)?;
-                let [(a, sat_a), (b, sat_b)] = [0, 1].map(|g| {
-                    let column: Vec<f64> = rates.iter().map(|r| r[g]).collect();
-                    adc(&column, *input)
-                });
+                let [(a, sat_a), (b, sat_b)] = [0, 1].map(|g| adc(&rates[g], *input));
                 saturations[0] += sat_a;
                 saturations[1] += sat_b;
                 batch
                     .codes
                     .extend(a.into_iter().zip(b).map(|(a, b)| [a, b]));
-                batch.raw.extend_from_slice(rates);
+                batch
+                    .raw
+                    .extend(rates[0].iter().zip(&rates[1]).map(|(a, b)| [*a, *b]));
             }
         }
         Ok(())

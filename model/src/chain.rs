@@ -61,11 +61,23 @@ impl Plan {
     /// [`estimator::Plan::bias_error_bound`] + 2 rounding errors of the calibrated format —
     /// times the ℓ1 norm `|g1| / (1 − |1 − S|)` of the KF's response from input to `x1`.
     pub fn rate_error_bound_lsb(&self, samples: u64, switches: u64) -> f64 {
-        let u = self.estimator.rounding.max_error_lsb();
-        let input_error =
-            self.estimator.bias_error_bound() + 2.0 * u * self.estimator.calibrated.lsb();
+        let input_error = self.estimator.bias_error_bound() + self.calibration_rounding();
         kf::bound::rate_error_bound_lsb(&self.kf, samples, switches)
             + self.kf_input_gain() * input_error / self.kf.output.lsb()
+    }
+
+    /// The part of [`Plan::rate_error_bound_lsb`] that no guard bits of the estimator or the
+    /// KF's state remove, output LSB: the output's rounding and the calibrated samples' two
+    /// roundings through the KF's gain (their formats are the output's and the ADC's).
+    pub fn rate_error_floor_lsb(&self) -> f64 {
+        self.kf.rounding.max_error_lsb()
+            + self.kf_input_gain() * self.calibration_rounding() / self.kf.output.lsb()
+    }
+
+    /// The calibrated samples' rounding error, °/s: one at the calibration, one at the
+    /// combination of both gyros.
+    fn calibration_rounding(&self) -> f64 {
+        2.0 * self.estimator.rounding.max_error_lsb() * self.estimator.calibrated.lsb()
     }
 
     /// The ℓ1 norm `max |g1| / (1 − |1 − S|)` over the ROM of the KF's response from its input

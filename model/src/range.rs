@@ -163,6 +163,11 @@ impl NodeRange {
     }
 }
 
+/// The node named `name` (`"kf.state"`) of `nodes`.
+pub fn find<'a>(nodes: &'a [NodeRange], name: &str) -> Option<&'a NodeRange> {
+    nodes.iter().find(|node| node.name == name)
+}
+
 /// The KF's proven ranges.
 #[derive(Clone, Debug, PartialEq)]
 pub struct KfRanges {

@@ -57,33 +57,40 @@ pub(crate) fn same_length(lengths: &[(&str, usize)]) -> PyResult<usize> {
     Ok(length)
 }
 
-/// `bw_sel` for `process`: one value for the whole record or one per sample.
+/// A port `process` takes as one value for the whole record or one per sample (`bw_sel`,
+/// `mode`, `enable`).
 #[derive(FromPyObject)]
-pub(crate) enum BandwidthSelect<'py> {
+pub(crate) enum PerSample<'py> {
     One(i64),
     Each(PyReadonlyArray1<'py, i64>),
 }
 
-impl BandwidthSelect<'_> {
-    pub(crate) fn per_sample(&self, samples: usize, rom_depth: usize) -> PyResult<Vec<usize>> {
+impl PerSample<'_> {
+    /// The values for `samples` samples, each checked by `check` (given the port's name, with
+    /// its index for an array).
+    pub(crate) fn values<T: Copy>(
+        &self,
+        samples: usize,
+        port: &str,
+        check: impl Fn(i64, &str) -> golden::PortResult<T>,
+    ) -> PyResult<Vec<T>> {
         match self {
-            BandwidthSelect::One(b) => Ok(vec![
-                check_bw_sel(*b, rom_depth, "bw_sel")
-                    .map_err(refused)?;
-                samples
-            ]),
-            BandwidthSelect::Each(array) => {
+            PerSample::One(value) => Ok(vec![check(*value, port).map_err(refused)?; samples]),
+            PerSample::Each(array) => {
                 let array = array.as_array();
-                same_length(&[("the input", samples), ("bw_sel", array.len())])?;
+                same_length(&[("the input", samples), (port, array.len())])?;
                 array
                     .iter()
                     .enumerate()
-                    .map(|(i, b)| {
-                        check_bw_sel(*b, rom_depth, &format!("bw_sel[{i}]")).map_err(refused)
-                    })
+                    .map(|(i, v)| check(*v, &format!("{port}[{i}]")).map_err(refused))
                     .collect()
             }
         }
+    }
+
+    /// `bw_sel` for `samples` samples, each addressing a ROM of `rom_depth` entries.
+    pub(crate) fn per_sample(&self, samples: usize, rom_depth: usize) -> PyResult<Vec<usize>> {
+        self.values(samples, "bw_sel", |b, port| check_bw_sel(b, rom_depth, port))
     }
 }
 
@@ -118,17 +125,17 @@ impl Kf {
 
     /// `step` over a record: `z` an int64 array, `bw_sel` one address or one per sample;
     /// returns `rate_out` as an int64 array.
-    #[pyo3(signature = (z, bw_sel = BandwidthSelect::One(0)))]
+    #[pyo3(signature = (z, bw_sel = PerSample::One(0)))]
     fn process<'py>(
         &mut self,
         py: Python<'py>,
         z: PyReadonlyArray1<'py, i64>,
-        bw_sel: BandwidthSelect<'py>,
+        bw_sel: PerSample<'py>,
     ) -> PyResult<Array<'py, i64>> {
         let (input, depth) = (self.ports.plan().input, self.ports.plan().rom.len());
         let z = port_codes(&z, input, "z")?;
         let select = match bw_sel {
-            BandwidthSelect::One(sel) => {
+            PerSample::One(sel) => {
                 vec![check_bw_sel(sel, depth, "bw_sel").map_err(refused)?]
             }
             each => each.per_sample(z.len(), depth)?,
@@ -224,12 +231,12 @@ impl KfFloat {
     }
 
     /// `step` over a float64 record.
-    #[pyo3(signature = (z, bw_sel = BandwidthSelect::One(0)))]
+    #[pyo3(signature = (z, bw_sel = PerSample::One(0)))]
     fn process<'py>(
         &mut self,
         py: Python<'py>,
         z: PyReadonlyArray1<'py, f64>,
-        bw_sel: BandwidthSelect<'py>,
+        bw_sel: PerSample<'py>,
     ) -> PyResult<Array<'py, f64>> {
         let z = z.as_array().to_vec();
         let select = bw_sel.per_sample(z.len(), self.rom_depth)?;
@@ -638,13 +645,13 @@ impl Chain {
     }
 
     /// `step` over records: a dict of int64 arrays, one per output port.
-    #[pyo3(signature = (y_a, y_b, bw_sel = BandwidthSelect::One(0)))]
+    #[pyo3(signature = (y_a, y_b, bw_sel = PerSample::One(0)))]
     fn process<'py>(
         &mut self,
         py: Python<'py>,
         y_a: PyReadonlyArray1<'py, i64>,
         y_b: PyReadonlyArray1<'py, i64>,
-        bw_sel: BandwidthSelect<'py>,
+        bw_sel: PerSample<'py>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let input = self.ports.plan().estimator.input;
         let y_a = port_codes(&y_a, input, "y_a")?;

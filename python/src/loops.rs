@@ -16,39 +16,8 @@ use gyrofx_model::gyro_loop::gyro::{FloatGyroLoop, Plan as LoopPlan};
 use gyrofx_model::resonator::{Mode, Resonator as PhysicalResonator};
 use gyrofx_model::system::FloatSystem;
 
-use crate::blocks::{port_codes, port_dict, same_length, BandwidthSelect};
+use crate::blocks::{port_codes, port_dict, same_length, PerSample};
 use crate::refused;
-
-/// A port that takes one value for the whole record or one per sample (`mode`, `enable`).
-#[derive(FromPyObject)]
-pub(crate) enum PerSample<'py> {
-    One(i64),
-    Each(PyReadonlyArray1<'py, i64>),
-}
-
-impl PerSample<'_> {
-    /// The values for `samples` samples, each checked by `check` (given the port's name with
-    /// its index).
-    fn values<T: Copy>(
-        &self,
-        samples: usize,
-        port: &str,
-        check: impl Fn(i64, &str) -> golden::PortResult<T>,
-    ) -> PyResult<Vec<T>> {
-        match self {
-            PerSample::One(value) => Ok(vec![check(*value, port).map_err(refused)?; samples]),
-            PerSample::Each(array) => {
-                let array = array.as_array();
-                same_length(&[("the ADC records", samples), (port, array.len())])?;
-                array
-                    .iter()
-                    .enumerate()
-                    .map(|(i, v)| check(*v, &format!("{port}[{i}]")).map_err(refused))
-                    .collect()
-            }
-        }
-    }
-}
 
 /// One gyro's digital loop (`gyrofx_gyro_loop`): NCOs, demodulators, PLL, AGC, CICs, lock
 /// detector and mode switch. One `step` per ADC sample.
@@ -258,7 +227,7 @@ impl System {
 
     /// `step` over records: four int64 ADC arrays; `enable` and `bw_sel` one value or one per
     /// sample. A dict of int64 arrays, one per output port.
-    #[pyo3(signature = (adc_a_x, adc_a_y, adc_b_x, adc_b_y, enable = PerSample::One(1), bw_sel = BandwidthSelect::One(0)))]
+    #[pyo3(signature = (adc_a_x, adc_a_y, adc_b_x, adc_b_y, enable = PerSample::One(1), bw_sel = PerSample::One(0)))]
     #[allow(clippy::too_many_arguments)]
     fn process<'py>(
         &mut self,
@@ -268,7 +237,7 @@ impl System {
         adc_b_x: PyReadonlyArray1<'py, i64>,
         adc_b_y: PyReadonlyArray1<'py, i64>,
         enable: PerSample<'py>,
-        bw_sel: BandwidthSelect<'py>,
+        bw_sel: PerSample<'py>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let adc = self.ports.loops()[0].adc;
         let records = [

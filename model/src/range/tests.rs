@@ -47,7 +47,7 @@ fn extremes(plan: &Plan, bw_sel: usize, z: impl Iterator<Item = i64>) -> [Interv
 }
 
 fn node<'a>(ranges: &'a KfRanges, name: &str) -> &'a NodeRange {
-    ranges.nodes.iter().find(|n| n.name == name).unwrap()
+    find(&ranges.nodes, name).unwrap()
 }
 
 #[test]
@@ -190,7 +190,7 @@ fn the_bias_bound_is_reached_by_means_with_the_gains_signs() {
     let plan = chain_plan(20, 2, 0, 0, Rounding::Nearest).estimator;
     let input = Interval::of_format(plan.input);
     let nodes = estimator(&plan, input);
-    let bias = nodes.iter().find(|n| n.name == "estimator.bias").unwrap();
+    let bias = find(&nodes, "estimator.bias").unwrap();
     let calibrated = nodes
         .iter()
         .find(|n| n.name == "estimator.calibrated")
@@ -353,7 +353,7 @@ proptest! {
     ) {
         let plan = chain_plan(interval_length, blank, 0, smoothing, Rounding::Nearest).estimator;
         let nodes = estimator(&plan, Interval::of_format(plan.input));
-        let bias = nodes.iter().find(|n| n.name == "estimator.bias").unwrap().range;
+        let bias = find(&nodes, "estimator.bias").unwrap().range;
         let mut sequencer = Sequencer::new(&plan.schedule);
         let mut fixed = FixedEstimator::new(&plan);
         let (min, max) = (plan.input.min_code(), plan.input.max_code());
