@@ -241,3 +241,58 @@ fn an_output_error_budget_is_met_by_the_written_config() {
     assert_eq!(last(&dps), last(&lsb));
     assert!(last(&lsb).contains("at most 2.000 LSB"), "{lsb}");
 }
+
+/// Bad input as a new user gives it: one clear error each, exit 2 (1 for a missing file), and
+/// nothing written.
+#[test]
+fn bad_input_is_refused_naming_what_is_allowed_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let target = dir.path().join("out.toml");
+    let target_text = target.to_str().unwrap();
+    let folder = dir.path().to_str().unwrap();
+    let missing = dir.path().join("missing.toml");
+    for (args, code, message) in [
+        (
+            vec!["--output-error", "nan"],
+            2,
+            "a finite number of output LSB",
+        ),
+        (
+            vec!["--output-error", "-3dps"],
+            2,
+            "is not allowed: more than 1.5",
+        ),
+        (vec!["--output-error", "lots"], 2, "is not a budget"),
+        (vec!["--write", folder, "--force"], 2, "is a folder"),
+        (
+            vec!["--config", missing.to_str().unwrap()],
+            1,
+            "missing.toml",
+        ),
+        (vec!["--preset", "nope"], 1, "one of gu2019"),
+    ] {
+        let mut full = vec!["formats"];
+        if args[0] != "--write" {
+            full.extend(["--write", target_text]);
+        }
+        full.extend(args.iter().copied());
+        let output = gyrofx(&full);
+        assert_eq!(
+            output.status.code(),
+            Some(code),
+            "{args:?}: {}",
+            text(&output)
+        );
+        assert!(
+            text(&output).contains(message),
+            "{args:?}: {}",
+            text(&output)
+        );
+        assert!(!target.exists(), "{args:?} wrote {target_text}");
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            0,
+            "{args:?} left a file behind"
+        );
+    }
+}

@@ -136,7 +136,12 @@ pub fn fractions_for(
     let floor_lsb = chain.rate_error_floor_lsb();
     let refuse =
         |allowed: String| format!("--output-error {budget_lsb} LSB is not allowed: {allowed}");
-    if !(budget_lsb.is_finite() && budget_lsb > floor_lsb) {
+    if !budget_lsb.is_finite() {
+        return Err(refuse(format!(
+            "a finite number of output LSB above {floor_lsb:.3}"
+        )));
+    }
+    if budget_lsb <= floor_lsb {
         return Err(refuse(format!(
             "more than {floor_lsb:.3} LSB: the output's rounding and the calibrated samples' (their formats are kf.output_format and kf.input_format) give that much with any guard bits"
         )));

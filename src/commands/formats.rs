@@ -31,7 +31,7 @@ pub struct Args {
     /// Error budget on the chain's output against its float model, in KF output LSB (`1.5`)
     /// or °/s (`0.0001dps`): also choose the fewest fraction bits of the interval means, bias
     /// estimates and KF state that meet it over the record (for --write and the table).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     output_error: Option<String>,
     /// Print JSON.
     #[arg(long)]
@@ -51,6 +51,12 @@ pub struct Args {
 /// Prints the table (or JSON); writes the derived config.
 pub fn run(args: Args) -> Result<ExitCode> {
     if let Some(path) = &args.write {
+        if path.is_dir() {
+            usage!(
+                "--write {} is a folder: name the TOML file to write",
+                path.display()
+            );
+        }
         if path.exists() && !args.force {
             usage!(
                 "--write {} exists: choose another file, or give --force to replace it",
