@@ -90,7 +90,9 @@ impl PerSample<'_> {
 
     /// `bw_sel` for `samples` samples, each addressing a ROM of `rom_depth` entries.
     pub(crate) fn per_sample(&self, samples: usize, rom_depth: usize) -> PyResult<Vec<usize>> {
-        self.values(samples, "bw_sel", |b, port| check_bw_sel(b, rom_depth, port))
+        self.values(samples, "bw_sel", |b, port| {
+            check_bw_sel(b, rom_depth, port)
+        })
     }
 }
 
