@@ -1,7 +1,7 @@
-//! `gyrofx formats`: the table and JSON name every analysed node with its proven range, a
-//! too-narrow format is reported (and `--strict` fails on it), `--write` gives a config whose
-//! configured nodes are proven and which `generate --strict` accepts, and an existing file is
-//! not replaced without `--force`.
+//! `gyrofx formats`: the table and JSON name every analysed node (the chain's and the gyro
+//! loop's) with its proven range and config key, a too-narrow format is reported (and
+//! `--strict` fails on it), `--write` gives a config whose configured nodes are proven and which
+//! `generate --strict` accepts, and an existing file is not replaced without `--force`.
 
 mod common;
 
@@ -33,10 +33,78 @@ fn the_default_is_analysed_node_by_node() {
     ] {
         assert!(table.contains(name), "{name}: {table}");
     }
-    assert!(table.contains("hand-set, not analysed: [loop]"), "{table}");
     let json: serde_json::Value =
         serde_json::from_str(&ok(&["formats", "--json", "--switches", "0"])).unwrap();
     let nodes = nodes(&json);
+    // The loop's nodes, each with the key that sets its format (or none: bit growth, or the
+    // NCO's frequency word), and which of them --write leaves.
+    for (name, key, written) in [
+        (
+            "loop.demod_product",
+            Some("loop.demod_product_format"),
+            true,
+        ),
+        ("loop.demod_state", Some("loop.demod_state_format"), true),
+        ("loop.demod_output", Some("loop.demod_output_format"), true),
+        ("loop.agc_error", Some("loop.demod_output_format"), true),
+        (
+            "loop.pll_integrator",
+            Some("loop.pll_integrator_format"),
+            true,
+        ),
+        ("loop.pll_output", None, false),
+        (
+            "loop.agc_integrator",
+            Some("loop.agc_integrator_format"),
+            true,
+        ),
+        ("loop.agc_output", Some("loop.agc_output_format"), false),
+        ("loop.dac", Some("loop.dac_format"), false),
+        ("loop.cic_comb", None, true),
+        ("loop.cic_internal", Some("loop.cic_internal_format"), true),
+        ("loop.cic_output", Some("loop.cic_output_format"), true),
+        ("loop.output", Some("loop.output_format"), false),
+    ] {
+        let line = table
+            .lines()
+            .find(|l| l.split_whitespace().next() == Some(name))
+            .unwrap_or_else(|| panic!("{name}: {table}"));
+        let n = node(&nodes, name);
+        assert_eq!(n["config_key"].as_str(), key, "{n}");
+        assert_eq!(n["not_written"].is_null(), written, "{n}");
+        if let (Some(key), false) = (key, n["fits"] == true) {
+            assert!(line.contains(&format!("(set {key})")), "{line}");
+        }
+    }
+    assert!(
+        node(&nodes, "loop.pll_output")["not_written"]
+            .as_str()
+            .unwrap()
+            .contains("loop.nco_phase_bits"),
+        "{table}"
+    );
+    // What stays hand-set has no range to prove, and says why.
+    let hand_set = table
+        .lines()
+        .find(|l| l.starts_with("hand-set, not analysed: [loop]"))
+        .unwrap_or_else(|| panic!("{table}"));
+    assert!(
+        hand_set.contains("NCO") && !hand_set.contains("CIC"),
+        "{hand_set}"
+    );
+    // 2·x·ref at the ADC's full scale against the NCO's largest code (just under 1): just
+    // under ±2 FS, in FS.
+    let product = node(&nodes, "loop.demod_product");
+    assert_eq!(product["unit"], "FS");
+    let range = product["range_dps"].as_array().unwrap();
+    let (low, high) = (range[0].as_f64().unwrap(), range[1].as_f64().unwrap());
+    assert!(high > 1.99 && high < 2.0 && low == -high, "{product}");
+    // A full-scale sense signal is some 10⁵ °/s (1e-5 FS per °/s): far beyond the chain's
+    // input format, which the loop's output shares.
+    let output = node(&nodes, "loop.output");
+    assert_eq!(output["fits"], false);
+    assert!(output["range_dps"][1].as_f64().unwrap() > 5e4, "{output}");
+    assert_eq!(json["loop"]["input_range_fs"][0], -1.0);
     let input = json["input_range_dps"].as_array().unwrap();
     let (low, high) = (input[0].as_f64().unwrap(), input[1].as_f64().unwrap());
     // The calibrated sample is y ∓ b with both at full scale: about twice the input range,
@@ -112,6 +180,50 @@ fn a_narrow_format_is_reported_and_strict_fails_on_it() {
     assert_eq!(output.status.code(), Some(1), "{}", text(&output));
 }
 
+/// One integer bit less than the default's product format needs (its range is just under
+/// ±2 FS) is reported on the product's line, naming the key; `--strict` exits 1.
+#[test]
+fn a_narrow_loop_format_is_reported_and_strict_fails_on_it() {
+    let line = |table: &str| {
+        table
+            .lines()
+            .find(|l| l.starts_with("loop.demod_product"))
+            .unwrap_or_else(|| panic!("{table}"))
+            .to_string()
+    };
+    let default = line(&ok(&["formats", "--switches", "0"]));
+    assert!(
+        default.contains("s36.34") && default.contains("proven"),
+        "{default}"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("narrow.toml");
+    std::fs::write(&config, "[loop]\ndemod_product_format = \"s35.34\"\n").unwrap();
+    let config = config.to_str().unwrap();
+    let table = ok(&["formats", "--config", config, "--switches", "0"]);
+    let narrow = line(&table);
+    assert!(
+        narrow.contains(
+            "OVERFLOW POSSIBLE: needs 1 more integer bit (set loop.demod_product_format)"
+        ),
+        "{narrow}"
+    );
+    // The state keeps its own format, proven as before: it holds every product (the plan
+    // requires it), saturated or not.
+    let state = table
+        .lines()
+        .find(|l| l.starts_with("loop.demod_state"))
+        .unwrap();
+    assert!(!state.contains("OVERFLOW"), "{state}");
+    let output = gyrofx(&["formats", "--config", config, "--strict"]);
+    assert_eq!(output.status.code(), Some(1), "{}", text(&output));
+    assert!(
+        text(&output).contains("set loop.demod_product_format"),
+        "{}",
+        text(&output)
+    );
+}
+
 #[test]
 fn write_gives_a_proven_config_that_generate_accepts_and_keeps_existing_files() {
     let dir = tempfile::tempdir().unwrap();
@@ -128,9 +240,39 @@ fn write_gives_a_proven_config_that_generate_accepts_and_keeps_existing_files() 
     ]))
     .unwrap();
     for n in nodes(&json) {
-        // Every node --write sets is now proven; the shared input format is left as it was.
+        // Every node --write sets is now proven, the loop's too; the shared formats are left as
+        // they were.
         if n["config_key"].is_string() && n["not_written"].is_null() {
             assert_eq!(n["fits"], true, "{n}");
+        }
+    }
+    // The loop's written keys hold the proven formats of the default (the wider where two
+    // nodes share a key); the others are as they were.
+    let default: serde_json::Value =
+        serde_json::from_str(&ok(&["formats", "--switches", "100", "--json"])).unwrap();
+    let before = nodes(&default);
+    let after = nodes(&json);
+    let width = |f: &serde_json::Value| -> u32 {
+        let text = f.as_str().unwrap();
+        text[1..text.find('.').unwrap()].parse().unwrap()
+    };
+    for n in before
+        .iter()
+        .filter(|n| n["node"].as_str().unwrap().starts_with("loop."))
+    {
+        let Some(key) = n["config_key"].as_str() else {
+            continue;
+        };
+        let written = node(&after, n["node"].as_str().unwrap())["format"].clone();
+        if n["not_written"].is_null() {
+            let widest = before
+                .iter()
+                .filter(|m| m["config_key"] == key)
+                .max_by_key(|m| width(&m["proven_format"]))
+                .unwrap();
+            assert_eq!(written, widest["proven_format"], "{key}");
+        } else {
+            assert_eq!(written, n["format"], "{key} is left as it was");
         }
     }
     let out = dir.path().join("pkg");

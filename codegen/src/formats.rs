@@ -5,8 +5,13 @@
 //! The analysis is [`gyrofx_model::range`] (worst-case peak gain of each linear block, interval
 //! arithmetic for the estimator and calibration); here it is applied to the job's plans, named
 //! by config key, and printed. Covered: the estimator, the calibration, the KF (the chain from
-//! the gyros' samples to the KF's output) and the mean filter. Not yet: the gyro loop's points
-//! (their formats stay hand-set; the table says so).
+//! the gyros' samples to the KF's output), the mean filter, and the resonator-level loop
+//! ([`gyrofx_model::range::gyro_loop`]: demodulators, PLL, AGC, DAC, CICs and the rate output,
+//! for any code of the loop's ADC). One `[loop]` section sets both gyros' formats while their
+//! designs (PI gains and limits, setpoints, `1/SF`) follow their resonators, so each loop node's
+//! range is the union of gyro A's and gyro B's. What stays hand-set ([`NOT_ANALYSED`]) has no
+//! range to prove: the NCO's widths are resolutions, the lock filters are wide enough by
+//! construction, coefficient formats are fitted to their values.
 
 use std::fmt::Write as _;
 
@@ -18,7 +23,7 @@ use serde_json::json;
 use gyrofx_model::chain;
 use gyrofx_model::estimator;
 
-use crate::config::Config;
+use crate::config::{Config, GyroLoop};
 use crate::error::{Error, Result};
 use crate::job::{plan_for, Job};
 
@@ -29,8 +34,11 @@ pub struct Row {
     pub node: NodeRange,
     /// The config key that sets its format, when one does (exact nodes follow by bit growth).
     pub key: Option<&'static str>,
-    /// Why the node is not written by `--write`, when it has a key.
+    /// Why `--write` does not set the node's format: its key sets other things too, or no key
+    /// sets it alone.
     pub shared: Option<&'static str>,
+    /// Units of its range.
+    pub unit: &'static str,
 }
 
 impl Row {
@@ -49,6 +57,8 @@ pub struct Analysis {
     pub switches: u64,
     /// The ADC's range (°/s): the gyros' samples.
     pub input: Interval,
+    /// The loop ADC's range (full-scale units): the resonators' pick-off codes.
+    pub loop_input: Interval,
     /// Every analysed node, in data-flow order.
     pub rows: Vec<Row>,
     /// How far one `bw_sel` switch can move the KF's states (°/s).
@@ -190,11 +200,73 @@ pub fn fractions_for(
     })
 }
 
-/// Blocks whose formats the analysis does not cover yet: they are reported as hand-set.
+/// Formats the analysis does not cover, with why none is needed: they are reported as
+/// hand-set.
 pub const NOT_ANALYSED: [(&str, &str); 1] = [(
     "loop",
-    "demodulator, PLL, AGC, CIC and output formats of the resonator-level loop",
+    "NCO phase, ROM and sine widths (resolutions: the phase wraps by design, the ROM's largest code is its format's), lock filters (demod_output width + s + 1 bits, cannot overflow), gain and 1/SF widths (fitted to their values)",
 )];
+
+/// Units of a loop node's range.
+fn loop_unit(name: &str) -> &'static str {
+    match name {
+        "loop.pll_integrator" | "loop.pll_output" => "cycles/sample",
+        "loop.agc_integrator" | "loop.agc_output" | "loop.dac" => "DAC LSB",
+        "loop.output" => "°/s",
+        _ => "FS",
+    }
+}
+
+/// The config key of a loop node, and why `--write` leaves it when it does.
+fn loop_key(name: &str) -> (Option<&'static str>, Option<&'static str>) {
+    match name {
+        "loop.demod_product" => (Some("loop.demod_product_format"), None),
+        "loop.demod_state" => (Some("loop.demod_state_format"), None),
+        // Both are quantized into one format: --write gives it the wider of the two.
+        "loop.demod_output" | "loop.agc_error" => (Some("loop.demod_output_format"), None),
+        "loop.pll_integrator" => (Some("loop.pll_integrator_format"), None),
+        "loop.pll_output" => (
+            None,
+            Some("the NCO's frequency word, s P.P cycles per sample with P = loop.nco_phase_bits"),
+        ),
+        "loop.agc_integrator" => (Some("loop.agc_integrator_format"), None),
+        "loop.agc_output" => (
+            Some("loop.agc_output_format"),
+            Some("loop.agc_output_format limits the drive at the DAC's full scale on purpose: a wider one moves the saturation to the DAC, which clips the drive's sine"),
+        ),
+        "loop.dac" => (
+            Some("loop.dac_format"),
+            Some("loop.dac_format is the DAC's (one LSB is front_end.dac_newton_per_lsb) and sets the AGC's limits"),
+        ),
+        "loop.cic_internal" => (Some("loop.cic_internal_format"), None),
+        "loop.cic_output" => (Some("loop.cic_output_format"), None),
+        "loop.output" => (
+            Some("loop.output_format"),
+            Some("loop.output_format is the chain's input format (kf.input_format, with the resonator plant): the rate saturates beyond it"),
+        ),
+        _ => (None, None),
+    }
+}
+
+/// The loop's rows over both gyros: each node's range is the union of both gyros' (one
+/// `[loop]` section sets both formats).
+fn loop_rows(loops: &[GyroLoop; 2]) -> Vec<Row> {
+    let [a, b] = loops.each_ref().map(|l| range::gyro_loop::gyro(&l.plan));
+    a.into_iter()
+        .zip(b)
+        .map(|(mut node, other)| {
+            debug_assert_eq!((node.name, node.format), (other.name, other.format));
+            node.range = node.range.union(other.range);
+            let (key, shared) = loop_key(node.name);
+            Row {
+                unit: loop_unit(node.name),
+                node,
+                key,
+                shared,
+            }
+        })
+        .collect()
+}
 
 /// Analyses `job` for a record of `samples` samples with at most `switches` changes of
 /// `bw_sel`.
@@ -213,7 +285,12 @@ pub fn analyse(job: &Job, samples: u64, switches: u64) -> Analysis {
                 ),
                 _ => (None, None),
             };
-            Row { node, key, shared }
+            Row {
+                node,
+                key,
+                shared,
+                unit: "°/s",
+            }
         })
         .collect();
     // The KF sees the calibrated samples after their (saturating) quantizer: its input range is
@@ -234,6 +311,7 @@ pub fn analyse(job: &Job, samples: u64, switches: u64) -> Analysis {
             node,
             key,
             shared: None,
+            unit: "°/s",
         }
     }));
     rows.extend(
@@ -246,9 +324,18 @@ pub fn analyse(job: &Job, samples: u64, switches: u64) -> Analysis {
                     node,
                     key,
                     shared: None,
+                    unit: "°/s",
                 }
             }),
     );
+    rows.extend(loop_rows(&job.gyro_loops));
+    let loop_input = job
+        .gyro_loops
+        .each_ref()
+        .map(|l| Interval::of_format(l.plan.adc))
+        .into_iter()
+        .reduce(Interval::union)
+        .expect("two gyros");
     let state_fits = |n: u64| {
         let ranges = range::kf(&chain.kf, Interval::of_format(chain.kf.input), n, switches);
         range::find(&ranges.nodes, "kf.state").is_some_and(NodeRange::fits)
@@ -258,6 +345,7 @@ pub fn analyse(job: &Job, samples: u64, switches: u64) -> Analysis {
         samples,
         switches,
         input,
+        loop_input,
         rows,
         per_switch_dps: kf_ranges.per_switch,
         kf_output_error_lsb: rate_error_bound_lsb(&chain.kf, samples, switches),
@@ -301,10 +389,19 @@ impl Analysis {
             "proven ranges for any input in the ADC's range [{}, {}] °/s, a record of {} samples and up to {} bw_sel switches:",
             self.input.lo, self.input.hi, self.samples, self.switches
         );
+        let range_of = |row: &Row| format!("[{:.6}, {:.6}]", row.node.range.lo, row.node.range.hi);
+        // The widest range sets the column (the CIC's comb holds ±2·10⁹ FS).
+        let width = self
+            .rows
+            .iter()
+            .map(|row| range_of(row).chars().count())
+            .max()
+            .unwrap_or(0)
+            .max(27);
         let _ = writeln!(
             out,
-            "{:<22} {:>27}  {:>9}  {:>9}  status",
-            "node", "range (°/s)", "proven", "config"
+            "{:<22} {:>width$} {:<13}  {:>9}  {:>9}  status",
+            "node", "range", "unit", "proven", "config"
         );
         for row in &self.rows {
             let node = &row.node;
@@ -314,8 +411,11 @@ impl Analysis {
                     "OVERFLOW POSSIBLE: needs {} more integer bit{} ({})",
                     -spare,
                     if spare == -1 { "" } else { "s" },
-                    row.key
-                        .map_or("derived by bit growth".to_string(), |k| format!("set {k}"))
+                    match (row.key, row.shared) {
+                        (Some(key), _) => format!("set {key}"),
+                        (None, Some(why)) => why.to_string(),
+                        (None, None) => "derived by bit growth".to_string(),
+                    }
                 )
             } else if node.exact {
                 "exact (bit growth)".to_string()
@@ -329,13 +429,19 @@ impl Analysis {
             };
             let _ = writeln!(
                 out,
-                "{:<22} {:>27}  {:>9}  {:>9}  {status}",
+                "{:<22} {:>width$} {:<13}  {:>9}  {:>9}  {status}",
                 node.name,
-                format!("[{:.6}, {:.6}]", node.range.lo, node.range.hi),
+                range_of(row),
+                row.unit,
                 row.proven().to_string(),
                 node.format.to_string(),
             );
         }
+        let _ = writeln!(
+            out,
+            "loop: for any code of the loop's ADC [{}, {}] FS and any NCO reference (a held one too), both gyros' designs; ranges assume the nodes before them hold theirs, as after --write",
+            self.loop_input.lo, self.loop_input.hi
+        );
         let _ = writeln!(
             out,
             "kf: one bw_sel switch can move x1 and x2 by {:.3e} °/s (the eigenvalue-1 direction is never corrected); the state format {}",
@@ -369,6 +475,7 @@ impl Analysis {
                     "node": node.name,
                     "what": node.what,
                     "range_dps": [node.range.lo, node.range.hi],
+                    "unit": row.unit,
                     "format": node.format.to_string(),
                     "proven_format": row.proven().to_string(),
                     "needed_integer_bits": node.needed_integer_bits(),
@@ -391,30 +498,43 @@ impl Analysis {
                 "state_proven_up_to_samples": self.kf_state_limit,
             },
             "estimator": {"bias_error_bound_lsb": self.bias_error_lsb},
+            "loop": {"input_range_fs": [self.loop_input.lo, self.loop_input.hi]},
             "hand_set": NOT_ANALYSED.iter().map(|(block, what)| json!({"block": block, "formats": what})).collect::<Vec<_>>(),
         })
     }
 
-    /// `config` with every configured node's proven format (those a key sets alone), and the
-    /// fraction bits of `budget` when one is given, checked by resolving it as `generate`
-    /// would.
+    /// `config` with every configured node's proven format (those `--write` may set; nodes
+    /// sharing a key get the widest of theirs), and the fraction bits of `budget` when one is
+    /// given, checked by resolving it as `generate` would.
     ///
     /// # Errors
     /// The derived config does not resolve (a format the blocks refuse).
     pub fn derived_config(&self, config: &Config, budget: Option<&Budget>) -> Result<Config> {
         let mut derived = config.clone();
-        for row in &self.rows {
-            if row.shared.is_some() {
-                continue;
+        let mut proven: Vec<(&str, Format)> = Vec::new();
+        for row in self.rows.iter().filter(|r| r.shared.is_none()) {
+            let Some(key) = row.key else { continue };
+            let format = row.proven();
+            match proven.iter_mut().find(|(k, _)| *k == key) {
+                // Rows of one key share its fraction bits: the wider holds both.
+                Some((_, widest)) if format.width > widest.width => *widest = format,
+                Some(_) => {}
+                None => proven.push((key, format)),
             }
-            let proven = row.proven().to_string();
-            match row.key {
-                Some("estimator.mean_format") => derived.estimator.mean_format = proven,
-                Some("estimator.bias_format") => derived.estimator.bias_format = proven,
-                Some("kf.state_format") => derived.kf.state_format = proven,
-                Some("kf.output_format") => derived.kf.output_format = proven,
-                Some("mean_filter.output_format") => derived.mean_filter.output_format = proven,
-                _ => {}
+        }
+        for (key, format) in proven {
+            let text = format.to_string();
+            match key {
+                "estimator.mean_format" => derived.estimator.mean_format = text,
+                "estimator.bias_format" => derived.estimator.bias_format = text,
+                "kf.state_format" => derived.kf.state_format = text,
+                "kf.output_format" => derived.kf.output_format = text,
+                "mean_filter.output_format" => derived.mean_filter.output_format = text,
+                _ => {
+                    if let Some(field) = key.strip_prefix("loop.") {
+                        derived.gyro_loop.insert(field.into(), text.into());
+                    }
+                }
             }
         }
         if let Some(budget) = budget {

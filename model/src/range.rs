@@ -32,6 +32,8 @@ use crate::fx::{pow2, requantize, Format, Overflow, Rounding};
 use crate::kf;
 use crate::mean_filter;
 
+pub mod gyro_loop;
+
 /// A closed interval of real values (°/s for the chain's nodes).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Interval {

@@ -202,6 +202,12 @@ impl FixedCic {
         written
     }
 
+    /// The compensator's delay line `c[m], c[m−1], …` (CIC output format codes), newest first:
+    /// what the last output was computed from.
+    pub fn compensator_line(&self) -> &[i64] {
+        &self.line[..self.tap_count]
+    }
+
     /// Input samples since the last output (or reset): `0..R`.
     pub fn phase(&self) -> u32 {
         self.phase
