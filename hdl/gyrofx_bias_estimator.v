@@ -29,34 +29,34 @@
  */
 module gyrofx_bias_estimator #(
     // gyro samples: width and fraction bits
-    parameter IN_W = 24,
-    parameter IN_F = 14,
+    parameter integer IN_W = 24,
+    parameter integer IN_F = 14,
     // accumulator width (fraction IN_F): IN_W + bits to count an interval
-    parameter ACC_W = 32,
+    parameter integer ACC_W = 32,
     // reciprocal 1/(L - M): format and code
-    parameter RECIP_W = 18,
-    parameter RECIP_F = 24,
+    parameter integer RECIP_W = 18,
+    parameter integer RECIP_F = 24,
     parameter [RECIP_W-1:0] RECIP = 18'd119837,
     // interval means
-    parameter MEAN_W = 28,
-    parameter MEAN_F = 18,
+    parameter integer MEAN_W = 28,
+    parameter integer MEAN_F = 18,
     // least-squares gains
-    parameter GAIN_W = 18,
-    parameter GAIN_F = 17,
+    parameter integer GAIN_W = 18,
+    parameter integer GAIN_F = 17,
     // exact dot product width (fraction GAIN_F + MEAN_F)
-    parameter DOT_W = 49,
+    parameter integer DOT_W = 49,
     // bias estimates
-    parameter BIAS_W = 28,
-    parameter BIAS_F = 18,
+    parameter integer BIAS_W = 28,
+    parameter integer BIAS_F = 18,
     // W intervals per window and the width of an interval index
-    parameter INTERVALS = 4,
-    parameter INTERVAL_W = 2,
+    parameter integer INTERVALS = 4,
+    parameter integer INTERVAL_W = 2,
     // smoothing shift s (0: none)
-    parameter SMOOTH = 0,
+    parameter integer SMOOTH = 0,
     // rounding: 0 floor, 1 ceil, 2 zero, 3 nearest, 4 round, 5 convergent
-    parameter ROUNDING = 3,
+    parameter integer ROUNDING = 3,
     // overflow: 0 wrap, 1 saturate
-    parameter SATURATE = 1,
+    parameter integer SATURATE = 1,
     // gain ROM image for $readmemh
     parameter ROM_FILE = "estimator_gains.mem"
 ) (
@@ -77,10 +77,10 @@ module gyrofx_bias_estimator #(
     output wire                    estimated
 );
 
-localparam TERMS = 2 * INTERVALS;
-localparam PRODUCT_W = ACC_W + RECIP_W;
-localparam TERM_W = GAIN_W + MEAN_W;
-localparam SMOOTH_W = BIAS_W + 2 + SMOOTH;
+localparam integer TERMS = 2 * INTERVALS;
+localparam integer PRODUCT_W = ACC_W + RECIP_W;
+localparam integer TERM_W = GAIN_W + MEAN_W;
+localparam integer SMOOTH_W = BIAS_W + 2 + SMOOTH;
 
 initial begin
     if (ACC_W <= IN_W || DOT_W < TERM_W) begin

@@ -22,18 +22,18 @@
  */
 module gyrofx_calibration #(
     // gyro samples
-    parameter IN_W = 24,
-    parameter IN_F = 14,
+    parameter integer IN_W = 24,
+    parameter integer IN_F = 14,
     // bias estimates
-    parameter BIAS_W = 28,
-    parameter BIAS_F = 18,
+    parameter integer BIAS_W = 28,
+    parameter integer BIAS_F = 18,
     // calibrated and combined outputs (CAL_F <= max(IN_F, BIAS_F))
-    parameter CAL_W = 24,
-    parameter CAL_F = 14,
+    parameter integer CAL_W = 24,
+    parameter integer CAL_F = 14,
     // rounding: 0 floor, 1 ceil, 2 zero, 3 nearest, 4 round, 5 convergent
-    parameter ROUNDING = 3,
+    parameter integer ROUNDING = 3,
     // overflow: 0 wrap, 1 saturate
-    parameter SATURATE = 1
+    parameter integer SATURATE = 1
 ) (
     input  wire signed [IN_W-1:0]   y_a,
     input  wire signed [IN_W-1:0]   y_b,
@@ -51,10 +51,10 @@ module gyrofx_calibration #(
     output wire                     combined_valid
 );
 
-localparam F = (IN_F > BIAS_F) ? IN_F : BIAS_F;
-localparam IN_I = IN_W - IN_F;
-localparam BIAS_I = BIAS_W - BIAS_F;
-localparam D_W = ((IN_I > BIAS_I) ? IN_I : BIAS_I) + 1 + F;
+localparam integer F = (IN_F > BIAS_F) ? IN_F : BIAS_F;
+localparam integer IN_I = IN_W - IN_F;
+localparam integer BIAS_I = BIAS_W - BIAS_F;
+localparam integer D_W = ((IN_I > BIAS_I) ? IN_I : BIAS_I) + 1 + F;
 
 wire signed [D_W-1:0] y_a_wide = {{(D_W-IN_W){y_a[IN_W-1]}}, y_a};
 wire signed [D_W-1:0] y_b_wide = {{(D_W-IN_W){y_b[IN_W-1]}}, y_b};

@@ -31,29 +31,29 @@
  */
 module gyrofx_cic #(
     // input x: width and fraction bits
-    parameter IN_W = 24,
-    parameter IN_F = 23,
+    parameter integer IN_W = 24,
+    parameter integer IN_F = 23,
     // integrator and comb stages (1..8)
-    parameter STAGES = 3,
+    parameter integer STAGES = 3,
     // decimation R (2..65536) and the comb's differential delay M (1 or 2)
-    parameter DECIMATION = 1000,
-    parameter DELAY = 1,
+    parameter integer DECIMATION = 1000,
+    parameter integer DELAY = 1,
     // the comb output is scaled by 2^-SHIFT
-    parameter SHIFT = 30,
+    parameter integer SHIFT = 30,
     // scaled CIC output c: width and fraction bits
-    parameter MID_W = 28,
-    parameter MID_F = 27,
+    parameter integer MID_W = 28,
+    parameter integer MID_F = 27,
     // compensator taps (odd) and their width and fraction bits
-    parameter TAPS = 5,
-    parameter COEF_W = 18,
-    parameter COEF_F = 16,
+    parameter integer TAPS = 5,
+    parameter integer COEF_W = 18,
+    parameter integer COEF_F = 16,
     // output y: width and fraction bits
-    parameter OUT_W = 24,
-    parameter OUT_F = 23,
+    parameter integer OUT_W = 24,
+    parameter integer OUT_F = 23,
     // rounding: 0 floor, 1 ceil, 2 zero, 3 nearest, 4 round, 5 convergent
-    parameter ROUNDING = 3,
+    parameter integer ROUNDING = 3,
     // overflow: 0 wrap, 1 saturate
-    parameter SATURATE = 1,
+    parameter integer SATURATE = 1,
     // compensator taps image for $readmemh
     parameter ROM_FILE = "cic_taps.mem"
 ) (
@@ -93,13 +93,13 @@ function integer ceil_log2;
     end
 endfunction
 
-localparam GROWTH = growth_bits(STAGES, DECIMATION * DELAY);
-localparam REG_W = IN_W + GROWTH;
-localparam CNT_W = ceil_log2(DECIMATION);
+localparam integer GROWTH = growth_bits(STAGES, DECIMATION * DELAY);
+localparam integer REG_W = IN_W + GROWTH;
+localparam integer CNT_W = ceil_log2(DECIMATION);
 // The count of the ce that completes a decimation period.
 localparam integer LAST_COUNT = DECIMATION - 1;
-localparam PROD_W = MID_W + COEF_W;
-localparam ACC_W = PROD_W + ceil_log2(TAPS);
+localparam integer PROD_W = MID_W + COEF_W;
+localparam integer ACC_W = PROD_W + ceil_log2(TAPS);
 
 initial begin
     if (STAGES < 1 || STAGES > 8 || DECIMATION < 2 || DELAY < 1 || DELAY > 2) begin

@@ -28,27 +28,27 @@
  */
 module gyrofx_demodulator #(
     // ADC sample: width and fraction bits (full-scale units)
-    parameter ADC_W = 24,
-    parameter ADC_F = 23,
+    parameter integer ADC_W = 24,
+    parameter integer ADC_F = 23,
     // NCO references: width and fraction bits
-    parameter REF_W = 18,
-    parameter REF_F = 17,
+    parameter integer REF_W = 18,
+    parameter integer REF_F = 17,
     // quantized product 2 * adc * ref: width and fraction bits
-    parameter PROD_W = 32,
-    parameter PROD_F = 30,
+    parameter integer PROD_W = 32,
+    parameter integer PROD_F = 30,
     // low-pass state: width and fraction bits (STATE_F >= PROD_F,
     // STATE_W - STATE_F >= PROD_W - PROD_F)
-    parameter STATE_W = 40,
-    parameter STATE_F = 38,
+    parameter integer STATE_W = 40,
+    parameter integer STATE_F = 38,
     // I and Q outputs: width and fraction bits (OUT_F <= STATE_F)
-    parameter OUT_W = 24,
-    parameter OUT_F = 23,
+    parameter integer OUT_W = 24,
+    parameter integer OUT_F = 23,
     // low-pass coefficient 2^-SHIFT (1..24)
-    parameter SHIFT = 8,
+    parameter integer SHIFT = 8,
     // rounding: 0 floor, 1 ceil, 2 zero, 3 nearest, 4 round, 5 convergent
-    parameter ROUNDING = 3,
+    parameter integer ROUNDING = 3,
     // overflow: 0 wrap, 1 saturate
-    parameter SATURATE = 1
+    parameter integer SATURATE = 1
 ) (
     input  wire                     clk,
     input  wire                     rst,
@@ -62,13 +62,13 @@ module gyrofx_demodulator #(
 );
 
 // Exact product 2 * adc * ref: the integer adc * ref at one fraction bit less.
-localparam X_W = ADC_W + REF_W;
-localparam X_F = ADC_F + REF_F - 1;
+localparam integer X_W = ADC_W + REF_W;
+localparam integer X_F = ADC_F + REF_F - 1;
 // Exact update (y << SHIFT) + (p - y) at STATE_F + SHIFT fraction bits.
-localparam U_W = STATE_W + SHIFT + 1;
-localparam U_F = STATE_F + SHIFT;
+localparam integer U_W = STATE_W + SHIFT + 1;
+localparam integer U_F = STATE_F + SHIFT;
 // Aligns a product to the state's fraction bits.
-localparam ALIGN = STATE_F - PROD_F;
+localparam integer ALIGN = STATE_F - PROD_F;
 
 initial begin
     if (ALIGN < 0 || STATE_W - STATE_F < PROD_W - PROD_F) begin

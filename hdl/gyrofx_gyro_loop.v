@@ -44,77 +44,77 @@
  */
 module gyrofx_gyro_loop #(
     // NCOs: phase bits, quarter-wave ROM address bits, sine width
-    parameter NCO_PHASE_W = 32,
-    parameter NCO_ADDR_W = 10,
-    parameter NCO_SIN_W = 18,
+    parameter integer NCO_PHASE_W = 32,
+    parameter integer NCO_ADDR_W = 10,
+    parameter integer NCO_SIN_W = 18,
     // demodulators (both): ADC, reference, product, state and output formats, low-pass shift
-    parameter DEMOD_ADC_W = 24,
-    parameter DEMOD_ADC_F = 23,
-    parameter DEMOD_REF_W = 18,
-    parameter DEMOD_REF_F = 17,
-    parameter DEMOD_PROD_W = 36,
-    parameter DEMOD_PROD_F = 34,
-    parameter DEMOD_STATE_W = 44,
-    parameter DEMOD_STATE_F = 42,
-    parameter DEMOD_OUT_W = 32,
-    parameter DEMOD_OUT_F = 30,
-    parameter DEMOD_SHIFT = 8,
+    parameter integer DEMOD_ADC_W = 24,
+    parameter integer DEMOD_ADC_F = 23,
+    parameter integer DEMOD_REF_W = 18,
+    parameter integer DEMOD_REF_F = 17,
+    parameter integer DEMOD_PROD_W = 36,
+    parameter integer DEMOD_PROD_F = 34,
+    parameter integer DEMOD_STATE_W = 44,
+    parameter integer DEMOD_STATE_F = 42,
+    parameter integer DEMOD_OUT_W = 32,
+    parameter integer DEMOD_OUT_F = 30,
+    parameter integer DEMOD_SHIFT = 8,
     // PLL: error, gains, integrator and output (the NCO word, s NCO_PHASE_W.NCO_PHASE_W)
-    parameter PLL_ERR_W = 32,
-    parameter PLL_ERR_F = 30,
-    parameter PLL_KP_W = 18,
-    parameter PLL_KP_F = 27,
-    parameter PLL_KI_W = 18,
-    parameter PLL_KI_F = 38,
-    parameter PLL_INT_W = 40,
-    parameter PLL_INT_F = 38,
-    parameter PLL_OUT_W = 32,
-    parameter PLL_OUT_F = 32,
+    parameter integer PLL_ERR_W = 32,
+    parameter integer PLL_ERR_F = 30,
+    parameter integer PLL_KP_W = 18,
+    parameter integer PLL_KP_F = 27,
+    parameter integer PLL_KI_W = 18,
+    parameter integer PLL_KI_F = 38,
+    parameter integer PLL_INT_W = 40,
+    parameter integer PLL_INT_F = 38,
+    parameter integer PLL_OUT_W = 32,
+    parameter integer PLL_OUT_F = 32,
     parameter signed [PLL_KP_W-1:0] PLL_KP = 18'sd67109,
     parameter signed [PLL_KI_W-1:0] PLL_KI = 18'sd96149,
     parameter signed [PLL_INT_W-1:0] PLL_INT_MIN = 40'sd11052846203,
     parameter signed [PLL_INT_W-1:0] PLL_INT_MAX = 40'sd11400555661,
     // AGC: error, gains, integrator and output (DAC LSB)
-    parameter AGC_ERR_W = 32,
-    parameter AGC_ERR_F = 30,
-    parameter AGC_KP_W = 18,
-    parameter AGC_KP_F = 1,
-    parameter AGC_KI_W = 18,
-    parameter AGC_KI_F = 11,
-    parameter AGC_INT_W = 40,
-    parameter AGC_INT_F = 20,
-    parameter AGC_OUT_W = 24,
-    parameter AGC_OUT_F = 6,
+    parameter integer AGC_ERR_W = 32,
+    parameter integer AGC_ERR_F = 30,
+    parameter integer AGC_KP_W = 18,
+    parameter integer AGC_KP_F = 1,
+    parameter integer AGC_KI_W = 18,
+    parameter integer AGC_KI_F = 11,
+    parameter integer AGC_INT_W = 40,
+    parameter integer AGC_INT_F = 20,
+    parameter integer AGC_OUT_W = 24,
+    parameter integer AGC_OUT_F = 6,
     parameter signed [AGC_KP_W-1:0] AGC_KP = 18'sd105114,
     parameter signed [AGC_KI_W-1:0] AGC_KI = 18'sd75300,
     parameter signed [AGC_INT_W-1:0] AGC_INT_MIN = 40'sd0,
     parameter signed [AGC_INT_W-1:0] AGC_INT_MAX = 40'sd137437904896,
     // CICs (both): input, stages, decimation, delay, shift, scaled output, taps, output
-    parameter CIC_IN_W = 32,
-    parameter CIC_IN_F = 30,
-    parameter CIC_STAGES = 3,
-    parameter CIC_DECIMATION = 1000,
-    parameter CIC_DELAY = 1,
-    parameter CIC_SHIFT = 30,
-    parameter CIC_MID_W = 40,
-    parameter CIC_MID_F = 38,
-    parameter CIC_TAPS = 5,
-    parameter CIC_COEF_W = 18,
-    parameter CIC_COEF_F = 16,
-    parameter CIC_OUT_W = 32,
-    parameter CIC_OUT_F = 30,
+    parameter integer CIC_IN_W = 32,
+    parameter integer CIC_IN_F = 30,
+    parameter integer CIC_STAGES = 3,
+    parameter integer CIC_DECIMATION = 1000,
+    parameter integer CIC_DELAY = 1,
+    parameter integer CIC_SHIFT = 30,
+    parameter integer CIC_MID_W = 40,
+    parameter integer CIC_MID_F = 38,
+    parameter integer CIC_TAPS = 5,
+    parameter integer CIC_COEF_W = 18,
+    parameter integer CIC_COEF_F = 16,
+    parameter integer CIC_OUT_W = 32,
+    parameter integer CIC_OUT_F = 30,
     // DAC codes, rate/quadrature output (deg/s) and the 1/SF coefficients' format
-    parameter DAC_W = 18,
-    parameter DAC_F = 0,
-    parameter OUT_W = 24,
-    parameter OUT_F = 14,
-    parameter COEF_W = 24,
-    parameter COEF_F = 6,
+    parameter integer DAC_W = 18,
+    parameter integer DAC_F = 0,
+    parameter integer OUT_W = 24,
+    parameter integer OUT_F = 14,
+    parameter integer COEF_W = 24,
+    parameter integer COEF_F = 6,
     // ADC-to-DAC latency, samples (0..8)
-    parameter LATENCY = 1,
+    parameter integer LATENCY = 1,
     // lock detector: filter shift and the samples both errors must stay inside
-    parameter LOCK_SHIFT = 9,
-    parameter LOCK_HOLD = 2000,
+    parameter integer LOCK_SHIFT = 9,
+    parameter integer LOCK_HOLD = 2000,
     // per mode (_N normal, _R reverse): AGC setpoint (demodulator output format),
     // nominal NCO word and PLL preset, DAC and sense reference offsets (cycles,
     // u NCO_PHASE_W.NCO_PHASE_W), 1/SF of the rate and quadrature, lock limits
@@ -137,9 +137,9 @@ module gyrofx_gyro_loop #(
     parameter signed [63:0] LOCK_A_N = 64'sd109950324,
     parameter signed [63:0] LOCK_A_R = 64'sd109950324,
     // rounding: 0 floor, 1 ceil, 2 zero, 3 nearest, 4 round, 5 convergent
-    parameter ROUNDING = 3,
+    parameter integer ROUNDING = 3,
     // overflow: 0 wrap, 1 saturate
-    parameter SATURATE = 1,
+    parameter integer SATURATE = 1,
     // ROM images for $readmemh
     parameter NCO_ROM_FILE = "nco_sine.mem",
     parameter CIC_ROM_FILE = "cic_taps.mem"
@@ -158,12 +158,12 @@ module gyrofx_gyro_loop #(
     output wire                           locked
 );
 
-localparam Z_W = DEMOD_OUT_W + LOCK_SHIFT + 1;
-localparam DRIVE_W = AGC_OUT_W + NCO_SIN_W;
-localparam DRIVE_F = AGC_OUT_F + NCO_SIN_W - 1;
-localparam RATE_W = CIC_OUT_W + COEF_W;
-localparam RATE_F = CIC_OUT_F + COEF_F;
-localparam DELAY_N = LATENCY > 0 ? LATENCY : 1;
+localparam integer Z_W = DEMOD_OUT_W + LOCK_SHIFT + 1;
+localparam integer DRIVE_W = AGC_OUT_W + NCO_SIN_W;
+localparam integer DRIVE_F = AGC_OUT_F + NCO_SIN_W - 1;
+localparam integer RATE_W = CIC_OUT_W + COEF_W;
+localparam integer RATE_F = CIC_OUT_F + COEF_F;
+localparam integer DELAY_N = LATENCY > 0 ? LATENCY : 1;
 
 // ---- stage 0: mode, switch actions, NCOs ----------------------------------
 reg mode_reg = 1'b1;

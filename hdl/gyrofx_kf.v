@@ -27,27 +27,27 @@
  */
 module gyrofx_kf #(
     // input z: width and fraction bits (°/s)
-    parameter IN_W = 24,
-    parameter IN_F = 14,
+    parameter integer IN_W = 24,
+    parameter integer IN_F = 14,
     // state x1, x2: width and fraction bits (STATE_F >= IN_F: guard bits)
-    parameter STATE_W = 36,
-    parameter STATE_F = 26,
+    parameter integer STATE_W = 36,
+    parameter integer STATE_F = 26,
     // output rate_out: width and fraction bits (OUT_F <= STATE_F)
-    parameter OUT_W = 24,
-    parameter OUT_F = 14,
+    parameter integer OUT_W = 24,
+    parameter integer OUT_F = 14,
     // coefficient g1: width and fraction bits
-    parameter G1_W = 18,
-    parameter G1_F = 17,
+    parameter integer G1_W = 18,
+    parameter integer G1_F = 17,
     // coefficient g2: width and fraction bits
-    parameter G2_W = 18,
-    parameter G2_F = 38,
+    parameter integer G2_W = 18,
+    parameter integer G2_F = 38,
     // bw_sel width and number of ROM words
-    parameter SEL_W = 2,
-    parameter ROM_DEPTH = 3,
+    parameter integer SEL_W = 2,
+    parameter integer ROM_DEPTH = 3,
     // rounding: 0 floor, 1 ceil, 2 zero, 3 nearest, 4 round, 5 convergent
-    parameter ROUNDING = 3,
+    parameter integer ROUNDING = 3,
     // overflow: 0 wrap, 1 saturate
-    parameter SATURATE = 1,
+    parameter integer SATURATE = 1,
     // coefficient ROM image for $readmemh
     parameter ROM_FILE = "kf_coefficients.mem"
 ) (
@@ -61,20 +61,20 @@ module gyrofx_kf #(
 );
 
 // Exact intermediate widths: integer bits (with sign) grow by one per add.
-localparam GUARD = STATE_F - IN_F;
-localparam IN_I = IN_W - IN_F;
-localparam STATE_I = STATE_W - STATE_F;
-localparam D1_I = (IN_I > STATE_I ? IN_I : STATE_I) + 1;     // z - x1
-localparam E_I = (D1_I > STATE_I ? D1_I : STATE_I) + 1;      // z - x1 - x2
-localparam E_W = E_I + STATE_F;
-localparam P1_W = G1_W + E_W;
-localparam P1_F = G1_F + STATE_F;
-localparam P2_W = G2_W + E_W;
-localparam P2_F = G2_F + STATE_F;
-localparam P1_I = P1_W - P1_F;
-localparam P2_I = P2_W - P2_F;
-localparam S1_W = (STATE_I > P1_I ? STATE_I : P1_I) + 1 + P1_F;  // x1 + g1*e
-localparam S2_W = (STATE_I > P2_I ? STATE_I : P2_I) + 1 + P2_F;  // x2 + g2*e
+localparam integer GUARD = STATE_F - IN_F;
+localparam integer IN_I = IN_W - IN_F;
+localparam integer STATE_I = STATE_W - STATE_F;
+localparam integer D1_I = (IN_I > STATE_I ? IN_I : STATE_I) + 1;     // z - x1
+localparam integer E_I = (D1_I > STATE_I ? D1_I : STATE_I) + 1;      // z - x1 - x2
+localparam integer E_W = E_I + STATE_F;
+localparam integer P1_W = G1_W + E_W;
+localparam integer P1_F = G1_F + STATE_F;
+localparam integer P2_W = G2_W + E_W;
+localparam integer P2_F = G2_F + STATE_F;
+localparam integer P1_I = P1_W - P1_F;
+localparam integer P2_I = P2_W - P2_F;
+localparam integer S1_W = (STATE_I > P1_I ? STATE_I : P1_I) + 1 + P1_F;  // x1 + g1*e
+localparam integer S2_W = (STATE_I > P2_I ? STATE_I : P2_I) + 1 + P2_F;  // x2 + g2*e
 
 initial begin
     if (GUARD < 0) begin

@@ -28,26 +28,26 @@
  */
 module gyrofx_mean_filter #(
     // input x: width and fraction bits (°/s)
-    parameter IN_W = 24,
-    parameter IN_F = 14,
+    parameter integer IN_W = 24,
+    parameter integer IN_F = 14,
     // output y: width and fraction bits
-    parameter OUT_W = 24,
-    parameter OUT_F = 14,
+    parameter integer OUT_W = 24,
+    parameter integer OUT_F = 14,
     // samples per block (2..1024) and the width of a count 0..WINDOW
-    parameter WINDOW = 20,
-    parameter COUNT_W = 5,
+    parameter integer WINDOW = 20,
+    parameter integer COUNT_W = 5,
     // exact block sum: IN_W + ceil(log2 WINDOW) bits
-    parameter SUM_W = 29,
+    parameter integer SUM_W = 29,
     // exact deviation WINDOW * s - sum: IN_W + COUNT_W + 1 bits, and WINDOW * r in input LSB
-    parameter DEV_W = 30,
+    parameter integer DEV_W = 30,
     parameter [DEV_W-1:0] SCALED_THRESHOLD = 30'd98300,
     // reciprocal codes 1/n: width and fraction bits
-    parameter RECIP_W = 18,
-    parameter RECIP_F = 16,
+    parameter integer RECIP_W = 18,
+    parameter integer RECIP_F = 16,
     // rounding: 0 floor, 1 ceil, 2 zero, 3 nearest, 4 round, 5 convergent
-    parameter ROUNDING = 3,
+    parameter integer ROUNDING = 3,
     // overflow: 0 wrap, 1 saturate
-    parameter SATURATE = 1,
+    parameter integer SATURATE = 1,
     // reciprocal ROM image for $readmemh: WINDOW + 1 words, address = kept count
     parameter ROM_FILE = "mean_filter_reciprocals.mem"
 ) (
@@ -60,7 +60,7 @@ module gyrofx_mean_filter #(
     output wire                    y_valid
 );
 
-localparam PRODUCT_W = SUM_W + RECIP_W;
+localparam integer PRODUCT_W = SUM_W + RECIP_W;
 
 initial begin
     if (WINDOW < 2 || (1 << COUNT_W) <= WINDOW) begin

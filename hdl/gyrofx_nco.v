@@ -32,11 +32,11 @@
  */
 module gyrofx_nco #(
     // phase accumulator, frequency word and offset width, bits (cycles, u PHASE_W.PHASE_W)
-    parameter PHASE_W = 32,
+    parameter integer PHASE_W = 32,
     // quarter-wave ROM address width: 2^ADDR_W words (PHASE_W >= ADDR_W + 2)
-    parameter ADDR_W = 10,
+    parameter integer ADDR_W = 10,
     // sine and cosine width, s SIN_W.SIN_W-1
-    parameter SIN_W = 18,
+    parameter integer SIN_W = 18,
     // quarter-wave sine ROM image for $readmemh
     parameter ROM_FILE = "nco_sine.mem"
 ) (
@@ -51,7 +51,7 @@ module gyrofx_nco #(
 );
 
 // Truncated phase: quadrant (2 bits) and ROM index.
-localparam T_W = ADDR_W + 2;
+localparam integer T_W = ADDR_W + 2;
 
 initial begin
     if (PHASE_W < T_W) begin

@@ -27,20 +27,20 @@
  */
 module gyrofx_pi #(
     // error input: width and fraction bits
-    parameter ERR_W = 24,
-    parameter ERR_F = 23,
+    parameter integer ERR_W = 24,
+    parameter integer ERR_F = 23,
     // kp: width and fraction bits
-    parameter KP_W = 18,
-    parameter KP_F = 26,
+    parameter integer KP_W = 18,
+    parameter integer KP_F = 26,
     // ki: width and fraction bits
-    parameter KI_W = 18,
-    parameter KI_F = 34,
+    parameter integer KI_W = 18,
+    parameter integer KI_F = 34,
     // integrator: width and fraction bits
-    parameter INT_W = 59,
-    parameter INT_F = 57,
+    parameter integer INT_W = 59,
+    parameter integer INT_F = 57,
     // output: width and fraction bits
-    parameter OUT_W = 32,
-    parameter OUT_F = 32,
+    parameter integer OUT_W = 32,
+    parameter integer OUT_F = 32,
     // kp and ki codes (the defaults: 2^-10 and 2^-18)
     parameter signed [KP_W-1:0] KP = 18'sd65536,
     parameter signed [KI_W-1:0] KI = 18'sd65536,
@@ -49,9 +49,9 @@ module gyrofx_pi #(
     parameter signed [INT_W-1:0] INT_MIN = 59'sd5044031582654956,
     parameter signed [INT_W-1:0] INT_MAX = 59'sd7205759403792794,
     // rounding: 0 floor, 1 ceil, 2 zero, 3 nearest, 4 round, 5 convergent
-    parameter ROUNDING = 3,
+    parameter integer ROUNDING = 3,
     // overflow at the output: 0 wrap, 1 saturate
-    parameter SATURATE = 1
+    parameter integer SATURATE = 1
 ) (
     input  wire                     clk,
     input  wire                     rst,
@@ -65,21 +65,21 @@ module gyrofx_pi #(
 
 // Integer bits (with sign) of each node; an exact sum has the finer fraction
 // and one integer bit more than the wider operand.
-localparam INT_I = INT_W - INT_F;
-localparam KIE_W = KI_W + ERR_W;
-localparam KIE_F = KI_F + ERR_F;
-localparam KIE_I = KIE_W - KIE_F;
-localparam UPD_F = INT_F > KIE_F ? INT_F : KIE_F;
-localparam UPD_I = (INT_I > KIE_I ? INT_I : KIE_I) + 1;
-localparam UPD_W = UPD_I + UPD_F;
+localparam integer INT_I = INT_W - INT_F;
+localparam integer KIE_W = KI_W + ERR_W;
+localparam integer KIE_F = KI_F + ERR_F;
+localparam integer KIE_I = KIE_W - KIE_F;
+localparam integer UPD_F = INT_F > KIE_F ? INT_F : KIE_F;
+localparam integer UPD_I = (INT_I > KIE_I ? INT_I : KIE_I) + 1;
+localparam integer UPD_W = UPD_I + UPD_F;
 // The rounded update before the clamp: one bit more than the sum's integer part.
-localparam RND_W = UPD_I + 1 + INT_F;
-localparam KPE_W = KP_W + ERR_W;
-localparam KPE_F = KP_F + ERR_F;
-localparam KPE_I = KPE_W - KPE_F;
-localparam SUM_F = INT_F > KPE_F ? INT_F : KPE_F;
-localparam SUM_I = (INT_I > KPE_I ? INT_I : KPE_I) + 1;
-localparam SUM_W = SUM_I + SUM_F;
+localparam integer RND_W = UPD_I + 1 + INT_F;
+localparam integer KPE_W = KP_W + ERR_W;
+localparam integer KPE_F = KP_F + ERR_F;
+localparam integer KPE_I = KPE_W - KPE_F;
+localparam integer SUM_F = INT_F > KPE_F ? INT_F : KPE_F;
+localparam integer SUM_I = (INT_I > KPE_I ? INT_I : KPE_I) + 1;
+localparam integer SUM_W = SUM_I + SUM_F;
 
 initial begin
     if (INT_MIN > INT_MAX) begin

@@ -25,17 +25,17 @@
  */
 module gyrofx_quantize #(
     // input word width, bits
-    parameter IN_W = 40,
+    parameter integer IN_W = 40,
     // input fraction bits
-    parameter IN_F = 20,
+    parameter integer IN_F = 20,
     // output word width, bits
-    parameter OUT_W = 24,
+    parameter integer OUT_W = 24,
     // output fraction bits (IN_F - IN_W < OUT_F <= IN_F)
-    parameter OUT_F = 10,
+    parameter integer OUT_F = 10,
     // rounding mode: 0 floor, 1 ceil, 2 zero, 3 nearest, 4 round, 5 convergent
-    parameter ROUNDING = 3,
+    parameter integer ROUNDING = 3,
     // overflow mode: 0 wrap, 1 saturate
-    parameter SATURATE = 1
+    parameter integer SATURATE = 1
 ) (
     input  wire signed [IN_W-1:0]  in,
     output wire signed [OUT_W-1:0] out,
@@ -43,9 +43,9 @@ module gyrofx_quantize #(
     output wire                    overflow
 );
 
-localparam SHIFT = IN_F - OUT_F;
+localparam integer SHIFT = IN_F - OUT_F;
 // Rounded quotient: the kept bits plus one bit for the increment.
-localparam Q_W = IN_W - SHIFT + 1;
+localparam integer Q_W = IN_W - SHIFT + 1;
 
 initial begin
     if (SHIFT < 0 || SHIFT >= IN_W) begin

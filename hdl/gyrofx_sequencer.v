@@ -25,18 +25,18 @@
  */
 module gyrofx_sequencer #(
     // L: samples per measurement interval
-    parameter INTERVAL_LENGTH = 150,
+    parameter integer INTERVAL_LENGTH = 150,
     // W: intervals per cycle
-    parameter INTERVALS = 4,
+    parameter integer INTERVALS = 4,
     // A's mode per interval, bit i for interval i: 1 = normal, 0 = reversed
     parameter [INTERVALS-1:0] PATTERN = 4'b0101,
     // M: blanked samples at the start of every interval
-    parameter BLANK = 10,
+    parameter integer BLANK = 10,
     // S: samples by which B runs behind A
-    parameter STAGGER = 0,
+    parameter integer STAGGER = 0,
     // width of the phase counter; width of an interval index, ceil(log2(INTERVALS))
-    parameter PHASE_W = 8,
-    parameter INTERVAL_W = 2
+    parameter integer PHASE_W = 8,
+    parameter integer INTERVAL_W = 2
 ) (
     input  wire                  clk,
     input  wire                  rst,
@@ -53,8 +53,8 @@ module gyrofx_sequencer #(
 );
 
 // B's position after reset: W*L - S (mod W*L).
-localparam B_START_INTERVAL = (STAGGER == 0) ? 0 : INTERVALS - 1;
-localparam B_START_PHASE = (STAGGER == 0) ? 0 : INTERVAL_LENGTH - STAGGER;
+localparam integer B_START_INTERVAL = (STAGGER == 0) ? 0 : INTERVALS - 1;
+localparam integer B_START_PHASE = (STAGGER == 0) ? 0 : INTERVAL_LENGTH - STAGGER;
 
 initial begin
     if (INTERVAL_LENGTH < 1 || INTERVALS < 2 || INTERVALS > 256) begin

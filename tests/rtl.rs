@@ -515,3 +515,43 @@ end architecture;
         }
     }
 }
+
+/// Every numeric parameter and every width localparam is `integer`-typed: an untyped one
+/// takes the signedness of the values given it, and a tool that sets them unsigned (yosys 0.23's
+/// `chparam`) then wraps a negative intermediate such as the KF's `P2_I = P2_W − P2_F`.
+#[test]
+fn numeric_parameters_and_localparams_are_integer_typed() {
+    let untyped = untyped_declaration();
+    let mut found = Vec::new();
+    for (name, source) in gyrofx_codegen::hdl::RTL_SOURCES {
+        if !name.ends_with(".v") {
+            continue;
+        }
+        for (number, line) in source.lines().enumerate() {
+            if untyped(line) {
+                found.push(format!("{name}:{}: {}", number + 1, line.trim()));
+            }
+        }
+    }
+    assert!(found.is_empty(), "untyped:\n{}", found.join("\n"));
+}
+
+/// Whether a line declares a `parameter`/`localparam` with no type or range before its name,
+/// given a number or an expression (string parameters name files and stay untyped).
+fn untyped_declaration() -> impl Fn(&str) -> bool {
+    |line: &str| {
+        let line = line.trim_start();
+        let rest = match line
+            .strip_prefix("localparam ")
+            .or_else(|| line.strip_prefix("parameter "))
+        {
+            Some(rest) => rest.trim_start(),
+            None => return false,
+        };
+        let typed = ["integer ", "signed ", "[", "real "]
+            .iter()
+            .any(|t| rest.starts_with(t));
+        let value = rest.split_once('=').map(|(_, v)| v.trim_start());
+        !typed && value.is_some_and(|v| !v.starts_with('"'))
+    }
+}

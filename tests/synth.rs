@@ -127,3 +127,149 @@ fn the_chain_synthesizes_and_wider_formats_cost_more_and_latches_fail() {
     assert!(error.contains("kf.coefficient_width"), "{error}");
     assert!(!none.exists());
 }
+
+fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let entry = entry.unwrap();
+        let target = to.join(entry.file_name());
+        if entry.file_type().unwrap().is_dir() {
+            copy_tree(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), target).unwrap();
+        }
+    }
+}
+
+fn flip_flops(generic_json: &Path) -> u64 {
+    let text = std::fs::read_to_string(generic_json).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let module = json["modules"]
+        .as_object()
+        .unwrap()
+        .values()
+        .next()
+        .unwrap();
+    module["num_cells_by_type"]
+        .as_object()
+        .unwrap()
+        .iter()
+        .filter(|(k, _)| k.contains("DFF"))
+        .map(|(_, v)| v.as_u64().unwrap())
+        .sum()
+}
+
+/// The synthesized netlists run the package's testbenches bit-exact in Icarus and Verilator;
+/// the `chparam` script on RTL whose parameters and width localparams are untyped (what `synth`
+/// did before)
+/// gives a netlist that fails them.
+#[test]
+fn netlists_pass_the_vectors_and_chparam_on_untyped_localparams_fails_them() {
+    use gyrofx_codegen::synth::{generic_script, Parameters};
+
+    let dir = tempfile::tempdir().unwrap();
+    // chparam's widths keep `P2_I + 1` integer bits of x2's update, P2_I = P2_W − P2_F < 0:
+    // x2 = (g2/S)·y must pass 2^P2_I. A 0.2 Hz entry (g2 in s18.31, P2_I = −1, g2/S = 6·10⁻³)
+    // at 300 °/s does; the default (P2_I = −8, g2/S ≈ 10⁻⁶) never does at any rate in range.
+    let config = write_config(
+        dir.path(),
+        "slow.toml",
+        "[stimulus]\nrate_dps = 300.0\n[kf]\nbandwidths_hz = [0.2, 10.0, 20.0]\n",
+    );
+    let synth = dir.path().join("synth");
+    ok(&[
+        "synth",
+        "--out",
+        synth.to_str().unwrap(),
+        "--config",
+        &config,
+    ]);
+    // Another stimulus length: the netlists depend on the formats and coefficients only.
+    let package = dir.path().join("pkg");
+    ok(&[
+        "generate",
+        "--out",
+        package.to_str().unwrap(),
+        "--samples",
+        "3000",
+        "--config",
+        &config,
+    ]);
+    let (pkg, syn) = (package.to_str().unwrap(), synth.to_str().unwrap());
+    let log = ok(&[
+        "verify",
+        "--out",
+        pkg,
+        "--netlist",
+        syn,
+        "--sim",
+        "iverilog,verilator",
+        "--blocks",
+        "top",
+        "--quiet",
+    ]);
+    assert_eq!(log.matches("PASS n=3001").count(), 2, "{log}");
+    // The loop's netlist (80 000 cells) in Verilator: 40 000 closed-loop samples.
+    let log = ok(&[
+        "verify",
+        "--out",
+        pkg,
+        "--netlist",
+        syn,
+        "--sim",
+        "verilator",
+        "--blocks",
+        "gyro_loop",
+        "--quiet",
+    ]);
+    assert!(log.contains("PASS n=40000"), "{log}");
+    // GHDL has no netlist to run.
+    let error = fails(&["verify", "--out", pkg, "--netlist", syn, "--sim", "ghdl"]);
+    assert!(error.contains("--sim ghdl is not allowed"), "{error}");
+
+    // The old way: chparam on the module, and parameters and localparams without a type.
+    let old = dir.path().join("chparam");
+    copy_tree(&synth, &old);
+    for entry in std::fs::read_dir(&old).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "v") {
+            let source = std::fs::read_to_string(&path).unwrap();
+            let untyped = source
+                .replace("localparam integer ", "localparam ")
+                .replace("parameter integer ", "parameter ");
+            std::fs::write(&path, untyped).unwrap();
+        }
+    }
+    let params: Vec<(String, String)> = manifest(&synth)["parameters"]
+        .as_object()
+        .unwrap()
+        .iter()
+        .map(|(k, v)| (k.clone(), v.as_str().unwrap().to_string()))
+        .collect();
+    std::fs::write(
+        old.join("generic.ys"),
+        generic_script("gyrofx_top", &params, Parameters::Chparam),
+    )
+    .unwrap();
+    let (passed, log) = run_tool("yosys", &["-q", "-s", "generic.ys"], &old);
+    assert!(passed, "{log}");
+    // chparam's unsigned values wrap P2_I and x2 loses flip-flops.
+    let (kept, cut) = (
+        flip_flops(&synth.join("yosys/generic.json")),
+        flip_flops(&old.join("generic.json")),
+    );
+    assert!(cut < kept, "chparam: {cut} flip-flops, the wrapper: {kept}");
+    let error = fails(&[
+        "verify",
+        "--out",
+        pkg,
+        "--netlist",
+        old.to_str().unwrap(),
+        "--sim",
+        "verilator",
+        "--blocks",
+        "top",
+        "--quiet",
+    ]);
+    assert!(error.contains("FAIL mismatches="), "{error}");
+}

@@ -81,6 +81,9 @@ pub struct Options {
     pub waves: bool,
     /// Only these blocks (all when `None`).
     pub blocks: Option<Vec<String>>,
+    /// A `gyrofx synth` folder whose gate-level netlists replace the RTL of the blocks it
+    /// synthesized (only those blocks run; Icarus and Verilator only).
+    pub netlist: Option<std::path::PathBuf>,
 }
 
 impl Default for Options {
@@ -91,6 +94,7 @@ impl Default for Options {
             max_mismatches: 0,
             waves: false,
             blocks: None,
+            netlist: None,
         }
     }
 }
@@ -181,6 +185,10 @@ pub fn run(out: &Path, simulator: Simulator, options: &Options) -> Result<Outcom
 /// [`Error::Simulation`] when the folder is not a package or names a block it lacks.
 pub fn block_names(out: &Path, simulator: Simulator, options: &Options) -> Result<Vec<String>> {
     let mut names = blocks(out, simulator)?;
+    if let Some(folder) = &options.netlist {
+        let netlists = Netlists::read(folder, out, simulator)?;
+        names.retain(|n| netlists.files.iter().any(|(block, _)| block == n));
+    }
     if let Some(wanted) = &options.blocks {
         if let Some(unknown) = wanted.iter().find(|w| !names.contains(w)) {
             return Err(Error::Simulation(format!(
@@ -227,10 +235,18 @@ pub fn run_reporting(
             )));
         }
     }
+    let netlists = match &options.netlist {
+        Some(folder) => Some(Netlists::read(folder, out, simulator)?),
+        None => None,
+    };
     let mut blocks = Vec::with_capacity(names.len());
     for block in names {
         let start = Instant::now();
-        let output = Command::new("make")
+        let mut make = Command::new("make");
+        if let Some(netlists) = &netlists {
+            make.args(netlists.make_variables(&block, simulator));
+        }
+        let output = make
             .arg("--no-print-directory")
             .arg("-C")
             .arg(out)
@@ -261,4 +277,132 @@ pub fn run_reporting(
         blocks.push(outcome);
     }
     Ok(Outcome { simulator, blocks })
+}
+
+/// The gate-level netlists of a `gyrofx synth` folder, by the package block they replace.
+#[derive(Clone, Debug)]
+struct Netlists {
+    /// (block, absolute paths of its netlist files: the shell, then the netlist).
+    files: Vec<(String, Vec<std::path::PathBuf>)>,
+}
+
+/// Verilator's options for a netlist. `-fno-const-bit-op-tree` keeps 5.006 from miscompiling
+/// yosys netlists: its bit-op-tree optimization gives wrong results on gate-level XOR/AND trees
+/// (verilator issue #4059; the netlist passes with it off, as it does with `-O0` and in Icarus).
+/// The C++ is compiled at `-O0`: for a gate-level netlist the compile dominates (the loop's
+/// 80 000 cells: 6 min at Verilator's default, under 2 min at `-O0`; its 40 000 samples then run
+/// in seconds).
+pub const VERILATOR_NETLIST_OPTIONS: &str = "-fno-const-bit-op-tree -MAKEFLAGS OPT_FAST=-O0 -MAKEFLAGS OPT_SLOW=-O0 -MAKEFLAGS OPT_GLOBAL=-O0";
+
+/// A ROM image's words: its lines other than comments (whose provenance names the command).
+fn rom_words(path: &Path) -> Result<Vec<String>> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    Ok(text
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && !l.starts_with("//"))
+        .map(str::to_string)
+        .collect())
+}
+
+/// Refuses a netlist whose ROM images (baked into its gates) differ from the package block's.
+fn same_roms(design: &Path, block_folder: &Path, block: &str) -> Result<()> {
+    let entries = std::fs::read_dir(design).map_err(|e| Error::io(design, e))?;
+    let mut names: Vec<std::ffi::OsString> = entries
+        .filter_map(|e| e.ok().map(|e| e.file_name()))
+        .filter(|n| n.to_string_lossy().ends_with(".mem"))
+        .collect();
+    names.sort();
+    for name in names {
+        let packaged = block_folder.join(&name);
+        if !packaged.is_file() {
+            continue;
+        }
+        if rom_words(&design.join(&name))? != rom_words(&packaged)? {
+            return Err(Error::Simulation(format!(
+                "the ROM image {} differs between the netlist ({}) and the package's {block} block ({}): synthesize and generate from the same formats and coefficients",
+                name.to_string_lossy(),
+                design.display(),
+                block_folder.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+fn read_manifest(folder: &Path, what: &str) -> Result<serde_json::Value> {
+    let path = folder.join(crate::package::MANIFEST);
+    let text = std::fs::read_to_string(&path).map_err(|e| {
+        Error::Simulation(format!(
+            "{} is not {what} (no readable {}: {e})",
+            folder.display(),
+            path.display()
+        ))
+    })?;
+    serde_json::from_str(&text)
+        .map_err(|e| Error::Simulation(format!("{} is not JSON: {e}", path.display())))
+}
+
+impl Netlists {
+    /// The netlists of the synthesis folder `folder`, checked against the package `out`: the
+    /// same ROM contents (the config may differ elsewhere, e.g. in the stimulus; the netlist's
+    /// shell refuses other parameter values when the simulation starts) and a simulator that
+    /// runs the Verilog testbenches.
+    fn read(folder: &Path, out: &Path, simulator: Simulator) -> Result<Netlists> {
+        if !matches!(simulator, Simulator::Icarus | Simulator::Verilator) {
+            return Err(Error::Simulation(format!(
+                "--netlist runs the Verilog testbenches on the netlists: --sim {} is not allowed; use iverilog and/or verilator",
+                simulator.name()
+            )));
+        }
+        let synth = read_manifest(folder, "a `gyrofx synth` folder")?;
+        let netlists = synth["netlists"].as_array().ok_or_else(|| {
+            Error::Simulation(format!(
+                "{} holds no netlists: run gyrofx synth --out {} with this gyrofx",
+                folder.display(),
+                folder.display()
+            ))
+        })?;
+        let folder = std::path::absolute(folder).map_err(|e| Error::io(folder, e))?;
+        let mut files = Vec::new();
+        for netlist in netlists {
+            let block = netlist["block"].as_str().unwrap_or_default().to_string();
+            let paths: Vec<std::path::PathBuf> = netlist["files"]
+                .as_array()
+                .into_iter()
+                .flatten()
+                .filter_map(|f| f.as_str())
+                .map(|f| folder.join(f))
+                .collect();
+            if let Some(missing) = paths.iter().find(|p| !p.is_file()) {
+                return Err(Error::Simulation(format!(
+                    "{} lists the netlist {}, which is missing",
+                    folder.join(crate::package::MANIFEST).display(),
+                    missing.display()
+                )));
+            }
+            let design = paths
+                .first()
+                .and_then(|shell| shell.parent())
+                .and_then(Path::parent)
+                .unwrap_or(&folder);
+            same_roms(design, &out.join(&block), &block)?;
+            files.push((block, paths));
+        }
+        Ok(Netlists { files })
+    }
+
+    /// The Makefile variables that build `block`'s testbench on its netlist.
+    fn make_variables(&self, block: &str, simulator: Simulator) -> Vec<String> {
+        let Some((_, paths)) = self.files.iter().find(|(b, _)| b == block) else {
+            return Vec::new();
+        };
+        let rtl: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+        let mut variables = vec![format!("RTL={}", rtl.join(" "))];
+        if simulator == Simulator::Verilator {
+            let verilator = std::env::var("VERILATOR").unwrap_or_else(|_| "verilator".into());
+            variables.push(format!("VERILATOR={verilator} {VERILATOR_NETLIST_OPTIONS}"));
+        }
+        variables
+    }
 }

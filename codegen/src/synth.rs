@@ -67,58 +67,243 @@ pub struct Resources {
     pub xilinx: Xilinx,
 }
 
-/// The `chparam` lines that give the block's module its parameters.
-fn chparams(block: &Block) -> String {
-    block
+/// How the job's parameters reach the synthesized module.
+///
+/// yosys 0.23's `chparam` makes the values it sets unsigned, so width arithmetic with a negative
+/// intermediate (`P2_I = P2_W − P2_F` in the KF) wraps and the netlist no longer matches the RTL.
+/// An instance in a generated wrapper passes them as the simulators do.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Parameters {
+    /// An instance with the parameters in [`configured_module`] (the only passing `synth` uses).
+    #[default]
+    Instance,
+    /// `chparam -set` on the module itself: kept so that a test can show the netlist check
+    /// catching what it did.
+    Chparam,
+}
+
+/// The module name of a block's wrapper: the block's module with the job's parameters.
+pub fn configured_name(block: &Block) -> String {
+    format!("{}_configured", block.module)
+}
+
+/// The name the synthesized netlist's module gets, under the shell named like the RTL module.
+fn netlist_name(block: &Block) -> String {
+    format!("{}_netlist", block.module)
+}
+
+/// A port declaration of one of the block's signals.
+fn port(direction: &str, signal: &crate::block::Signal) -> String {
+    let signed = if signal.format.signed { "signed " } else { "" };
+    let range = if signal.format.width > 1 {
+        format!("[{}:0] ", signal.format.width - 1)
+    } else {
+        String::new()
+    };
+    format!("    {direction} wire {signed}{range}{}", signal.name)
+}
+
+/// Every port of the block: `clk`, `rst`, `ce`, its inputs, its outputs.
+fn ports(block: &Block) -> Vec<String> {
+    let mut ports: Vec<String> = ["clk", "rst", "ce"]
+        .iter()
+        .map(|name| format!("    input wire {name}"))
+        .collect();
+    ports.extend(block.inputs.iter().map(|s| port("input", s)));
+    ports.extend(block.outputs.iter().map(|o| port("output", &o.signal)));
+    ports
+}
+
+/// Each port connected to the signal of its name.
+fn connections(block: &Block) -> String {
+    let mut names = vec!["clk", "rst", "ce"];
+    names.extend(block.inputs.iter().map(|s| s.name));
+    names.extend(block.outputs.iter().map(|o| o.signal.name));
+    names
+        .iter()
+        .map(|name| format!("    .{name}({name})"))
+        .collect::<Vec<_>>()
+        .join(",\n")
+}
+
+/// The wrapper synthesized instead of the block's module: the module instantiated with the
+/// job's parameters, as the testbenches instantiate it.
+pub fn configured_module(block: &Block) -> String {
+    let params: Vec<String> = block
         .params
         .iter()
-        .map(|p| format!("chparam -set {} {} {}\n", p.name, p.value, block.module))
+        .map(|p| format!("    .{}({})", p.name, p.value))
+        .collect();
+    format!(
+        "`default_nettype none\n\
+         // {module} with the job's parameters, passed on an instance (not chparam: see\n\
+         // gyrofx's synth docs) so that yosys computes every width as the simulators do.\n\
+         module {name} (\n{ports}\n);\n\
+         {module} #(\n{params}\n) configured (\n{connections}\n);\n\
+         endmodule\n\
+         `default_nettype wire\n",
+        module = block.module,
+        name = configured_name(block),
+        ports = ports(block).join(",\n"),
+        params = params.join(",\n"),
+        connections = connections(block),
+    )
+}
+
+/// The netlist file's first module: named like the RTL module, with its parameters (defaults:
+/// the job's values), so the package's testbench instantiates it unchanged. The netlist was
+/// synthesized for those values only: any other integer or bit-vector value stops the
+/// simulation at time 0 (string parameters name ROM images, whose contents the netlist holds).
+pub fn netlist_shell(block: &Block) -> String {
+    let declarations: Vec<String> = block
+        .params
+        .iter()
+        .map(|p| {
+            let kind = if p.kind.is_empty() {
+                String::new()
+            } else {
+                format!("{} ", p.kind)
+            };
+            format!("    parameter {kind}{} = {}", p.name, p.value)
+        })
+        .collect();
+    let checks: String = block
+        .params
+        .iter()
+        .filter(|p| !p.kind.is_empty())
+        .map(|p| {
+            format!(
+                "    if ({name} != {value}) begin\n\
+                 \x20       $display(\"{module} netlist: parameter {name} is %0d; it was synthesized with {value}\", {name});\n\
+                 \x20       $fatal(1);\n\
+                 \x20   end\n",
+                name = p.name,
+                value = p.value,
+                module = block.module,
+            )
+        })
+        .collect();
+    format!(
+        "`timescale 1ns / 1ps\n\
+         `default_nettype none\n\
+         // {module}: the synthesized netlist ({netlist}, below) behind the RTL module's ports and\n\
+         // parameters.\n\
+         module {module} #(\n{declarations}\n) (\n{ports}\n);\n\
+         initial begin\n{checks}end\n\
+         {netlist} netlist (\n{connections}\n);\n\
+         endmodule\n\
+         `default_nettype wire\n",
+        module = block.module,
+        netlist = netlist_name(block),
+        declarations = declarations.join(",\n"),
+        ports = ports(block).join(",\n"),
+        connections = connections(block),
+    )
+}
+
+/// The `chparam` lines that give `module` its parameters ([`Parameters::Chparam`]).
+fn chparams(module: &str, params: &[(String, String)]) -> String {
+    params
+        .iter()
+        .map(|(name, value)| format!("chparam -set {name} {value} {module}\n"))
         .collect()
 }
 
 /// The RTL of the block's module: its file and its submodules' (for the chain, not the mean
 /// filter beside it: yosys would load its ROM image while reading it).
-fn sources(block: &Block) -> Vec<&'static (&'static str, &'static str)> {
-    hdl::verilog_sources_of(block.module)
+fn sources(module: &str) -> Vec<&'static (&'static str, &'static str)> {
+    hdl::verilog_sources_of(module)
 }
 
-fn read_sources(block: &Block) -> String {
-    let names: Vec<&str> = sources(block).iter().map(|(n, _)| *n).collect();
-    format!("read_verilog {}\n", names.join(" "))
+/// The file holding [`configured_module`].
+const CONFIGURED_FILE: &str = "configured.v";
+
+/// The folder of a design's netlist: `<module>.v`, the shell ([`netlist_shell`]), and
+/// `<module>_netlist.v`, yosys's gate-level netlist (plain Verilog: gates as expressions,
+/// flip-flops as `always` blocks).
+pub const NETLIST_FOLDER: &str = "netlist";
+
+/// The two files of a design's netlist, relative to its synthesis folder: the shell, then the
+/// netlist.
+pub fn netlist_files(module: &str) -> [String; 2] {
+    [
+        format!("{NETLIST_FOLDER}/{module}.v"),
+        format!("{NETLIST_FOLDER}/{module}_netlist.v"),
+    ]
 }
 
-/// The yosys script of the generic flow for the block's module; writes `coarse.json` and
-/// `generic.json`.
-pub fn generic_script(top: &Block) -> String {
-    let module = top.module;
+/// The script's first lines: read the RTL and elaborate `module` with `params` (name, Verilog
+/// value) passed as `parameters` says; then the synthesized design's top (returned).
+fn elaborate(
+    module: &str,
+    params: &[(String, String)],
+    parameters: Parameters,
+) -> (String, String) {
+    let names: Vec<&str> = sources(module).iter().map(|(n, _)| *n).collect();
+    match parameters {
+        Parameters::Instance => {
+            let top = format!("{module}_configured");
+            (
+                format!(
+                    "read_verilog {} {CONFIGURED_FILE}\nhierarchy -check -top {top}\n",
+                    names.join(" ")
+                ),
+                top,
+            )
+        }
+        Parameters::Chparam => (
+            format!(
+                "read_verilog {}\n{}hierarchy -check -top {module}\n",
+                names.join(" "),
+                chparams(module, params),
+            ),
+            module.to_string(),
+        ),
+    }
+}
+
+/// The yosys script of the generic flow for `module` with `params` (name, Verilog value);
+/// writes `coarse.json`, `generic.json` and the gate-level netlist
+/// (`netlist/<module>_netlist.v`, [`netlist_files`]).
+pub fn generic_script(module: &str, params: &[(String, String)], parameters: Parameters) -> String {
+    let (elaborate, top) = elaborate(module, params, parameters);
+    let [_, netlist] = netlist_files(module);
     format!(
-        "{}{}hierarchy -check -top {module}\n\
-         synth -flatten -top {module} -run :coarse\n\
+        "{elaborate}\
+         synth -flatten -top {top} -run :coarse\n\
          flatten\nproc\n\
          select -assert-none t:$dlatch t:$adlatch t:$dlatchsr\n\
          opt -fast\nwreduce\n\
          tee -q -o coarse.json stat -json\n\
-         synth -flatten -top {module} -run coarse:\n\
+         synth -flatten -top {top} -run coarse:\n\
          select -assert-none t:$dlatch t:$adlatch t:$_DLATCH_*\n\
          check -assert\n\
-         tee -q -o generic.json stat -json\n",
-        read_sources(top),
-        chparams(top)
+         tee -q -o generic.json stat -json\n\
+         rename {top} {module}_netlist\n\
+         write_verilog -noattr {netlist}\n",
     )
 }
 
-/// The yosys script of the Xilinx 7-series flow for the block's module; writes `xilinx.json`.
-pub fn xilinx_script(top: &Block) -> String {
-    let module = top.module;
+/// The yosys script of the Xilinx 7-series flow for `module` with `params`; writes
+/// `xilinx.json`.
+pub fn xilinx_script(module: &str, params: &[(String, String)], parameters: Parameters) -> String {
+    let (elaborate, top) = elaborate(module, params, parameters);
     format!(
-        "{}{}hierarchy -check -top {module}\n\
-         synth_xilinx -flatten -top {module}\n\
+        "{elaborate}\
+         synth_xilinx -flatten -top {top}\n\
          select -assert-none t:LDCE t:LDPE\n\
          check -assert\n\
-         tee -q -o xilinx.json stat -json\n",
-        read_sources(top),
-        chparams(top)
+         tee -q -o xilinx.json stat -json\n"
     )
+}
+
+/// The block's parameters as (name, Verilog value).
+pub fn parameter_values(block: &Block) -> Vec<(String, String)> {
+    block
+        .params
+        .iter()
+        .map(|p| (p.name.clone(), p.value.clone()))
+        .collect()
 }
 
 /// Cell counts of the one (flattened) module in a `stat -json` file.
@@ -207,8 +392,10 @@ fn report_section(top: &Block, resources: &Resources) -> String {
         .map(|p| format!("{}={}", p.name, p.value))
         .collect();
     format!(
-        "yosys, flattened, with the config's parameters ({}).\n\
-         Checks passed: every module present, no latch, no undriven or multiply-driven net.\n\n\
+        "yosys, flattened, with the config's parameters ({}), passed on an instance in `{CONFIGURED_FILE}`.\n\
+         Checks passed: every module present, no latch, no undriven or multiply-driven net.\n\
+         Gate-level netlist: `{NETLIST_FOLDER}/` (`gyrofx verify --out <package> --netlist <this folder>` \
+         runs the package's testbench on it).\n\n\
          | generic | count |\n|---|---|\n| cells | {} |\n| flip-flops | {} |\n| multipliers | {} |\n\n\
          | Xilinx 7-series (`synth_xilinx`) | count |\n|---|---|\n| LUTs | {} |\n| flip-flops | {} |\n\
          | DSP48E1 | {} |\n| block RAM | {} |\n| CARRY4 | {} |\n",
@@ -253,8 +440,8 @@ pub struct Synthesis {
 }
 
 /// One design's inputs (RTL, ROM images, both scripts) by file name.
-fn inputs(top: &Block) -> Vec<(String, String)> {
-    let mut inputs: Vec<(String, String)> = sources(top)
+fn inputs(top: &Block, parameters: Parameters) -> Vec<(String, String)> {
+    let mut inputs: Vec<(String, String)> = sources(top.module)
         .into_iter()
         .map(|(n, s)| (n.to_string(), s.to_string()))
         .collect();
@@ -272,14 +459,27 @@ fn inputs(top: &Block) -> Vec<(String, String)> {
         inputs.push(("nco_sine.mem".into(), image("gyro_loop_nco_sine")));
         inputs.push(("cic_taps.mem".into(), image("gyro_loop_cic_taps")));
     }
-    inputs.push(("generic.ys".into(), generic_script(top)));
-    inputs.push(("xilinx.ys".into(), xilinx_script(top)));
+    if parameters == Parameters::Instance {
+        inputs.push((CONFIGURED_FILE.into(), configured_module(top)));
+    }
+    let [shell, _] = netlist_files(top.module);
+    inputs.push((shell, netlist_shell(top)));
+    let params = parameter_values(top);
+    inputs.push((
+        "generic.ys".into(),
+        generic_script(top.module, &params, parameters),
+    ));
+    inputs.push((
+        "xilinx.ys".into(),
+        xilinx_script(top.module, &params, parameters),
+    ));
     inputs
 }
 
 /// Writes `inputs` into `dir` and runs both flows there.
 fn run_in(dir: &Path, inputs: &[(String, String)]) -> Result<Resources> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    let netlists = dir.join(NETLIST_FOLDER);
+    std::fs::create_dir_all(&netlists).map_err(|e| Error::io(&netlists, e))?;
     for (name, text) in inputs {
         let path = dir.join(name);
         std::fs::write(&path, text).map_err(|e| Error::io(&path, e))?;
@@ -287,14 +487,19 @@ fn run_in(dir: &Path, inputs: &[(String, String)]) -> Result<Resources> {
     measure(dir)
 }
 
-/// Adds a design's inputs, report files and yosys outputs under `prefix` (`""` or
+/// Adds a design's inputs, report files, yosys outputs and netlist under `prefix` (`""` or
 /// `"gyro_loop/"`).
 fn add_design(
     package: &mut Package,
     prefix: &str,
     work: &Path,
+    block: &Block,
     inputs: &[(String, String)],
 ) -> Result<()> {
+    let [_, netlist] = netlist_files(block.module);
+    let path = work.join(&netlist);
+    let data = std::fs::read(&path).map_err(|e| Error::io(&path, e))?;
+    package.add(format!("{prefix}{netlist}"), data);
     for (name, text) in inputs {
         package.add(format!("{prefix}{name}"), text.as_str());
     }
@@ -325,12 +530,27 @@ pub fn synthesize(
     replace: Replace,
     provenance: &Provenance,
 ) -> Result<Synthesis> {
+    synthesize_with(job, out, replace, provenance, Parameters::Instance)
+}
+
+/// [`synthesize`] with the parameters passed as `parameters` says (only tests pass
+/// [`Parameters::Chparam`]).
+///
+/// # Errors
+/// Those of [`synthesize`].
+pub fn synthesize_with(
+    job: &Job,
+    out: &Path,
+    replace: Replace,
+    provenance: &Provenance,
+    parameters: Parameters,
+) -> Result<Synthesis> {
     output_folder::check(out, Kind::Synth, replace)?;
     let roms = RomImages::new(job, provenance);
     let top = blocks::find(TOP_BLOCK).block(job, &roms);
     let gyro_loop = blocks::find(LOOP_BLOCK).block(job, &roms);
-    let chain_inputs = inputs(&top);
-    let loop_inputs = inputs(&gyro_loop);
+    let chain_inputs = inputs(&top, parameters);
+    let loop_inputs = inputs(&gyro_loop, parameters);
 
     let work = tempfile::tempdir().map_err(|e| Error::io(Path::new("temporary folder"), e))?;
     let loop_work = work.path().join(LOOP_FOLDER);
@@ -350,18 +570,17 @@ pub fn synthesize(
         "report.md",
         report(&top, &gyro_loop, &synthesis, provenance),
     );
-    add_design(&mut package, "", work.path(), &chain_inputs)?;
+    add_design(&mut package, "", work.path(), &top, &chain_inputs)?;
     add_design(
         &mut package,
         &format!("{LOOP_FOLDER}/"),
         &loop_work,
+        &gyro_loop,
         &loop_inputs,
     )?;
-    let parameters = |block: &Block| {
-        block
-            .params
-            .iter()
-            .map(|p| (p.name.clone(), p.value.clone()))
+    let parameters_of = |block: &Block| {
+        parameter_values(block)
+            .into_iter()
             .collect::<std::collections::BTreeMap<_, _>>()
     };
     let manifest = serde_json::json!({
@@ -370,15 +589,24 @@ pub fn synthesize(
         "config_sha256": provenance.config_sha256,
         "config": job.config,
         "top": TOP,
-        "parameters": parameters(&top),
+        "parameters": parameters_of(&top),
         "resources": synthesis.chain,
         "gyro_loop": {
             "top": LOOP_TOP,
             "gyro": "a",
             "folder": LOOP_FOLDER,
-            "parameters": parameters(&gyro_loop),
+            "parameters": parameters_of(&gyro_loop),
             "resources": synthesis.gyro_loop,
         },
+        "parameter_passing": match parameters {
+            Parameters::Instance => "instance",
+            Parameters::Chparam => "chparam",
+        },
+        "netlists": [
+            {"block": TOP_BLOCK, "module": TOP, "files": netlist_files(TOP)},
+            {"block": LOOP_BLOCK, "module": LOOP_TOP, "files": netlist_files(LOOP_TOP).map(|f| format!("{LOOP_FOLDER}/{f}"))},
+        ],
+        "netlist_cells": "yosys's internal gate library: simulate with its simcells.v",
         "files": package.entries(),
     });
     let mut text = serde_json::to_string_pretty(&manifest).expect("manifest serializes");
@@ -386,4 +614,70 @@ pub fn synthesize(
     package.add(crate::package::MANIFEST, text);
     package.write_atomically(out, replace)?;
     Ok(synthesis)
+}
+
+/// A design [`cost`] synthesizes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Design {
+    /// `gyrofx_top`: sequencer, estimator, calibration, KF.
+    Chain,
+    /// `gyrofx_gyro_loop` with gyro A's parameters.
+    GyroLoop,
+}
+
+/// The inputs of one design of `job` (RTL, ROM images, wrapper, shell, scripts) by file name.
+/// ROM images carry a provenance comment that [`cache_key`] leaves out.
+pub fn design_inputs(job: &Job, design: Design) -> Vec<(String, String)> {
+    let provenance = Provenance {
+        version: env!("CARGO_PKG_VERSION").to_string(),
+        command: "gyrofx explore".to_string(),
+        config_sha256: "0".repeat(64),
+    };
+    let roms = RomImages::new(job, &provenance);
+    let name = match design {
+        Design::Chain => TOP_BLOCK,
+        Design::GyroLoop => LOOP_BLOCK,
+    };
+    inputs(&blocks::find(name).block(job, &roms), Parameters::Instance)
+}
+
+/// What identifies a synthesis result: the SHA-256 (hex) of every input file's name and
+/// content, comment lines left out (two jobs with the same RTL, parameters and ROM words get the
+/// same key), and the yosys version it runs.
+pub fn cache_key(inputs: &[(String, String)]) -> String {
+    let mut text = String::new();
+    text.push_str(&yosys_version());
+    let mut sorted: Vec<&(String, String)> = inputs.iter().collect();
+    sorted.sort();
+    for (name, content) in sorted {
+        text.push_str(name);
+        text.push('\n');
+        for line in content
+            .lines()
+            .filter(|l| !l.trim_start().starts_with("//"))
+        {
+            text.push_str(line);
+            text.push('\n');
+        }
+    }
+    crate::package::sha256_hex(text.as_bytes())
+}
+
+/// `yosys -V`, or empty when yosys is missing (the synthesis then fails with its own error).
+fn yosys_version() -> String {
+    Command::new("yosys")
+        .arg("-V")
+        .output()
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+        .unwrap_or_default()
+}
+
+/// Synthesizes `inputs` ([`design_inputs`]) in a temporary folder, removed afterwards, and
+/// returns what both flows measured.
+///
+/// # Errors
+/// Those of [`measure`].
+pub fn cost(inputs: &[(String, String)]) -> Result<Resources> {
+    let work = tempfile::tempdir().map_err(|e| Error::io(Path::new("temporary folder"), e))?;
+    run_in(work.path(), inputs)
 }

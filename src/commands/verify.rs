@@ -41,6 +41,11 @@ pub struct Args {
     /// Write a JUnit XML summary here (one testsuite per simulator, one testcase per block).
     #[arg(long)]
     junit: Option<PathBuf>,
+    /// A `gyrofx synth` folder (same config): run the testbenches of the blocks it synthesized
+    /// (top, gyro_loop) on its gate-level netlists instead of the RTL, in iverilog and/or
+    /// verilator.
+    #[arg(long, value_name = "SYNTH_DIR")]
+    netlist: Option<PathBuf>,
 }
 
 /// Runs every block's testbench in each simulator, prints the mismatches and a verdict per
@@ -56,6 +61,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
         blocks,
         quiet,
         junit: junit_path,
+        netlist,
     } = args;
     let options = simulate::Options {
         mask,
@@ -63,6 +69,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
         max_mismatches,
         waves,
         blocks,
+        netlist,
     };
     let simulators: Vec<Simulator> = if sim == "all" {
         Simulator::ALL.to_vec()
