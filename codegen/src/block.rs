@@ -251,6 +251,27 @@ pub struct Block {
 }
 
 impl Block {
+    /// Its Verilog port declarations, one per line, indented: `clk`, `rst`, `ce`, the inputs,
+    /// the outputs (a wrapper or shell around the module declares these).
+    pub fn port_declarations(&self) -> Vec<String> {
+        let port = |direction: &str, signal: &Signal| {
+            let signed = if signal.format.signed { "signed " } else { "" };
+            let range = if signal.format.width > 1 {
+                format!("[{}:0] ", signal.format.width - 1)
+            } else {
+                String::new()
+            };
+            format!("    {direction} wire {signed}{range}{}", signal.name)
+        };
+        let mut ports: Vec<String> = ["clk", "rst", "ce"]
+            .iter()
+            .map(|name| format!("    input wire {name}"))
+            .collect();
+        ports.extend(self.inputs.iter().map(|s| port("input", s)));
+        ports.extend(self.outputs.iter().map(|o| port("output", &o.signal)));
+        ports
+    }
+
     /// An empty block.
     pub fn new(
         name: &'static str,

@@ -10,7 +10,7 @@
 
 use std::fmt::Write as _;
 
-use crate::block::{Block, Signal};
+use crate::block::Block;
 use crate::hdl::RTL_SOURCES;
 use crate::testbench::verilog::instance;
 use crate::writers::Provenance;
@@ -68,26 +68,10 @@ pub fn files(blocks: &[Block], provenance: &Provenance) -> Vec<(String, String)>
     files
 }
 
-fn port(direction: &str, signal: &Signal) -> String {
-    let signed = if signal.format.signed { "signed " } else { "" };
-    let range = if signal.format.width > 1 {
-        format!("[{}:0] ", signal.format.width - 1)
-    } else {
-        String::new()
-    };
-    format!("    {direction} wire {signed}{range}{}", signal.name)
-}
-
 /// `cocotb_<module>`: the block's module with this package's parameters, the test's top level.
 pub fn wrapper(block: &Block, provenance: &Provenance) -> String {
     let top = format!("cocotb_{}", block.module);
-    let mut ports = vec![
-        "    input wire clk".to_string(),
-        "    input wire rst".into(),
-        "    input wire ce".into(),
-    ];
-    ports.extend(block.inputs.iter().map(|s| port("input", s)));
-    ports.extend(block.outputs.iter().map(|o| port("output", &o.signal)));
+    let ports = block.port_declarations();
     let mut out = String::new();
     let _ = write!(
         out,

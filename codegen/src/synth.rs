@@ -92,28 +92,6 @@ fn netlist_name(block: &Block) -> String {
     format!("{}_netlist", block.module)
 }
 
-/// A port declaration of one of the block's signals.
-fn port(direction: &str, signal: &crate::block::Signal) -> String {
-    let signed = if signal.format.signed { "signed " } else { "" };
-    let range = if signal.format.width > 1 {
-        format!("[{}:0] ", signal.format.width - 1)
-    } else {
-        String::new()
-    };
-    format!("    {direction} wire {signed}{range}{}", signal.name)
-}
-
-/// Every port of the block: `clk`, `rst`, `ce`, its inputs, its outputs.
-fn ports(block: &Block) -> Vec<String> {
-    let mut ports: Vec<String> = ["clk", "rst", "ce"]
-        .iter()
-        .map(|name| format!("    input wire {name}"))
-        .collect();
-    ports.extend(block.inputs.iter().map(|s| port("input", s)));
-    ports.extend(block.outputs.iter().map(|o| port("output", &o.signal)));
-    ports
-}
-
 /// Each port connected to the signal of its name.
 fn connections(block: &Block) -> String {
     let mut names = vec!["clk", "rst", "ce"];
@@ -144,7 +122,7 @@ pub fn configured_module(block: &Block) -> String {
          `default_nettype wire\n",
         module = block.module,
         name = configured_name(block),
-        ports = ports(block).join(",\n"),
+        ports = block.port_declarations().join(",\n"),
         params = params.join(",\n"),
         connections = connections(block),
     )
@@ -196,7 +174,7 @@ pub fn netlist_shell(block: &Block) -> String {
         module = block.module,
         netlist = netlist_name(block),
         declarations = declarations.join(",\n"),
-        ports = ports(block).join(",\n"),
+        ports = block.port_declarations().join(",\n"),
         connections = connections(block),
     )
 }

@@ -28,22 +28,6 @@ fn node<'a>(nodes: &'a [NodeRange], name: &str) -> &'a NodeRange {
     find(nodes, name).unwrap_or_else(|| panic!("{name} in {nodes:?}"))
 }
 
-/// What the node's format can output when its exact value ranges over `range`: the range,
-/// its ends saturated into the format, or anything the format holds when it wraps.
-fn observable(range: Interval, point: &Point) -> Interval {
-    if range.fits(point.to) {
-        return range;
-    }
-    let format = Interval::of_format(point.to);
-    match point.overflow {
-        Overflow::Saturate => Interval::new(
-            range.lo.clamp(format.lo, format.hi),
-            range.hi.clamp(format.lo, format.hi),
-        ),
-        Overflow::Wrap => format,
-    }
-}
-
 fn inside(value: f64, range: Interval) -> bool {
     value >= range.lo && value <= range.hi
 }
@@ -461,9 +445,9 @@ proptest! {
         segments in prop::collection::vec((0u8..3, any::<u64>(), any::<u64>(), any::<bool>(), 1usize..400), 1..12),
     ) {
         let nodes = demodulator(&plan, Interval::of_format(plan.input), reference(&nco_plan));
-        let product = observable(node(&nodes, "loop.demod_product").range, &plan.product);
+        let product = output_of(node(&nodes, "loop.demod_product").range, &plan.product);
         let state = node(&nodes, "loop.demod_state").range;
-        let output = observable(node(&nodes, "loop.demod_output").range, &plan.output);
+        let output = output_of(node(&nodes, "loop.demod_output").range, &plan.output);
         let mut nco = FixedNco::new(&nco_plan);
         let mut demod = FixedDemodulator::new(&plan);
         let mut quantizer = plan.product.quantizer();
@@ -546,7 +530,7 @@ proptest! {
     ) {
         let nodes = pi(&plan, Interval::of_format(plan.input), Controller::Agc);
         let integrator = node(&nodes, "loop.agc_integrator").range;
-        let output = observable(node(&nodes, "loop.agc_output").range, &plan.output);
+        let output = output_of(node(&nodes, "loop.agc_output").range, &plan.output);
         let mut fixed = FixedPi::new(&plan);
         for (choice, raw, event, preset, length) in segments {
             match event {
@@ -617,8 +601,8 @@ proptest! {
     ) {
         let input = Interval::of_format(plan.input);
         let nodes = cic(&plan, input);
-        let c = observable(node(&nodes, "loop.cic_internal").range, &plan.cic);
-        let y = observable(node(&nodes, "loop.cic_output").range, &plan.output);
+        let c = output_of(node(&nodes, "loop.cic_internal").range, &plan.cic);
+        let y = output_of(node(&nodes, "loop.cic_output").range, &plan.output);
         let response = cascade_response(&plan);
         let mut fixed = FixedCic::new(&plan);
         for (choice, raw, length) in segments {
@@ -771,7 +755,7 @@ proptest! {
         segments in prop::collection::vec((0u8..5, 0u8..5, any::<u64>(), 1usize..300), 1..12),
     ) {
         let nodes = gyro(&plan);
-        let bound = |name: &str, point: &Point| observable(node(&nodes, name).range, point);
+        let bound = |name: &str, point: &Point| output_of(node(&nodes, name).range, point);
         let d = &plan.demodulator;
         let product = bound("loop.demod_product", &d.product);
         let state = node(&nodes, "loop.demod_state").range;
