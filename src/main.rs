@@ -8,7 +8,8 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use commands::{
-    allan, ar, davar, design, filter, formats, generate, gyro_loop, init, reproduce, synth, verify,
+    allan, ar, davar, design, explore, filter, formats, generate, gyro_loop, init, reproduce,
+    synth, verify,
 };
 
 #[derive(Parser)]
@@ -31,6 +32,7 @@ enum Command {
     Init(init::Args),
     Design(design::Args),
     Formats(formats::Args),
+    Explore(explore::Args),
     Generate(generate::Args),
     Synth(synth::Args),
     Loop(gyro_loop::Args),
@@ -55,6 +57,7 @@ fn main() -> ExitCode {
         Command::Init(args) => init::run(args),
         Command::Design(args) => design::run(args),
         Command::Formats(args) => formats::run(args),
+        Command::Explore(args) => explore::run(args),
         Command::Generate(args) => generate::run(args),
         Command::Synth(args) => synth::run(args),
         Command::Loop(args) => gyro_loop::run(args),

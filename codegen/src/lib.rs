@@ -14,6 +14,7 @@ pub mod cocotb;
 pub mod config;
 pub mod dpi;
 pub mod error;
+pub mod explore;
 pub mod filter_package;
 pub mod formats;
 pub mod generate;

@@ -40,6 +40,8 @@ pub enum Kind {
     Reproduce,
     /// `gyrofx filter --vectors`: the KF's vectors of a filtered record.
     Filter,
+    /// `gyrofx explore`: the candidates' CSV, the Pareto plots and the chosen config.
+    Explore,
 }
 
 impl Kind {
@@ -50,13 +52,20 @@ impl Kind {
             Kind::Synth => "synth",
             Kind::Reproduce => "reproduce",
             Kind::Filter => "filter",
+            Kind::Explore => "explore",
         }
     }
 
     fn from_name(name: &str) -> Option<Kind> {
-        [Kind::Generate, Kind::Synth, Kind::Reproduce, Kind::Filter]
-            .into_iter()
-            .find(|k| k.name() == name)
+        [
+            Kind::Generate,
+            Kind::Synth,
+            Kind::Reproduce,
+            Kind::Filter,
+            Kind::Explore,
+        ]
+        .into_iter()
+        .find(|k| k.name() == name)
     }
 }
 

@@ -32,7 +32,7 @@ const FONT_PATHS: [&str; 6] = [
 ];
 
 /// Registers a TrueType font for plot text (once).
-fn ensure_font() -> Result<()> {
+pub(crate) fn ensure_font() -> Result<()> {
     static FONT: std::sync::OnceLock<std::result::Result<(), String>> = std::sync::OnceLock::new();
     FONT.get_or_init(|| {
         let candidates: Vec<PathBuf> = std::env::var_os("GYROFX_FONT")

@@ -10,7 +10,7 @@
 use std::path::Path;
 use std::process::Command;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::block::Block;
 use crate::blocks::{self, RomImages};
@@ -33,7 +33,7 @@ const LOOP_BLOCK: &str = "gyro_loop";
 pub const LOOP_FOLDER: &str = "gyro_loop";
 
 /// Generic (technology-independent) resources of the flattened chain.
-#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Generic {
     /// Gate-level cells after `synth`.
     pub cells: u64,
@@ -44,7 +44,7 @@ pub struct Generic {
 }
 
 /// Xilinx 7-series estimate from `synth_xilinx`.
-#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Xilinx {
     /// LUT1..LUT6.
     pub luts: u64,
@@ -59,7 +59,7 @@ pub struct Xilinx {
 }
 
 /// What one synthesis run measured.
-#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Resources {
     /// Generic mapping.
     pub generic: Generic,

@@ -4,6 +4,7 @@ pub mod allan;
 pub mod ar;
 pub mod davar;
 pub mod design;
+pub mod explore;
 pub mod filter;
 pub mod formats;
 pub mod generate;
