@@ -10,10 +10,28 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-use common::{fails, gyrofx, ok, text};
+use common::{gyrofx, ok, text};
 
 const SWEEP: &str = "kf.state_format=s26.16..s28.18";
 const SAMPLES: &str = "2000";
+
+/// `gyrofx explore` over [`SWEEP`] on [`SAMPLES`] samples with `cache`, writing `out`, then
+/// `extra`.
+fn sweep(cache: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
+    let mut args = vec![
+        "explore",
+        "--vary",
+        SWEEP,
+        "--samples",
+        SAMPLES,
+        "--cache",
+        cache.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    gyrofx(&args)
+}
 
 /// The first run, shared by the tests that read it: its folder, cache and output.
 struct Fixture {
@@ -31,20 +49,9 @@ fn fixture() -> &'static Fixture {
         let root = dir.path().to_path_buf();
         let out = root.join("sweep");
         let cache = root.join("cache");
-        let printed = ok(&[
-            "explore",
-            "--vary",
-            SWEEP,
-            "--samples",
-            SAMPLES,
-            "--cache",
-            cache.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--jobs",
-            "2",
-            "--quiet",
-        ]);
+        let output = sweep(&cache, &out, &["--jobs", "2", "--quiet"]);
+        assert!(output.status.success(), "{}", text(&output));
+        let printed = text(&output);
         Fixture {
             _root: dir,
             root,
@@ -253,20 +260,9 @@ fn a_second_run_takes_every_cost_from_the_cache_and_writes_the_same_csv() {
     let f = fixture();
     let before = cache_files(&f.cache);
     let again = f.root.join("again");
-    let printed = ok(&[
-        "explore",
-        "--vary",
-        SWEEP,
-        "--samples",
-        SAMPLES,
-        "--cache",
-        f.cache.to_str().unwrap(),
-        "--out",
-        again.to_str().unwrap(),
-        "--jobs",
-        "1",
-        "--quiet",
-    ]);
+    let output = sweep(&f.cache, &again, &["--jobs", "1", "--quiet"]);
+    assert!(output.status.success(), "{}", text(&output));
+    let printed = text(&output);
     assert!(
         printed.contains("0 synthesized by yosys, 3 from the cache"),
         "{printed}"
@@ -283,20 +279,7 @@ fn a_second_run_takes_every_cost_from_the_cache_and_writes_the_same_csv() {
 fn a_target_nobody_meets_writes_no_best_toml_and_exits_1() {
     let f = fixture();
     let out = f.root.join("unmet");
-    let output = gyrofx(&[
-        "explore",
-        "--vary",
-        SWEEP,
-        "--samples",
-        SAMPLES,
-        "--cache",
-        f.cache.to_str().unwrap(),
-        "--target",
-        "max-error-lsb<=0",
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-    ]);
+    let output = sweep(&f.cache, &out, &["--target", "max-error-lsb<=0", "--quiet"]);
     assert_eq!(output.status.code(), Some(1), "{}", text(&output));
     assert!(
         text(&output).contains("no best.toml: no candidate meets max-error-lsb<=0"),
@@ -414,17 +397,9 @@ fn a_folder_gyrofx_did_not_write_is_refused_before_any_work() {
     let out = dir.path().join("mine");
     std::fs::create_dir(&out).unwrap();
     std::fs::write(out.join("notes.txt"), "mine").unwrap();
-    let message = fails(&[
-        "explore",
-        "--vary",
-        SWEEP,
-        "--samples",
-        SAMPLES,
-        "--cache",
-        dir.path().join("cache").to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let output = sweep(&dir.path().join("cache"), &out, &[]);
+    assert!(!output.status.success(), "{}", text(&output));
+    let message = text(&output);
     assert!(message.contains("notes.txt"), "{message}");
     assert_eq!(
         std::fs::read_to_string(out.join("notes.txt")).unwrap(),

@@ -19,12 +19,16 @@ fn resource(manifest: &serde_json::Value, flow: &str, what: &str) -> u64 {
         .unwrap_or_else(|| panic!("manifest has no resources.{flow}.{what}"))
 }
 
-fn copy_folder(from: &Path, to: &Path) {
+/// A copy of the folder `from` and everything in it.
+fn copy_tree(from: &Path, to: &Path) {
     std::fs::create_dir_all(to).unwrap();
     for entry in std::fs::read_dir(from).unwrap() {
         let entry = entry.unwrap();
-        if entry.file_type().unwrap().is_file() {
-            std::fs::copy(entry.path(), to.join(entry.file_name())).unwrap();
+        let target = to.join(entry.file_name());
+        if entry.file_type().unwrap().is_dir() {
+            copy_tree(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), target).unwrap();
         }
     }
 }
@@ -102,7 +106,7 @@ fn the_chain_synthesizes_and_wider_formats_cost_more_and_latches_fail() {
 
     // The same scripts on a requantizer whose rounding branch no longer always assigns.
     let latched = dir.path().join("latched");
-    copy_folder(&narrow, &latched);
+    copy_tree(&narrow, &latched);
     let source = std::fs::read_to_string(latched.join("gyrofx_quantize.v")).unwrap();
     let broken = source.replace(
         "3: increment = half_bit;",
@@ -115,7 +119,7 @@ fn the_chain_synthesizes_and_wider_formats_cost_more_and_latches_fail() {
     assert!(error.contains("dlatch"), "{error}");
 
     let missing = dir.path().join("missing");
-    copy_folder(&narrow, &missing);
+    copy_tree(&narrow, &missing);
     std::fs::remove_file(missing.join("gyrofx_kf.v")).unwrap();
     let error = measure(&missing).unwrap_err().to_string();
     assert!(error.contains("gyrofx_kf"), "{error}");
@@ -126,19 +130,6 @@ fn the_chain_synthesizes_and_wider_formats_cost_more_and_latches_fail() {
     let error = fails(&["synth", "--out", none.to_str().unwrap(), "--config", &bad]);
     assert!(error.contains("kf.coefficient_width"), "{error}");
     assert!(!none.exists());
-}
-
-fn copy_tree(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for entry in std::fs::read_dir(from).unwrap() {
-        let entry = entry.unwrap();
-        let target = to.join(entry.file_name());
-        if entry.file_type().unwrap().is_dir() {
-            copy_tree(&entry.path(), &target);
-        } else {
-            std::fs::copy(entry.path(), target).unwrap();
-        }
-    }
 }
 
 fn flip_flops(generic_json: &Path) -> u64 {
@@ -226,6 +217,25 @@ fn netlists_pass_the_vectors_and_chparam_on_untyped_localparams_fails_them() {
     // GHDL has no netlist to run.
     let error = fails(&["verify", "--out", pkg, "--netlist", syn, "--sim", "ghdl"]);
     assert!(error.contains("--sim ghdl is not allowed"), "{error}");
+    // A block the folder has no netlist of, and a package of other coefficients: refused,
+    // naming why, before any simulation.
+    let error = fails(&["verify", "--out", pkg, "--netlist", syn, "--blocks", "kf"]);
+    assert!(error.contains("has no netlist of it"), "{error}");
+    std::fs::create_dir(dir.path().join("default")).unwrap();
+    let other = generate_default(&dir.path().join("default"), "1000");
+    let error = fails(&[
+        "verify",
+        "--out",
+        other.to_str().unwrap(),
+        "--netlist",
+        syn,
+        "--blocks",
+        "top",
+    ]);
+    assert!(
+        error.contains("the ROM image kf_coefficients.mem differs"),
+        "{error}"
+    );
 
     // The old way: chparam on the module, and parameters and localparams without a type.
     let old = dir.path().join("chparam");

@@ -46,8 +46,7 @@ mod target;
 pub use cache::{default_folder, CostCounts, Costs};
 pub use measure::{Metrics, Reference};
 pub use sweep::{
-    candidates, explorable_keys, set_format, Candidate, GuardBits, Sweep, Vary, GUARD_BIT_KEYS,
-    MAX_CANDIDATES,
+    candidates, explorable_keys, Candidate, GuardBits, Sweep, Vary, GUARD_BIT_KEYS, MAX_CANDIDATES,
 };
 pub use target::{Metric, Target};
 
@@ -218,7 +217,7 @@ impl Plan {
         let mut config = self.base.clone();
         config.samples = self.samples;
         for (key, format) in &candidate.formats {
-            set_format(&mut config, key, *format);
+            crate::formats::set_format(&mut config, key, *format);
         }
         config
     }
@@ -552,7 +551,7 @@ impl Exploration {
         };
         let mut config = self.base.clone();
         for (key, format) in &row.candidate.formats {
-            set_format(&mut config, key, *format);
+            crate::formats::set_format(&mut config, key, *format);
         }
         Job::new(config.clone())?;
         let c = m.cost();

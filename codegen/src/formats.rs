@@ -200,6 +200,27 @@ pub fn fractions_for(
     })
 }
 
+/// Sets the format of `key` in `config`: a format key of an analysed node ([`Row::key`]).
+///
+/// # Panics
+/// On any other key: the keys come from the analysis's rows.
+pub fn set_format(config: &mut Config, key: &str, format: Format) {
+    let text = format.to_string();
+    match key {
+        "estimator.mean_format" => config.estimator.mean_format = text,
+        "estimator.bias_format" => config.estimator.bias_format = text,
+        "kf.state_format" => config.kf.state_format = text,
+        "kf.output_format" => config.kf.output_format = text,
+        "mean_filter.output_format" => config.mean_filter.output_format = text,
+        _ => {
+            let field = key
+                .strip_prefix("loop.")
+                .unwrap_or_else(|| panic!("{key} is not a format key of an analysed node"));
+            config.gyro_loop.insert(field.into(), text.into());
+        }
+    }
+}
+
 /// Formats the analysis does not cover, with why none is needed: they are reported as
 /// hand-set.
 pub const NOT_ANALYSED: [(&str, &str); 1] = [(
@@ -523,19 +544,7 @@ impl Analysis {
             }
         }
         for (key, format) in proven {
-            let text = format.to_string();
-            match key {
-                "estimator.mean_format" => derived.estimator.mean_format = text,
-                "estimator.bias_format" => derived.estimator.bias_format = text,
-                "kf.state_format" => derived.kf.state_format = text,
-                "kf.output_format" => derived.kf.output_format = text,
-                "mean_filter.output_format" => derived.mean_filter.output_format = text,
-                _ => {
-                    if let Some(field) = key.strip_prefix("loop.") {
-                        derived.gyro_loop.insert(field.into(), text.into());
-                    }
-                }
-            }
+            set_format(&mut derived, key, format);
         }
         if let Some(budget) = budget {
             derived.estimator.mean_format = budget.mean.to_string();

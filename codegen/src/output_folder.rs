@@ -399,6 +399,35 @@ pub fn clean_stale(parent: &Path) {
     }
 }
 
+/// A private work folder (yosys's scratch files, ...) in the system's temporary folder,
+/// registered so that a signal ending the process removes it ([`remove_registered`]), and
+/// removed when dropped.
+#[derive(Debug)]
+pub struct WorkFolder(tempfile::TempDir);
+
+impl WorkFolder {
+    /// Creates one.
+    ///
+    /// # Errors
+    /// The error of creating it.
+    pub fn new() -> std::io::Result<WorkFolder> {
+        let folder = tempfile::Builder::new().prefix("gyrofx-work-").tempdir()?;
+        register(folder.path());
+        Ok(WorkFolder(folder))
+    }
+
+    /// Its path.
+    pub fn path(&self) -> &Path {
+        self.0.path()
+    }
+}
+
+impl Drop for WorkFolder {
+    fn drop(&mut self) {
+        unregister(self.0.path());
+    }
+}
+
 /// A temporary file in `folder` (`<prefix>…<suffix>`) for a single output file that is
 /// renamed into place when complete. Created with mode 0666 less the umask, as any file a
 /// program writes, not the 0600 of a private temporary file: the renamed output keeps it.

@@ -185,10 +185,6 @@ pub fn run(out: &Path, simulator: Simulator, options: &Options) -> Result<Outcom
 /// [`Error::Simulation`] when the folder is not a package or names a block it lacks.
 pub fn block_names(out: &Path, simulator: Simulator, options: &Options) -> Result<Vec<String>> {
     let mut names = blocks(out, simulator)?;
-    if let Some(folder) = &options.netlist {
-        let netlists = Netlists::read(folder, out, simulator)?;
-        names.retain(|n| netlists.files.iter().any(|(block, _)| block == n));
-    }
     if let Some(wanted) = &options.blocks {
         if let Some(unknown) = wanted.iter().find(|w| !names.contains(w)) {
             return Err(Error::Simulation(format!(
@@ -197,6 +193,23 @@ pub fn block_names(out: &Path, simulator: Simulator, options: &Options) -> Resul
             )));
         }
         names.retain(|n| wanted.contains(n));
+    }
+    if let Some(folder) = &options.netlist {
+        let netlists = Netlists::read(folder, out, simulator)?;
+        let covered: Vec<&str> = netlists.files.iter().map(|(b, _)| b.as_str()).collect();
+        if let Some(uncovered) = options
+            .blocks
+            .iter()
+            .flatten()
+            .find(|w| !covered.contains(&w.as_str()))
+        {
+            return Err(Error::Simulation(format!(
+                "--blocks {uncovered}: {} has no netlist of it; its netlists are of {}",
+                folder.display(),
+                covered.join(", ")
+            )));
+        }
+        names.retain(|n| covered.contains(&n.as_str()));
     }
     Ok(names)
 }
@@ -358,8 +371,7 @@ impl Netlists {
         let synth = read_manifest(folder, "a `gyrofx synth` folder")?;
         let netlists = synth["netlists"].as_array().ok_or_else(|| {
             Error::Simulation(format!(
-                "{} holds no netlists: run gyrofx synth --out {} with this gyrofx",
-                folder.display(),
+                "{} holds no netlists (it is not the folder of this gyrofx's `synth`): run gyrofx synth --out SYNTH_DIR with the package's config and pass --netlist SYNTH_DIR",
                 folder.display()
             ))
         })?;

@@ -72,10 +72,9 @@ pub struct Resources {
 /// yosys 0.23's `chparam` makes the values it sets unsigned, so width arithmetic with a negative
 /// intermediate (`P2_I = P2_W − P2_F` in the KF) wraps and the netlist no longer matches the RTL.
 /// An instance in a generated wrapper passes them as the simulators do.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Parameters {
     /// An instance with the parameters in [`configured_module`] (the only passing `synth` uses).
-    #[default]
     Instance,
     /// `chparam -set` on the module itself: kept so that a test can show the netlist check
     /// catching what it did.
@@ -83,13 +82,13 @@ pub enum Parameters {
 }
 
 /// The module name of a block's wrapper: the block's module with the job's parameters.
-pub fn configured_name(block: &Block) -> String {
-    format!("{}_configured", block.module)
+pub fn configured_name(module: &str) -> String {
+    format!("{module}_configured")
 }
 
 /// The name the synthesized netlist's module gets, under the shell named like the RTL module.
-fn netlist_name(block: &Block) -> String {
-    format!("{}_netlist", block.module)
+fn netlist_name(module: &str) -> String {
+    format!("{module}_netlist")
 }
 
 /// Each port connected to the signal of its name.
@@ -121,7 +120,7 @@ pub fn configured_module(block: &Block) -> String {
          endmodule\n\
          `default_nettype wire\n",
         module = block.module,
-        name = configured_name(block),
+        name = configured_name(block.module),
         ports = block.port_declarations().join(",\n"),
         params = params.join(",\n"),
         connections = connections(block),
@@ -172,7 +171,7 @@ pub fn netlist_shell(block: &Block) -> String {
          endmodule\n\
          `default_nettype wire\n",
         module = block.module,
-        netlist = netlist_name(block),
+        netlist = netlist_name(block.module),
         declarations = declarations.join(",\n"),
         ports = block.port_declarations().join(",\n"),
         connections = connections(block),
@@ -206,7 +205,7 @@ pub const NETLIST_FOLDER: &str = "netlist";
 pub fn netlist_files(module: &str) -> [String; 2] {
     [
         format!("{NETLIST_FOLDER}/{module}.v"),
-        format!("{NETLIST_FOLDER}/{module}_netlist.v"),
+        format!("{NETLIST_FOLDER}/{}.v", netlist_name(module)),
     ]
 }
 
@@ -220,7 +219,7 @@ fn elaborate(
     let names: Vec<&str> = sources(module).iter().map(|(n, _)| *n).collect();
     match parameters {
         Parameters::Instance => {
-            let top = format!("{module}_configured");
+            let top = configured_name(module);
             (
                 format!(
                     "read_verilog {} {CONFIGURED_FILE}\nhierarchy -check -top {top}\n",
@@ -257,8 +256,9 @@ pub fn generic_script(module: &str, params: &[(String, String)], parameters: Par
          select -assert-none t:$dlatch t:$adlatch t:$_DLATCH_*\n\
          check -assert\n\
          tee -q -o generic.json stat -json\n\
-         rename {top} {module}_netlist\n\
+         rename {top} {netlist_module}\n\
          write_verilog -noattr {netlist}\n",
+        netlist_module = netlist_name(module),
     )
 }
 
@@ -418,7 +418,7 @@ pub struct Synthesis {
 }
 
 /// One design's inputs (RTL, ROM images, both scripts) by file name.
-fn inputs(top: &Block, parameters: Parameters) -> Vec<(String, String)> {
+fn inputs(top: &Block) -> Vec<(String, String)> {
     let mut inputs: Vec<(String, String)> = sources(top.module)
         .into_iter()
         .map(|(n, s)| (n.to_string(), s.to_string()))
@@ -437,19 +437,17 @@ fn inputs(top: &Block, parameters: Parameters) -> Vec<(String, String)> {
         inputs.push(("nco_sine.mem".into(), image("gyro_loop_nco_sine")));
         inputs.push(("cic_taps.mem".into(), image("gyro_loop_cic_taps")));
     }
-    if parameters == Parameters::Instance {
-        inputs.push((CONFIGURED_FILE.into(), configured_module(top)));
-    }
+    inputs.push((CONFIGURED_FILE.into(), configured_module(top)));
     let [shell, _] = netlist_files(top.module);
     inputs.push((shell, netlist_shell(top)));
     let params = parameter_values(top);
     inputs.push((
         "generic.ys".into(),
-        generic_script(top.module, &params, parameters),
+        generic_script(top.module, &params, Parameters::Instance),
     ));
     inputs.push((
         "xilinx.ys".into(),
-        xilinx_script(top.module, &params, parameters),
+        xilinx_script(top.module, &params, Parameters::Instance),
     ));
     inputs
 }
@@ -508,29 +506,15 @@ pub fn synthesize(
     replace: Replace,
     provenance: &Provenance,
 ) -> Result<Synthesis> {
-    synthesize_with(job, out, replace, provenance, Parameters::Instance)
-}
-
-/// [`synthesize`] with the parameters passed as `parameters` says (only tests pass
-/// [`Parameters::Chparam`]).
-///
-/// # Errors
-/// Those of [`synthesize`].
-pub fn synthesize_with(
-    job: &Job,
-    out: &Path,
-    replace: Replace,
-    provenance: &Provenance,
-    parameters: Parameters,
-) -> Result<Synthesis> {
     output_folder::check(out, Kind::Synth, replace)?;
     let roms = RomImages::new(job, provenance);
     let top = blocks::find(TOP_BLOCK).block(job, &roms);
     let gyro_loop = blocks::find(LOOP_BLOCK).block(job, &roms);
-    let chain_inputs = inputs(&top, parameters);
-    let loop_inputs = inputs(&gyro_loop, parameters);
+    let chain_inputs = inputs(&top);
+    let loop_inputs = inputs(&gyro_loop);
 
-    let work = tempfile::tempdir().map_err(|e| Error::io(Path::new("temporary folder"), e))?;
+    let work = output_folder::WorkFolder::new()
+        .map_err(|e| Error::io(Path::new("temporary folder"), e))?;
     let loop_work = work.path().join(LOOP_FOLDER);
     // The two designs are independent: synthesize them side by side.
     let (chain, looped) = std::thread::scope(|scope| {
@@ -576,11 +560,7 @@ pub fn synthesize_with(
             "parameters": parameters_of(&gyro_loop),
             "resources": synthesis.gyro_loop,
         },
-        "parameter_passing": match parameters {
-            Parameters::Instance => "instance",
-            Parameters::Chparam => "chparam",
-        },
-        "netlists": [
+    "netlists": [
             {"block": TOP_BLOCK, "module": TOP, "files": netlist_files(TOP)},
             {"block": LOOP_BLOCK, "module": LOOP_TOP, "files": netlist_files(LOOP_TOP).map(|f| format!("{LOOP_FOLDER}/{f}"))},
         ],
@@ -616,7 +596,7 @@ pub fn design_inputs(job: &Job, design: Design) -> Vec<(String, String)> {
         Design::Chain => TOP_BLOCK,
         Design::GyroLoop => LOOP_BLOCK,
     };
-    inputs(&blocks::find(name).block(job, &roms), Parameters::Instance)
+    inputs(&blocks::find(name).block(job, &roms))
 }
 
 /// What identifies a synthesis result: the SHA-256 (hex) of every input file's name and
@@ -643,11 +623,16 @@ pub fn cache_key(inputs: &[(String, String)]) -> String {
 
 /// `yosys -V`, or empty when yosys is missing (the synthesis then fails with its own error).
 fn yosys_version() -> String {
-    Command::new("yosys")
-        .arg("-V")
-        .output()
-        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
-        .unwrap_or_default()
+    static VERSION: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    VERSION
+        .get_or_init(|| {
+            Command::new("yosys")
+                .arg("-V")
+                .output()
+                .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+                .unwrap_or_default()
+        })
+        .clone()
 }
 
 /// Synthesizes `inputs` ([`design_inputs`]) in a temporary folder, removed afterwards, and
@@ -656,6 +641,7 @@ fn yosys_version() -> String {
 /// # Errors
 /// Those of [`measure`].
 pub fn cost(inputs: &[(String, String)]) -> Result<Resources> {
-    let work = tempfile::tempdir().map_err(|e| Error::io(Path::new("temporary folder"), e))?;
+    let work = output_folder::WorkFolder::new()
+        .map_err(|e| Error::io(Path::new("temporary folder"), e))?;
     run_in(work.path(), inputs)
 }

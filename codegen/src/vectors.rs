@@ -12,17 +12,19 @@ use gyrofx_model::analysis::allan::OverlappingStream;
 use gyrofx_model::chain::{FixedChain, FloatChain};
 use gyrofx_model::estimator::OverflowCounts as EstimatorOverflows;
 use gyrofx_model::fx::Format;
-use gyrofx_model::gyro_loop::closed::FixedClosedLoop;
+use gyrofx_model::gyro_loop::closed::{ClosedLoop, FixedClosedLoop, LoopUnderTest};
 use gyrofx_model::kf::OverflowCounts;
 use gyrofx_model::plant::GyroStream;
 use gyrofx_model::resonator::Mode;
 use gyrofx_model::sequencer::Sequencer;
 use gyrofx_model::stimulus::adc;
+use gyrofx_model::system::loop_mode;
 use serde::Serialize;
 
 use crate::block::Block;
 use crate::blocks::kf::TieCases;
 use crate::blocks::{ChainSample, RomImages};
+use crate::config::GyroLoop;
 use crate::error::{Error, Result};
 use crate::job::Job;
 use crate::progress::Progress;
@@ -97,6 +99,25 @@ pub struct KfCounts {
     pub rate_hat: u64,
 }
 
+impl EstimatorCounts {
+    /// Every overflow and saturation counted.
+    pub fn total(&self) -> u64 {
+        self.mean
+            .iter()
+            .chain(&self.bias)
+            .chain(&self.calibrated)
+            .sum::<u64>()
+            + self.combined
+    }
+}
+
+impl KfCounts {
+    /// Every overflow and saturation counted.
+    pub fn total(&self) -> u64 {
+        self.x1 + self.x2 + self.rate_hat
+    }
+}
+
 impl From<OverflowCounts> for KfCounts {
     fn from(c: OverflowCounts) -> Self {
         KfCounts {
@@ -167,6 +188,11 @@ pub struct Results {
 /// Samples the run keeps each `bw_sel` for: it cycles through the ROM twice.
 fn bw_sel_chunk(samples: usize, entries: usize) -> usize {
     (samples / (2 * entries)).max(1)
+}
+
+/// `bw_sel` at sample `k` of a run of `samples` samples over `entries` ROM entries.
+pub fn bw_sel_at(k: usize, samples: usize, entries: usize) -> usize {
+    (k / bw_sel_chunk(samples, entries)) % entries
 }
 
 /// Changes of `bw_sel` in a run of `samples` samples over `entries` ROM entries.
@@ -266,7 +292,6 @@ fn run_with(
     };
     progress.plan((simulations + 1) * n as u64);
     let entries = kf.rom.len();
-    let chunk = bw_sel_chunk(n, entries);
     // One reset of the whole chain, late in the run, so that the report has a long stretch of
     // calibrated output before it.
     // A recording runs without it: its rows follow the sequencer from the first on.
@@ -333,7 +358,7 @@ fn run_with(
                     builder.reset();
                 }
             }
-            let bw_sel = (k / chunk) % entries;
+            let bw_sel = bw_sel_at(k, n, entries);
             let y = batch.codes[i];
             let y_real = [
                 est.input.to_f64(i128::from(y[0])),
@@ -441,6 +466,32 @@ enum Gyros {
 /// Start-up before the record: the loops lock from rest (about 80 ms for paper 004's gyro).
 const RESONATOR_STARTUP_S: f64 = 0.5;
 
+/// Resonator-level gyro `g` of a run seeded `seed` (the seed `2·seed + g`), its loop closed
+/// (fixed or float: `L`) and run [`RESONATOR_STARTUP_S`] at the first sample's rate `rate0`
+/// (°/s) in normal mode before the record, as every run of gyrofx starts it.
+///
+/// # Errors
+/// Resonator parameters the physics refuses, named by their config section.
+pub fn started_loop<L: LoopUnderTest>(
+    gyro: &GyroLoop,
+    g: usize,
+    seed: u64,
+    rate0: f64,
+) -> Result<ClosedLoop<L>> {
+    let mut closed = ClosedLoop::<L>::new(
+        &gyro.plan,
+        &gyro.params,
+        &gyro.front_end,
+        seed.wrapping_mul(2).wrapping_add(g as u64),
+    )
+    .map_err(|e| Error::config(format!("resonator_{}", gyro.name), e, "see gyrofx init"))?;
+    let startup = (RESONATOR_STARTUP_S * gyro.plan.chain_rate_hz()).ceil() as usize;
+    for _ in 0..startup {
+        closed.step_chain(rate0, Mode::Normal);
+    }
+    Ok(closed)
+}
+
 /// Chain samples between two counts of [`Progress::advance`].
 const PROGRESS_STEP: usize = 1024;
 
@@ -475,23 +526,7 @@ impl Gyros {
                 }
             }
             Some(loops) => {
-                let closed = |g: usize| -> Result<FixedClosedLoop> {
-                    let gyro = &loops[g];
-                    let mut closed = FixedClosedLoop::new(
-                        &gyro.plan,
-                        &gyro.params,
-                        &gyro.front_end,
-                        seed.wrapping_mul(2).wrapping_add(g as u64),
-                    )
-                    .map_err(|e| {
-                        Error::config(format!("resonator_{}", gyro.name), e, "see gyrofx init")
-                    })?;
-                    let startup = (RESONATOR_STARTUP_S * gyro.plan.chain_rate_hz()).ceil() as usize;
-                    for _ in 0..startup {
-                        closed.step_chain(rate0, Mode::Normal);
-                    }
-                    Ok(closed)
-                };
+                let closed = |g: usize| started_loop(&loops[g], g, seed, rate0);
                 let reversed = Box::new([closed(0)?, closed(1)?]);
                 let normal = reversed.clone();
                 Gyros::Resonator {
@@ -546,12 +581,10 @@ impl Gyros {
                             if k % PROGRESS_STEP == PROGRESS_STEP - 1 {
                                 progress.advance(2 * PROGRESS_STEP as u64);
                             }
-                            let mode = if mode[g] > 0 {
-                                Mode::Normal
-                            } else {
-                                Mode::Reverse
-                            };
-                            let output = reversed.step_chain(*omega, mode).output.rate_dps;
+                            let output = reversed
+                                .step_chain(*omega, loop_mode(mode[g]))
+                                .output
+                                .rate_dps;
                             let raw = normal.step_chain(*omega, Mode::Normal).output.rate_dps;
                             out.push(((output * scale).round() as i64, raw));
                         }
@@ -707,9 +740,8 @@ mod tests {
             (7, 1),
             (999, 4),
         ] {
-            let chunk = bw_sel_chunk(samples, entries);
             let changes = (1..samples)
-                .filter(|k| (k / chunk) % entries != ((k - 1) / chunk) % entries)
+                .filter(|&k| bw_sel_at(k, samples, entries) != bw_sel_at(k - 1, samples, entries))
                 .count() as u64;
             assert_eq!(
                 bw_sel_switches(samples, entries),

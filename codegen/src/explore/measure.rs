@@ -34,21 +34,17 @@
 
 use gyrofx_model::analysis::allan::OverlappingStream;
 use gyrofx_model::chain::{FixedChain, FloatChain};
-use gyrofx_model::gyro_loop::closed::{ClosedLoop, FixedHarness, FloatHarness, LoopUnderTest};
-use gyrofx_model::resonator::Mode;
+use gyrofx_model::gyro_loop::closed::{FixedHarness, FloatHarness, LoopUnderTest};
 use gyrofx_model::sequencer::Sequencer;
 use gyrofx_model::stimulus::adc;
 use gyrofx_model::system::loop_mode;
 use serde::Serialize;
 
 use crate::config::GyroLoop;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::job::Job;
 use crate::stats::Accumulator;
-use crate::vectors::{bw_sel_switches, EstimatorCounts, KfCounts};
-
-/// Start-up of the resonator loops before the record, s: as `generate`'s run.
-const RESONATOR_STARTUP_S: f64 = 0.5;
+use crate::vectors::{bw_sel_at, bw_sel_switches, started_loop, EstimatorCounts, KfCounts};
 
 /// The averaging time of the ADEV and ARW readings, s.
 pub const TAU_S: f64 = 1.0;
@@ -120,8 +116,8 @@ fn modes(job: &Job, samples: usize) -> Vec<[i8; 2]> {
         .collect()
 }
 
-/// Gyro `g`'s loop closed around its resonator, started up as `generate` starts it; its
-/// chain-rate outputs (°/s) over the record.
+/// Gyro `g`'s loop closed around its resonator and started up as every run starts it
+/// ([`started_loop`]); its chain-rate outputs (°/s) over the record.
 fn closed_loop_rates<L: LoopUnderTest>(
     gyro: &GyroLoop,
     g: usize,
@@ -129,18 +125,8 @@ fn closed_loop_rates<L: LoopUnderTest>(
     rates: &[f64],
     modes: &[[i8; 2]],
 ) -> Result<Vec<f64>> {
-    let mut closed: ClosedLoop<L> = ClosedLoop::new(
-        &gyro.plan,
-        &gyro.params,
-        &gyro.front_end,
-        seed.wrapping_mul(2).wrapping_add(g as u64),
-    )
-    .map_err(|e| Error::config(format!("resonator_{}", gyro.name), e, "see gyrofx init"))?;
-    let startup = (RESONATOR_STARTUP_S * gyro.plan.chain_rate_hz()).ceil() as usize;
     let rate0 = rates.first().copied().unwrap_or(0.0);
-    for _ in 0..startup {
-        closed.step_chain(rate0, Mode::Normal);
-    }
+    let mut closed = started_loop::<L>(gyro, g, seed, rate0)?;
     Ok(rates
         .iter()
         .zip(modes)
@@ -205,12 +191,6 @@ pub fn stimulus(job: &Job, float_twin: bool) -> Result<Stimulus> {
     })
 }
 
-/// `bw_sel` at sample `k` of a run of `samples`: each ROM entry for `samples / (2·entries)`
-/// samples, cycling twice, as in `generate`'s run.
-fn bw_sel(k: usize, samples: usize, entries: usize) -> usize {
-    (k / (samples / (2 * entries)).max(1)) % entries
-}
-
 /// The first sample at which the chain of `job` has a bias estimate (from reset, whatever the
 /// data): the analysed part of the record starts there.
 pub fn first_estimate(job: &Job) -> usize {
@@ -255,7 +235,7 @@ pub fn measure(job: &Job, stimulus: &Stimulus) -> std::result::Result<Metrics, S
     let (mut last_fixed, mut last_float) = (0.0, 0.0);
     let mut analysed = false;
     for k in 0..samples {
-        let sel = bw_sel(k, samples, entries);
+        let sel = bw_sel_at(k, samples, entries);
         let codes = stimulus.codes[k];
         let a = fixed.step(codes, sel);
         let y = match &stimulus.float {
@@ -294,13 +274,7 @@ pub fn measure(job: &Job, stimulus: &Stimulus) -> std::result::Result<Metrics, S
     let arw_deg_per_sqrt_h = adev_error_dps * tau.sqrt() * 60.0;
     let e: EstimatorCounts = fixed.estimator().overflow_counts().into();
     let f: KfCounts = fixed.kf().overflow_counts().into();
-    let overflows = e.mean.iter().sum::<u64>()
-        + e.bias.iter().sum::<u64>()
-        + e.calibrated.iter().sum::<u64>()
-        + e.combined
-        + f.x1
-        + f.x2
-        + f.rate_hat;
+    let overflows = e.total() + f.total();
     Ok(Metrics {
         rms_lsb: stats.rms_lsb,
         max_lsb: stats.max_lsb,

@@ -8,7 +8,6 @@
 
 use gyrofx_model::fx::Format;
 
-use crate::config::Config;
 use crate::formats::Analysis;
 
 /// The most candidates one run explores.
@@ -335,25 +334,6 @@ pub fn candidates(
     Ok((keys, candidates))
 }
 
-/// Sets the format of `key` (one of [`explorable_keys`]) in `config`, as `gyrofx formats
-/// --write` does.
-pub fn set_format(config: &mut Config, key: &str, format: Format) {
-    let text = format.to_string();
-    match key {
-        "estimator.mean_format" => config.estimator.mean_format = text,
-        "estimator.bias_format" => config.estimator.bias_format = text,
-        "kf.state_format" => config.kf.state_format = text,
-        "kf.output_format" => config.kf.output_format = text,
-        "mean_filter.output_format" => config.mean_filter.output_format = text,
-        _ => {
-            let field = key
-                .strip_prefix("loop.")
-                .unwrap_or_else(|| panic!("{key} is not a format key explore sets"));
-            config.gyro_loop.insert(field.into(), text.into());
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -410,7 +390,7 @@ mod tests {
     }
 
     fn default_analysis() -> Analysis {
-        let job = crate::job::Job::new(Config::embedded()).unwrap();
+        let job = crate::job::Job::new(crate::config::Config::embedded()).unwrap();
         crate::formats::analyse(&job, 10_000, 10)
     }
 
