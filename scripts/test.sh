@@ -3,8 +3,8 @@
 #
 #   scripts/test.sh
 #
-# Installs the simulators and synthesis tool with apt-get where missing (iverilog, verilator,
-# ghdl, yosys, make, and the DejaVu font the plots use), FuseSoC with pip in a virtualenv, and
+# Installs the simulators and synthesis tools with apt-get where missing (iverilog, verilator,
+# ghdl, yosys, nextpnr-ice40, make, and the DejaVu font the plots use), FuseSoC with pip in a virtualenv, and
 # maturin, numpy and pytest in another (for the Python package in python/):
 # a missing simulator is a failure, never a skipped test. Then: rustfmt,
 # clippy, Verilator lint of the RTL, and the whole test suite (unit, property, end-to-end
@@ -28,7 +28,7 @@ exec </dev/null
 
 font=/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf
 missing=()
-for program in iverilog vvp verilator ghdl yosys make sha256sum; do
+for program in iverilog vvp verilator ghdl yosys nextpnr-ice40 make sha256sum; do
     command -v "$program" >/dev/null 2>&1 || missing+=("$program")
 done
 [ -f "$font" ] || missing+=("$font")
@@ -38,7 +38,7 @@ if [ ${#missing[@]} -gt 0 ]; then
     if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
     $sudo apt-get update -qq
     DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq \
-        iverilog verilator ghdl yosys make coreutils fonts-dejavu-core >/dev/null
+        iverilog verilator ghdl yosys nextpnr-ice40 make coreutils fonts-dejavu-core >/dev/null
 fi
 # GHDL's LLVM back end runs the closed-loop testbenches about 3x faster than the default mcode
 # one (2310 us of the system testbench: 90 s against 258 s); Debian's ghdl wrapper takes it from
@@ -52,7 +52,7 @@ if [ ! -x /usr/bin/ghdl-llvm ] && command -v apt-get >/dev/null 2>&1; then
 fi
 if [ -x /usr/bin/ghdl-llvm ]; then export GHDL_BACKEND=llvm; fi
 [ -f "$font" ] || { echo "FAIL: $font is still missing after apt-get (plots need it)" >&2; exit 1; }
-for program in iverilog vvp verilator ghdl yosys make sha256sum; do
+for program in iverilog vvp verilator ghdl yosys nextpnr-ice40 make sha256sum; do
     command -v "$program" >/dev/null 2>&1 || { echo "FAIL: $program is still missing after apt-get" >&2; exit 1; }
 done
 
@@ -75,7 +75,7 @@ if ! command -v fusesoc >/dev/null 2>&1; then
 fi
 command -v fusesoc >/dev/null 2>&1 || { echo "FAIL: fusesoc is still missing" >&2; exit 1; }
 
-echo "== tools: $(iverilog -V 2>&1 | head -1); $(verilator --version); $(ghdl --version | head -1) ($(ghdl --version | grep -i 'code generator' | sed 's/^ *//')); $(yosys -V); fusesoc $(fusesoc --version)"
+echo "== tools: $(iverilog -V 2>&1 | head -1); $(verilator --version); $(ghdl --version | head -1) ($(ghdl --version | grep -i 'code generator' | sed 's/^ *//')); $(yosys -V); $(nextpnr-ice40 --version 2>&1 | head -1); fusesoc $(fusesoc --version)"
 echo "== cargo fmt --check"
 cargo fmt --all -- --check
 echo "== cargo clippy --all-targets -D warnings"

@@ -37,8 +37,19 @@ fn copy_tree(from: &Path, to: &Path) {
 fn the_chain_synthesizes_and_wider_formats_cost_more_and_latches_fail() {
     let dir = tempfile::tempdir().unwrap();
     let narrow = dir.path().join("narrow");
-    let log = ok(&["synth", "--out", narrow.to_str().unwrap()]);
+    let log = ok(&[
+        "synth",
+        "--out",
+        narrow.to_str().unwrap(),
+        "--target",
+        "xilinx,ice40-up5k",
+        "--blocks",
+        "kf,calibration,sequencer",
+        "--jobs",
+        "2",
+    ]);
     assert!(log.contains("synthesis check passed"), "{log}");
+    check_place_and_route(&narrow, &log);
     let narrow_manifest = manifest(&narrow);
     let report = std::fs::read_to_string(narrow.join("report.md")).unwrap();
     for flow_what in [("generic", "flip_flops"), ("xilinx", "luts")] {
@@ -130,6 +141,168 @@ fn the_chain_synthesizes_and_wider_formats_cost_more_and_latches_fail() {
     let error = fails(&["synth", "--out", none.to_str().unwrap(), "--config", &bad]);
     assert!(error.contains("kf.coefficient_width"), "{error}");
     assert!(!none.exists());
+}
+
+/// The counts of one module's cells in a yosys `stat -json` file, by type.
+fn stat_cells(path: &Path, module: &str) -> std::collections::BTreeMap<String, u64> {
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    let modules = json["modules"].as_object().unwrap();
+    let (_, found) = modules
+        .iter()
+        .find(|(name, _)| name.trim_start_matches('\\') == module)
+        .or_else(|| (modules.len() == 1).then(|| modules.iter().next().unwrap()))
+        .unwrap_or_else(|| panic!("{}: no module {module}", path.display()));
+    found["num_cells_by_type"]
+        .as_object()
+        .unwrap()
+        .iter()
+        .map(|(k, v)| (k.clone(), v.as_u64().unwrap()))
+        .collect()
+}
+
+/// `synth --target xilinx,ice40-up5k --blocks kf,calibration,sequencer`: each block on each
+/// target in the manifest, in target then block order, its counts re-derived from the kept
+/// yosys statistics and its Fmax from nextpnr's kept report; the sequencer and the
+/// combinational calibration fit the UP5K, the parallel KF (10 SB_MAC16) does not, and says
+/// why.
+fn check_place_and_route(synth: &Path, log: &str) {
+    let manifest = manifest(synth);
+    let placements = manifest["place_and_route"].as_array().unwrap();
+    let order: Vec<(&str, &str)> = placements
+        .iter()
+        .map(|p| (p["target"].as_str().unwrap(), p["block"].as_str().unwrap()))
+        .collect();
+    assert_eq!(
+        order,
+        [
+            ("ice40-up5k", "sequencer"),
+            ("ice40-up5k", "calibration"),
+            ("ice40-up5k", "kf"),
+            ("xilinx", "sequencer"),
+            ("xilinx", "calibration"),
+            ("xilinx", "kf"),
+        ]
+    );
+    let report = std::fs::read_to_string(synth.join("report.md")).unwrap();
+    assert!(report.contains("# Place and route"), "{report}");
+    let page = std::fs::read_to_string(synth.join("place_and_route.md")).unwrap();
+    for p in placements {
+        let (target, block) = (p["target"].as_str().unwrap(), p["block"].as_str().unwrap());
+        let folder = synth.join(p["folder"].as_str().unwrap());
+        let module = format!("{}_configured", p["module"].as_str().unwrap());
+        let cells = stat_cells(&folder.join("stat.json"), &module);
+        let total = |keep: &dyn Fn(&str) -> bool| -> u64 {
+            cells.iter().filter(|(k, _)| keep(k)).map(|(_, n)| n).sum()
+        };
+        assert!(page.contains(&format!("| {target} | {block} |")), "{page}");
+        let line = format!("{block} on {target}:");
+        assert!(log.contains(&line), "{line} missing from:\n{log}");
+        assert!(folder.join("run.sh").is_file() && folder.join("synth.ys").is_file());
+        if target == "xilinx" {
+            assert_eq!(
+                p["lut6"].as_u64().unwrap(),
+                total(&|k| k.starts_with("LUT"))
+            );
+            assert_eq!(
+                p["dsp"].as_u64().unwrap(),
+                total(&|k| k.starts_with("DSP48"))
+            );
+            assert!(p["fmax_mhz"].is_null() && p["fits"] == true, "{p}");
+            continue;
+        }
+        let lut4 = p["lut4"].as_u64().unwrap();
+        assert_eq!(lut4, total(&|k| k == "SB_LUT4"), "{block}");
+        assert_eq!(
+            p["ff"].as_u64().unwrap(),
+            total(&|k| k.starts_with("SB_DFF"))
+        );
+        assert_eq!(p["dsp"].as_u64().unwrap(), total(&|k| k == "SB_MAC16"));
+        assert!(lut4 > 0, "{block}");
+        if p["dsp"].as_u64().unwrap() > 8 {
+            // More SB_MAC16 than the UP5K's 8: refused before nextpnr runs.
+            assert_eq!(block, "kf");
+            assert_eq!(p["fits"], false, "{p}");
+            let limit = p["limit"].as_str().unwrap();
+            assert!(
+                limit.contains("SB_MAC16") && limit.contains("has 8"),
+                "{limit}"
+            );
+            assert!(p["fmax_mhz"].is_null(), "{p}");
+            assert!(!folder.join("report.json").exists());
+            continue;
+        }
+        assert_eq!(p["fits"], true, "{p}");
+        let nextpnr: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(folder.join("report.json")).unwrap())
+                .unwrap();
+        let achieved = nextpnr["fmax"]
+            .as_object()
+            .unwrap()
+            .values()
+            .next()
+            .unwrap()["achieved"]
+            .as_f64()
+            .unwrap();
+        let fmax = p["fmax_mhz"].as_f64().unwrap();
+        assert!(
+            (fmax - achieved).abs() <= 0.005,
+            "{fmax} against {achieved}"
+        );
+        assert!(fmax > 1.0, "{fmax}");
+        let path = p["critical_path"].as_str().unwrap();
+        assert!(
+            path.contains(" ns from ") && report.contains(path),
+            "{path}"
+        );
+        assert_eq!(
+            p["max_sample_rate_hz"].as_f64().unwrap(),
+            (fmax * 1e6 / p["clocks_per_sample"].as_f64().unwrap()).round()
+        );
+        // The block's flip-flops plus the harness's one per port bit fit in the cells used.
+        assert!(p["logic_cells"].as_u64().unwrap() >= lut4.max(p["ff"].as_u64().unwrap()));
+        let log = std::fs::read_to_string(folder.join("nextpnr.log")).unwrap();
+        assert!(log.contains("Max frequency") && !log.contains("negative timing budget"));
+    }
+    // The KF's state registers are the block's, not the harness's shift registers: its
+    // flip-flops are its two states, its output register and its valid flag.
+    let kf = placements
+        .iter()
+        .find(|p| p["block"] == "kf" && p["target"] == "ice40-up5k")
+        .unwrap();
+    let state = manifest["parameters"]["STATE_W"]
+        .as_str()
+        .unwrap()
+        .parse::<u64>()
+        .unwrap();
+    let out = manifest["parameters"]["OUT_W"]
+        .as_str()
+        .unwrap()
+        .parse::<u64>()
+        .unwrap();
+    assert_eq!(kf["ff"].as_u64().unwrap(), 2 * state + out + 1, "{kf}");
+    // The calibration is combinational: no flip-flop of its own.
+    let calibration = &placements[1];
+    assert_eq!(calibration["ff"].as_u64().unwrap(), 0, "{calibration}");
+
+    // Bad lists are refused by name before anything is written.
+    for (args, named) in [
+        (vec!["--target", "ecp5"], "\"ecp5\""),
+        (
+            vec!["--target", "xilinx", "--blocks", "kf,system"],
+            "\"system\"",
+        ),
+        (vec!["--target", "xilinx", "--jobs", "0"], "--jobs 0"),
+    ] {
+        let out = synth.with_file_name("refused");
+        let mut command = vec!["synth", "--out", out.to_str().unwrap()];
+        command.extend(args);
+        let error = fails(&command);
+        assert!(error.contains(named), "{error}");
+        assert!(!out.exists());
+    }
+    let error = fails(&["synth", "--out", "x", "--blocks", "kf"]);
+    assert!(error.contains("--target"), "{error}");
 }
 
 fn flip_flops(generic_json: &Path) -> u64 {

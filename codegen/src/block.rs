@@ -248,6 +248,8 @@ pub struct Block {
     /// latency. `ce` stays low meanwhile, so samples come every `2 + settle_clocks` clocks at
     /// most.
     pub settle_clocks: u32,
+    /// Whether the module has `clk`, `rst` and `ce` ports (a combinational block has none).
+    pub clocked: bool,
 }
 
 impl Block {
@@ -263,13 +265,23 @@ impl Block {
             };
             format!("    {direction} wire {signed}{range}{}", signal.name)
         };
-        let mut ports: Vec<String> = ["clk", "rst", "ce"]
+        let mut ports: Vec<String> = self
+            .clock_ports()
             .iter()
             .map(|name| format!("    input wire {name}"))
             .collect();
         ports.extend(self.inputs.iter().map(|s| port("input", s)));
         ports.extend(self.outputs.iter().map(|o| port("output", &o.signal)));
         ports
+    }
+
+    /// `clk`, `rst`, `ce`, or none for a combinational block.
+    pub fn clock_ports(&self) -> &'static [&'static str] {
+        if self.clocked {
+            &["clk", "rst", "ce"]
+        } else {
+            &[]
+        }
     }
 
     /// An empty block.
@@ -296,6 +308,7 @@ impl Block {
             count: 0,
             written: Vec::new(),
             settle_clocks: 0,
+            clocked: true,
         }
     }
 

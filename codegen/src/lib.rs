@@ -25,6 +25,7 @@ pub mod job;
 pub mod junit;
 pub mod output_folder;
 pub mod package;
+pub mod place_route;
 pub mod plot;
 pub mod progress;
 pub mod recording;

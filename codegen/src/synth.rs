@@ -19,6 +19,7 @@ use crate::hdl;
 use crate::job::Job;
 use crate::output_folder::{self, Kind, Replace};
 use crate::package::Package;
+use crate::place_route;
 use crate::writers::Provenance;
 
 /// Module synthesized: the whole chain.
@@ -93,7 +94,7 @@ fn netlist_name(module: &str) -> String {
 
 /// Each port connected to the signal of its name.
 fn connections(block: &Block) -> String {
-    let mut names = vec!["clk", "rst", "ce"];
+    let mut names = block.clock_ports().to_vec();
     names.extend(block.inputs.iter().map(|s| s.name));
     names.extend(block.outputs.iter().map(|o| o.signal.name));
     names
@@ -188,12 +189,12 @@ fn chparams(module: &str, params: &[(String, String)]) -> String {
 
 /// The RTL of the block's module: its file and its submodules' (for the chain, not the mean
 /// filter beside it: yosys would load its ROM image while reading it).
-fn sources(module: &str) -> Vec<&'static (&'static str, &'static str)> {
+pub fn sources(module: &str) -> Vec<&'static (&'static str, &'static str)> {
     hdl::verilog_sources_of(module)
 }
 
 /// The file holding [`configured_module`].
-const CONFIGURED_FILE: &str = "configured.v";
+pub const CONFIGURED_FILE: &str = "configured.v";
 
 /// The folder of a design's netlist: `<module>.v`, the shell ([`netlist_shell`]), and
 /// `<module>_netlist.v`, yosys's gate-level netlist (plain Verilog: gates as expressions,
@@ -405,39 +406,74 @@ fn report(
         provenance.line("").trim_start(),
         report_section(top, &synthesis.chain),
         report_section(gyro_loop, &synthesis.gyro_loop),
+    ) + &place_route_section(&synthesis.placements)
+}
+
+/// The report's place-and-route section (empty when nothing was placed).
+fn place_route_section(placements: &[place_route::Placement]) -> String {
+    if placements.is_empty() {
+        return String::new();
+    }
+    format!(
+        "\n# Place and route\n\n\
+         Each block alone with the config's parameters, inside a harness that feeds its inputs \
+         from one shift register and shifts its captured outputs out (4 pins; every path register \
+         to register). LUT, FF, DSP and BRAM count the block's own cells (yosys `stat` of its \
+         module, kept apart from the harness); fits and Fmax come from nextpnr-ice40 (seed 1) on \
+         block and harness together. Xilinx: yosys `synth_xilinx` figures against a {xilinx}; no \
+         open place and route for 7-series is available here, so no Fmax. A sample needs \
+         `clocks/sample` clocks; the max sample rate is Fmax over that. Files: \
+         `{folder}/<block>/<target>/` (yosys statistics `stat.json`, nextpnr's `report.json` \
+         and log; `run.sh`, run from the block's folder, re-derives them and writes yosys's \
+         log).\n\n{table}\n\
+         Critical paths (nextpnr; names inside the block, ports of the block by their name):\n\n{paths}",
+        xilinx = place_route::Target::Xilinx.device().name,
+        folder = place_route::FOLDER,
+        table = place_route::table(placements),
+        paths = place_route::critical_paths(placements),
     )
 }
 
 /// What `gyrofx synth` measured: the chain and one gyro's loop.
-#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct Synthesis {
     /// `gyrofx_top`.
     pub chain: Resources,
     /// `gyrofx_gyro_loop` (gyro A's parameters).
     pub gyro_loop: Resources,
+    /// Each placed block on each target (none unless asked for).
+    pub placements: Vec<place_route::Placement>,
 }
 
-/// One design's inputs (RTL, ROM images, both scripts) by file name.
-fn inputs(top: &Block) -> Vec<(String, String)> {
-    let mut inputs: Vec<(String, String)> = sources(top.module)
+/// A block's design files by name: its RTL (the module's file and its submodules'), the ROM
+/// images it reads and the wrapper with the job's parameters ([`configured_module`]).
+pub fn design_files(block: &Block) -> Vec<(String, String)> {
+    let mut files: Vec<(String, String)> = sources(block.module)
         .into_iter()
         .map(|(n, s)| (n.to_string(), s.to_string()))
         .collect();
-    inputs.extend(top.roms.iter().cloned());
+    files.extend(block.roms.iter().cloned());
     // yosys elaborates every module with its own defaults while reading it, and the loop's
     // NCO and CIC read their ROM images then: give them the images under their default names.
-    if top.module == LOOP_TOP {
+    if block.module == LOOP_TOP {
         let image = |rom: &str| {
-            top.roms
+            block
+                .roms
                 .iter()
                 .find(|(name, _)| name.starts_with(rom))
                 .map(|(_, text)| text.clone())
                 .expect("the loop block carries both ROMs")
         };
-        inputs.push(("nco_sine.mem".into(), image("gyro_loop_nco_sine")));
-        inputs.push(("cic_taps.mem".into(), image("gyro_loop_cic_taps")));
+        files.push(("nco_sine.mem".into(), image("gyro_loop_nco_sine")));
+        files.push(("cic_taps.mem".into(), image("gyro_loop_cic_taps")));
     }
-    inputs.push((CONFIGURED_FILE.into(), configured_module(top)));
+    files.push((CONFIGURED_FILE.into(), configured_module(block)));
+    files
+}
+
+/// One design's inputs (RTL, ROM images, wrapper, netlist shell, both scripts) by file name.
+fn inputs(top: &Block) -> Vec<(String, String)> {
+    let mut inputs = design_files(top);
     let [shell, _] = netlist_files(top.module);
     inputs.push((shell, netlist_shell(top)));
     let params = parameter_values(top);
@@ -493,18 +529,31 @@ fn add_design(
     Ok(())
 }
 
-/// Synthesizes the chain and one gyro's loop for `job` and writes the scripts, logs, stat
-/// files, report and manifest to `out` atomically (the loop's under `gyro_loop/`), if `out`
-/// may be replaced ([`output_folder::check`], checked first); nothing is written when a check
-/// fails.
+/// Which blocks `synth` also places and routes, on which targets.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct PlaceRequest {
+    /// The targets (none: no place and route).
+    pub targets: Vec<place_route::Target>,
+    /// The blocks, from [`place_route::BLOCKS`].
+    pub blocks: Vec<&'static str>,
+    /// Tools run at a time.
+    pub jobs: usize,
+}
+
+/// Synthesizes the chain and one gyro's loop for `job`, places and routes the blocks `place`
+/// asks for, and writes the scripts, logs, stat files, report and manifest to `out`
+/// atomically (the loop's under `gyro_loop/`, the placements' under `place_and_route/`), if
+/// `out` may be replaced ([`output_folder::check`], checked first); nothing is written when a
+/// check fails.
 ///
 /// # Errors
-/// A failed check or a missing yosys ([`Error::Synthesis`]), or an I/O error.
+/// A failed check or a missing yosys or nextpnr ([`Error::Synthesis`]), or an I/O error.
 pub fn synthesize(
     job: &Job,
     out: &Path,
     replace: Replace,
     provenance: &Provenance,
+    place: &PlaceRequest,
 ) -> Result<Synthesis> {
     output_folder::check(out, Kind::Synth, replace)?;
     let roms = RomImages::new(job, provenance);
@@ -522,16 +571,37 @@ pub fn synthesize(
         let chain = run_in(work.path(), &chain_inputs);
         (chain, looped.join().expect("synthesis does not panic"))
     });
-    let synthesis = Synthesis {
+    let mut synthesis = Synthesis {
         chain: chain?,
         gyro_loop: looped?,
+        placements: Vec::new(),
     };
 
     let mut package = Package::new(Kind::Synth, Vec::new());
+    if !place.targets.is_empty() {
+        synthesis.placements = place_route::place_and_route(
+            job,
+            &roms,
+            &place.blocks,
+            &place.targets,
+            place.jobs,
+            work.path(),
+            &mut package,
+        )?;
+    }
     package.add(
         "report.md",
         report(&top, &gyro_loop, &synthesis, provenance),
     );
+    if !synthesis.placements.is_empty() {
+        package.add(
+            "place_and_route.md",
+            place_route::page(
+                &synthesis.placements,
+                &format!("<!-- {} -->", provenance.line("").trim()),
+            ),
+        );
+    }
     add_design(&mut package, "", work.path(), &top, &chain_inputs)?;
     add_design(
         &mut package,
@@ -565,6 +635,7 @@ pub fn synthesize(
             {"block": LOOP_BLOCK, "module": LOOP_TOP, "files": netlist_files(LOOP_TOP).map(|f| format!("{LOOP_FOLDER}/{f}"))},
         ],
         "netlist_cells": "yosys's internal gate library: simulate with its simcells.v",
+        "place_and_route": synthesis.placements,
         "files": package.entries(),
     });
     let mut text = serde_json::to_string_pretty(&manifest).expect("manifest serializes");

@@ -7,9 +7,11 @@ use anyhow::Result;
 
 use gyrofx_codegen::generate::Output;
 use gyrofx_codegen::job::Job;
-use gyrofx_codegen::synth::{synthesize, LOOP_TOP, TOP};
+use gyrofx_codegen::place_route::{self, Target};
+use gyrofx_codegen::synth::{synthesize, PlaceRequest, LOOP_TOP, TOP};
 
-use super::options::{ConfigSource, OutputFolder};
+use super::options::{count, ConfigSource, OutputFolder};
+use super::usage;
 
 /// Synthesize the chain with the config's widths in yosys (generic and Xilinx 7-series):
 /// fails on a latch, an undriven or multiply-driven net or a missing module; writes the
@@ -20,6 +22,18 @@ pub struct Args {
     out: OutputFolder,
     #[command(flatten)]
     source: ConfigSource,
+    /// Also place and route each block on these targets, comma-separated: ice40-up5k,
+    /// ice40-hx8k (yosys synth_ice40 + nextpnr-ice40), xilinx (yosys synth_xilinx figures
+    /// against a Spartan-7 XC7S25), or all.
+    #[arg(long, value_name = "LIST")]
+    target: Option<String>,
+    /// The blocks placed with --target, comma-separated (default: all of sequencer,
+    /// estimator, calibration, kf, top, mean_filter, gyro_loop).
+    #[arg(long, value_name = "LIST", requires = "target")]
+    blocks: Option<String>,
+    /// yosys and nextpnr runs at a time for --target (default: the available cores).
+    #[arg(long, value_parser = count, requires = "target")]
+    jobs: Option<usize>,
     /// No progress spinner (it shows only on a terminal).
     #[arg(long)]
     quiet: bool,
@@ -30,14 +44,42 @@ pub fn run(args: Args) -> Result<ExitCode> {
     let Args {
         out: folder,
         source,
+        target,
+        blocks,
+        jobs,
         quiet,
     } = args;
+    let targets = match target.as_deref() {
+        Some(text) => Target::parse_list(text).map_err(super::Usage)?,
+        None => Vec::new(),
+    };
+    let blocks =
+        place_route::parse_blocks(blocks.as_deref().unwrap_or("all")).map_err(super::Usage)?;
+    if jobs == Some(0) {
+        usage!("--jobs 0 is not allowed: at least 1 tool at a time");
+    }
+    let place = PlaceRequest {
+        targets,
+        blocks,
+        jobs: jobs.unwrap_or_else(|| {
+            std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
+        }),
+    };
     let out = folder.out.as_path();
     let config = source.load()?;
     let job = Job::new(config)?;
     let provenance = source.provenance(&job, Output::Synthesis);
-    let spinner = super::progress::spinner("synth: yosys on the chain and the gyro loop", quiet);
-    let synthesis = synthesize(&job, out, folder.replace(), &provenance);
+    let what = if place.targets.is_empty() {
+        "synth: yosys on the chain and the gyro loop".to_string()
+    } else {
+        format!(
+            "synth: yosys on the chain and the gyro loop; {} blocks placed on {} targets",
+            place.blocks.len(),
+            place.targets.len()
+        )
+    };
+    let spinner = super::progress::spinner(&what, quiet);
+    let synthesis = synthesize(&job, out, folder.replace(), &provenance, &place);
     spinner.finish_and_clear();
     let synthesis = synthesis?;
     println!(
@@ -49,6 +91,32 @@ pub fn run(args: Args) -> Result<ExitCode> {
         println!(
             "{module} generic: {} cells, {} flip-flops, {} multipliers; xilinx 7-series: {} LUTs, {} flip-flops, {} DSP48E1, {} block RAM",
             g.cells, g.flip_flops, g.multipliers, x.luts, x.flip_flops, x.dsp48, x.block_rams
+        );
+    }
+    for p in &synthesis.placements {
+        let fmax = p
+            .fmax_mhz
+            .map_or_else(|| "no Fmax".to_string(), |f| format!("Fmax {f:.2} MHz"));
+        let fits = if p.fits {
+            "fits".to_string()
+        } else {
+            format!(
+                "does not fit: {}",
+                p.limit.as_deref().unwrap_or("too large")
+            )
+        };
+        let luts = p
+            .lut4
+            .map(|n| format!("{n} LUT4"))
+            .or(p.lut6.map(|n| format!("{n} LUT6")))
+            .unwrap_or_default();
+        println!(
+            "{} on {}: {luts}, {} flip-flops, {} DSP, {} block RAM; {fits}; {fmax}",
+            p.block,
+            p.target.name(),
+            p.ff,
+            p.dsp,
+            p.bram
         );
     }
     Ok(ExitCode::SUCCESS)

@@ -47,6 +47,7 @@ impl RtlBlock for Calibration {
                 Output::combinational(Signal::flag("combined_valid")),
             ],
         );
+        block.clocked = false;
         block
             .params
             .extend(Param::format("IN", est.input, "gyro samples"));

@@ -1,0 +1,887 @@
+//! Place and route of the reference RTL on the FPGAs a sensor board carries: yosys
+//! `synth_ice40` + nextpnr-ice40 for the iCE40 UP5K and HX8K, yosys `synth_xilinx` figures
+//! for a Spartan-7.
+//!
+//! Each block is placed alone, inside a harness ([`harness`]) that feeds every input from a
+//! shift register loaded through one pin and captures every output into a register shifted out
+//! through another: a block has more ports than a small package has pins, and registering both
+//! sides makes every timed path register to register, as inside a real design. The block's own
+//! resources are read from yosys's statistics of its module, kept as a hierarchy of its own
+//! (`keep_hierarchy`) so the harness's registers are not counted; whether it fits and how fast
+//! it runs come from nextpnr on the whole harness (4 pins, one shift register bit per port bit:
+//! a few percent of the device).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use serde::Serialize;
+
+use crate::block::Block;
+use crate::blocks::{self, RomImages};
+use crate::error::{Error, Result};
+use crate::job::Job;
+use crate::package::Package;
+use crate::synth;
+
+/// The blocks placed, in the package's order: the chain's blocks, the chain, the mean filter
+/// beside it and one gyro's loop (the system, two loops and the chain, is left out: it is
+/// larger than the loop that already does not fit).
+pub const BLOCKS: &[&str] = &[
+    "sequencer",
+    "estimator",
+    "calibration",
+    "kf",
+    "top",
+    "mean_filter",
+    "gyro_loop",
+];
+
+/// The harness module around a placed block.
+pub const HARNESS: &str = "gyrofx_place_route_harness";
+
+/// The folder of the place-and-route results in the synthesis package.
+pub const FOLDER: &str = "place_and_route";
+
+/// A device the RTL is placed on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Target {
+    /// Lattice iCE40 UP5K (SG48): 5 280 logic cells, 8 SB_MAC16, 30 block RAMs.
+    Ice40Up5k,
+    /// Lattice iCE40 HX8K (CT256): 7 680 logic cells, no multiplier, 32 block RAMs.
+    Ice40Hx8k,
+    /// Xilinx Spartan-7 XC7S25: synthesis figures only (no open place and route here).
+    Xilinx,
+}
+
+/// What a device offers.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Device {
+    /// Part name.
+    pub name: &'static str,
+    /// Package.
+    pub package: &'static str,
+    /// Logic cells (iCE40: a LUT4 and a flip-flop each) or LUT6s (Xilinx).
+    pub luts: u64,
+    /// Flip-flops.
+    pub flip_flops: u64,
+    /// Multiplier blocks (SB_MAC16, DSP48E1).
+    pub dsp: u64,
+    /// Block RAMs (SB_RAM40_4K; RAMB36E1, two RAMB18E1 each).
+    pub bram: u64,
+    /// The clock a design is asked to meet, MHz (nextpnr's `--freq`; the issue's goals).
+    pub goal_mhz: Option<f64>,
+}
+
+impl Target {
+    /// Every target, in report order.
+    pub const ALL: [Target; 3] = [Target::Ice40Up5k, Target::Ice40Hx8k, Target::Xilinx];
+
+    /// Its command-line and folder name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Target::Ice40Up5k => "ice40-up5k",
+            Target::Ice40Hx8k => "ice40-hx8k",
+            Target::Xilinx => "xilinx",
+        }
+    }
+
+    /// The device's resources.
+    pub fn device(self) -> Device {
+        match self {
+            Target::Ice40Up5k => Device {
+                name: "iCE40UP5K",
+                package: "sg48",
+                luts: 5280,
+                flip_flops: 5280,
+                dsp: 8,
+                bram: 30,
+                goal_mhz: Some(24.0),
+            },
+            Target::Ice40Hx8k => Device {
+                name: "iCE40HX8K",
+                package: "ct256",
+                luts: 7680,
+                flip_flops: 7680,
+                dsp: 0,
+                bram: 32,
+                goal_mhz: Some(40.0),
+            },
+            Target::Xilinx => Device {
+                name: "XC7S25 (Spartan-7)",
+                package: "csga324",
+                luts: 14_600,
+                flip_flops: 29_200,
+                dsp: 80,
+                bram: 45,
+                goal_mhz: None,
+            },
+        }
+    }
+
+    /// Parses a comma-separated list of target names (`all`: every target), in report order
+    /// without repeats.
+    ///
+    /// # Errors
+    /// A message naming the value and the names allowed.
+    pub fn parse_list(text: &str) -> std::result::Result<Vec<Target>, String> {
+        let mut targets = Vec::new();
+        for name in text.split(',').map(str::trim) {
+            if name == "all" {
+                targets.extend(Target::ALL);
+                continue;
+            }
+            let target = Target::ALL
+                .into_iter()
+                .find(|t| t.name() == name)
+                .ok_or_else(|| {
+                    format!(
+                        "--target {name:?} is not a target: ice40-up5k, ice40-hx8k, xilinx or all, comma-separated"
+                    )
+                })?;
+            targets.push(target);
+        }
+        targets.sort();
+        targets.dedup();
+        Ok(targets)
+    }
+}
+
+impl Serialize for Target {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+/// Parses a comma-separated list of [`BLOCKS`] (`all`: every one), in [`BLOCKS`]'s order.
+///
+/// # Errors
+/// A message naming the value and the names allowed.
+pub fn parse_blocks(text: &str) -> std::result::Result<Vec<&'static str>, String> {
+    let mut chosen = Vec::new();
+    for name in text.split(',').map(str::trim) {
+        if name == "all" {
+            chosen.extend(BLOCKS);
+            continue;
+        }
+        let block = BLOCKS.iter().find(|b| **b == name).ok_or_else(|| {
+            format!(
+                "--blocks {name:?} is not a placed block: {} or all, comma-separated",
+                BLOCKS.join(", ")
+            )
+        })?;
+        chosen.push(*block);
+    }
+    Ok(BLOCKS
+        .iter()
+        .copied()
+        .filter(|b| chosen.contains(b))
+        .collect())
+}
+
+/// One block on one target.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Placement {
+    /// The target.
+    pub target: Target,
+    /// Its part.
+    pub device: &'static str,
+    /// Its package.
+    pub package: &'static str,
+    /// The block (registry name).
+    pub block: &'static str,
+    /// Its module.
+    pub module: &'static str,
+    /// iCE40: SB_LUT4 cells of the block (yosys).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lut4: Option<u64>,
+    /// Xilinx: LUT1..LUT6 cells of the block (yosys `synth_xilinx`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lut6: Option<u64>,
+    /// Flip-flops of the block.
+    pub ff: u64,
+    /// SB_MAC16 or DSP48E1 blocks.
+    pub dsp: u64,
+    /// Block RAMs (SB_RAM40_4K; RAMB36E1 + RAMB18E1 / 2).
+    pub bram: u64,
+    /// Carry cells (SB_CARRY, CARRY4).
+    pub carry: u64,
+    /// iCE40: logic cells nextpnr used for the block and its harness (`None` when it does not
+    /// fit).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub logic_cells: Option<u64>,
+    /// Whether it fits the device (iCE40: nextpnr placed and routed it; Xilinx: every count
+    /// within the device's).
+    pub fits: bool,
+    /// Why it does not fit, in words.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub limit: Option<String>,
+    /// nextpnr's maximum clock, MHz (2 decimals); `None` for Xilinx or when it does not fit.
+    pub fmax_mhz: Option<f64>,
+    /// The clock asked for, MHz.
+    pub fmax_goal_mhz: Option<f64>,
+    /// The critical path, in words (from nextpnr's report).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub critical_path: Option<String>,
+    /// Clocks from one sample's `ce` to the next one's, at least.
+    pub clocks_per_sample: u32,
+    /// `fmax / clocks_per_sample`, samples per second.
+    pub max_sample_rate_hz: Option<f64>,
+    /// Its files in the synthesis package: `place_and_route/<block>/<target>/`.
+    pub folder: String,
+}
+
+/// The harness around `block`'s configured module ([`synth::configured_module`]): its inputs
+/// (`rst`, `ce` first) are one shift register loaded from `serial_in`; its outputs are
+/// captured when `capture` is high and shifted out on `serial_out` otherwise. Every port bit
+/// thus reaches a pin, and nothing the block computes can be optimized away.
+pub fn harness(block: &Block) -> String {
+    let clocked = block.clock_ports().len() == 3;
+    let mut inputs: Vec<(String, u32)> = Vec::new();
+    if clocked {
+        inputs.push(("rst".into(), 1));
+        inputs.push(("ce".into(), 1));
+    }
+    inputs.extend(
+        block
+            .inputs
+            .iter()
+            .map(|s| (s.name.to_string(), s.format.width)),
+    );
+    let outputs: Vec<(String, u32)> = block
+        .outputs
+        .iter()
+        .map(|o| (o.signal.name.to_string(), o.signal.format.width))
+        .collect();
+    let declare = |kind: &str, (name, width): &(String, u32), init: bool| {
+        let range = if *width > 1 {
+            format!("[{}:0] ", width - 1)
+        } else {
+            String::new()
+        };
+        let init = if init {
+            format!(" = {{{width}{{1'b0}}}}")
+        } else {
+            String::new()
+        };
+        format!("{kind} {range}{name}{init};\n")
+    };
+    let in_bits: u32 = inputs.iter().map(|(_, w)| w).sum();
+    let out_bits: u32 = outputs.iter().map(|(_, w)| w).sum();
+    let names = |list: &[(String, u32)]| {
+        list.iter()
+            .map(|(n, _)| n.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let mut ports: Vec<String> = Vec::new();
+    if clocked {
+        ports.push("    .clk(clk)".into());
+    }
+    ports.extend(inputs.iter().map(|(n, _)| format!("    .{n}({n})")));
+    ports.extend(outputs.iter().map(|(n, _)| format!("    .{n}({n})")));
+    format!(
+        "`default_nettype none\n\
+         // Place-and-route harness of {module}: {in_bits} input bits from one shift register,\n\
+         // {out_bits} output bits captured and shifted out, 4 pins.\n\
+         module {HARNESS} (\n\
+         \x20   input wire clk,\n\
+         \x20   input wire serial_in,\n\
+         \x20   input wire capture,\n\
+         \x20   output wire serial_out\n\
+         );\n\
+         {input_regs}\
+         {output_wires}\
+         reg [{out_top}:0] captured = {{{out_bits}{{1'b0}}}};\n\
+         always @(posedge clk) begin\n\
+         \x20   {{{input_names}}} <= {{{shifted_inputs}serial_in}};\n\
+         \x20   captured <= capture ? {{{output_names}}} : {{1'b0, captured[{out_top}:1]}};\n\
+         end\n\
+         assign serial_out = captured[0];\n\
+         {configured} dut (\n{ports}\n);\n\
+         endmodule\n\
+         `default_nettype wire\n",
+        module = block.module,
+        input_regs = inputs
+            .iter()
+            .map(|i| declare("reg", i, true))
+            .collect::<String>(),
+        output_wires = outputs
+            .iter()
+            .map(|o| declare("wire", o, false))
+            .collect::<String>(),
+        out_top = out_bits.max(2) - 1,
+        input_names = names(&inputs),
+        shifted_inputs = shift_source(&inputs),
+        output_names = names(&outputs),
+        configured = synth::configured_name(block.module),
+        ports = ports.join(",\n"),
+    )
+}
+
+/// The concatenation every input register is loaded from, `serial_in` last: the input bits
+/// shifted one place, `{rst, ce, y_a, ...} <= {ce, y_a, ..., serial_in}` read as one vector.
+fn shift_source(inputs: &[(String, u32)]) -> String {
+    let total: u32 = inputs.iter().map(|(_, w)| w).sum();
+    if total <= 1 {
+        return String::new();
+    }
+    // The inputs as one vector, most significant first, minus its top bit.
+    let mut parts = Vec::new();
+    let mut skip = 1;
+    for (name, width) in inputs {
+        if skip >= *width {
+            skip -= width;
+            continue;
+        }
+        let keep = width - skip;
+        parts.push(if keep == *width {
+            name.clone()
+        } else if keep == 1 {
+            format!("{name}[0]")
+        } else {
+            format!("{name}[{}:0]", keep - 1)
+        });
+        skip = 0;
+    }
+    format!("{}, ", parts.join(", "))
+}
+
+/// The file holding [`harness`].
+const HARNESS_FILE: &str = "harness.v";
+
+/// The yosys script of `target` for `block`, run in the block's folder; it writes
+/// `<target>/stat.json` (and, for iCE40, `<target>/netlist.json` for nextpnr).
+fn yosys_script(block: &Block, target: Target) -> String {
+    let sources: Vec<&str> = synth::sources(block.module)
+        .iter()
+        .map(|(n, _)| *n)
+        .collect();
+    let configured = synth::configured_name(block.module);
+    let folder = target.name();
+    match target {
+        Target::Xilinx => format!(
+            "read_verilog {sources} {config}\n\
+             hierarchy -check -top {configured}\n\
+             synth_xilinx -flatten -top {configured}\n\
+             tee -q -o {folder}/stat.json stat -json\n",
+            sources = sources.join(" "),
+            config = synth::CONFIGURED_FILE,
+        ),
+        Target::Ice40Up5k | Target::Ice40Hx8k => format!(
+            "read_verilog {sources} {config} {HARNESS_FILE}\n\
+             hierarchy -check -top {HARNESS}\n\
+             # The block keeps a module of its own, so that its statistics leave the harness out.\n\
+             setattr -mod -set keep_hierarchy 1 {configured}\n\
+             synth_ice40 {dsp}-top {HARNESS} -json {folder}/netlist.json\n\
+             tee -q -o {folder}/stat.json stat -json\n",
+            sources = sources.join(" "),
+            config = synth::CONFIGURED_FILE,
+            dsp = if target == Target::Ice40Up5k {
+                "-dsp "
+            } else {
+                ""
+            },
+        ),
+    }
+}
+
+/// nextpnr's arguments for an iCE40 target, run in the block's folder.
+fn nextpnr_args(target: Target) -> Vec<String> {
+    let device = target.device();
+    let folder = target.name();
+    let part = match target {
+        Target::Ice40Up5k => "--up5k",
+        _ => "--hx8k",
+    };
+    let goal = device.goal_mhz.unwrap_or(12.0);
+    [
+        part.to_string(),
+        "--package".into(),
+        device.package.into(),
+        "--json".into(),
+        format!("{folder}/netlist.json"),
+        "--freq".into(),
+        format!("{goal}"),
+        "--seed".into(),
+        "1".into(),
+        "--timing-allow-fail".into(),
+        "--report".into(),
+        format!("{folder}/report.json"),
+        "-q".into(),
+        "-l".into(),
+        format!("{folder}/nextpnr.log"),
+    ]
+    .to_vec()
+}
+
+/// The shell script that re-derives a target's figures, run from the block's folder.
+fn run_script(target: Target) -> String {
+    let folder = target.name();
+    let mut text = format!(
+        "#!/bin/sh\n\
+         # Re-derives {folder}/stat.json{report}: run from place_and_route/<block>/.\n\
+         set -e\n\
+         yosys -q -l {folder}/yosys.log -s {folder}/synth.ys\n",
+        report = if target == Target::Xilinx {
+            ""
+        } else {
+            " and nextpnr's report.json"
+        },
+    );
+    if target != Target::Xilinx {
+        text.push_str(&format!(
+            "nextpnr-ice40 {}\n",
+            nextpnr_args(target).join(" ")
+        ));
+    }
+    text
+}
+
+/// The cell counts of the module called `module` (or of the only module) in a `stat -json`.
+fn module_cells(path: &Path, module: &str) -> Result<Vec<(String, u64)>> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let json: serde_json::Value = serde_json::from_str(&text)
+        .map_err(|e| Error::Synthesis(format!("yosys wrote unreadable {}: {e}", path.display())))?;
+    let modules = json["modules"]
+        .as_object()
+        .ok_or_else(|| Error::Synthesis(format!("{} lists no module", path.display())))?;
+    let found = modules
+        .iter()
+        .find(|(name, _)| name.trim_start_matches('\\') == module)
+        .or_else(|| {
+            (modules.len() == 1)
+                .then(|| modules.iter().next())
+                .flatten()
+        })
+        .ok_or_else(|| Error::Synthesis(format!("{} has no module {module}", path.display())))?;
+    Ok(found.1["num_cells_by_type"]
+        .as_object()
+        .map(|m| {
+            m.iter()
+                .map(|(k, v)| (k.clone(), v.as_u64().unwrap_or(0)))
+                .collect()
+        })
+        .unwrap_or_default())
+}
+
+fn sum(cells: &[(String, u64)], keep: impl Fn(&str) -> bool) -> u64 {
+    cells.iter().filter(|(k, _)| keep(k)).map(|(_, n)| n).sum()
+}
+
+/// Runs `program` with `args` in `dir`; `Ok(None)` when it succeeded, else what it printed.
+fn run_tool(dir: &Path, program: &str, args: &[String]) -> Result<Option<String>> {
+    let output = Command::new(program)
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .map_err(|e| Error::Synthesis(format!("cannot run {program} (is it installed?): {e}")))?;
+    Ok((!output.status.success()).then(|| {
+        format!(
+            "{}{}",
+            String::from_utf8_lossy(&output.stdout),
+            String::from_utf8_lossy(&output.stderr)
+        )
+    }))
+}
+
+/// The last lines of a log, for an error message.
+fn log_tail(path: &Path) -> String {
+    let text = std::fs::read_to_string(path).unwrap_or_default();
+    let lines: Vec<&str> = text
+        .lines()
+        .filter(|l| !l.contains("negative timing budget"))
+        .collect();
+    lines[lines.len().saturating_sub(15)..].join("\n")
+}
+
+/// The first resource of nextpnr's device utilisation that a design uses more of than the
+/// device has: (bel type, used, available). nextpnr prints the table before it places, then
+/// fails to place such a design.
+fn over_capacity(log: &str) -> Option<(String, u64, u64)> {
+    log.lines().find_map(|line| {
+        let rest = line.strip_prefix("Info:")?.trim();
+        let (kind, counts) = rest.split_once(':')?;
+        let (used, available) = counts.split_once('/')?;
+        let used: u64 = used.trim().parse().ok()?;
+        let available: u64 = available.split_whitespace().next()?.parse().ok()?;
+        (used > available).then(|| (kind.trim().to_string(), used, available))
+    })
+}
+
+/// A net's name as the report shows it: inside the block without the wrapper's path and
+/// yosys's suffixes (`kf.rate_next[23]`); a port of the block by its name (`bias_a[2]`).
+fn net_name(net: &str) -> String {
+    // The wrapper's own nets are named `dut.<port>`, the block's `dut.configured.<net>`.
+    let inside = net
+        .strip_prefix("dut.configured.")
+        .or_else(|| net.strip_prefix("dut."))
+        .unwrap_or(net);
+    match inside.find("_SB_") {
+        Some(cut) if cut > 0 => inside[..cut].to_string(),
+        _ => inside.to_string(),
+    }
+}
+
+/// The register-to-register critical path of nextpnr's `--report` JSON, in words.
+pub fn critical_path_words(report: &serde_json::Value) -> Option<String> {
+    let path = report["critical_paths"].as_array()?.iter().find(|p| {
+        p["from"].as_str().is_some_and(|f| f.starts_with("posedge"))
+            && p["to"].as_str().is_some_and(|t| t.starts_with("posedge"))
+    })?;
+    let (mut cells, mut routing, mut levels) = (0.0, 0.0, 0);
+    let mut nets: Vec<&str> = Vec::new();
+    for segment in path["path"].as_array()? {
+        let delay = segment["delay"].as_f64().unwrap_or(0.0);
+        match segment["type"].as_str() {
+            Some("routing") => {
+                routing += delay;
+                nets.extend(segment["net"].as_str());
+            }
+            Some("logic") => {
+                cells += delay;
+                levels += 1;
+            }
+            _ => cells += delay,
+        }
+    }
+    let (first, last) = (nets.first()?, nets.last()?);
+    // The block's submodules the path crosses, in order (the chain's blocks, inside the top).
+    let mut through: Vec<String> = Vec::new();
+    for net in &nets {
+        let name = net_name(net);
+        if let Some((instance, _)) = name.split_once('.') {
+            if through.last().map(String::as_str) != Some(instance) {
+                through.push(instance.to_string());
+            }
+        }
+    }
+    let through = if through.len() > 1 {
+        format!(" through {}", through.join(" → "))
+    } else {
+        String::new()
+    };
+    Some(format!(
+        "{total:.1} ns from {first} to {last}{through}: {levels} logic cells ({cells:.1} ns) and {routing:.1} ns of routing",
+        total = cells + routing,
+        first = net_name(first),
+        last = net_name(last),
+    ))
+}
+
+/// Rounds a clock to 2 decimals (nextpnr prints its own to 2).
+fn mhz(value: f64) -> f64 {
+    (value * 100.0).round() / 100.0
+}
+
+/// Places one block on one target in `dir` (the block's folder, holding its design files and
+/// harness).
+fn place(dir: &Path, block: &Block, target: Target) -> Result<Placement> {
+    let device = target.device();
+    let folder = dir.join(target.name());
+    std::fs::create_dir_all(&folder).map_err(|e| Error::io(&folder, e))?;
+    for (name, text) in [
+        ("synth.ys", yosys_script(block, target)),
+        ("run.sh", run_script(target)),
+    ] {
+        let path = folder.join(name);
+        std::fs::write(&path, text).map_err(|e| Error::io(&path, e))?;
+    }
+    let yosys_log = PathBuf::from(target.name()).join("yosys.log");
+    let yosys_args: Vec<String> = [
+        "-q".to_string(),
+        "-l".into(),
+        yosys_log.display().to_string(),
+        "-s".into(),
+        format!("{}/synth.ys", target.name()),
+    ]
+    .to_vec();
+    if let Some(printed) = run_tool(dir, "yosys", &yosys_args)? {
+        return Err(Error::Synthesis(format!(
+            "yosys failed on {} for {}:\n{}\n{printed}",
+            block.name,
+            target.name(),
+            log_tail(&dir.join(&yosys_log))
+        )));
+    }
+    let cells = module_cells(
+        &folder.join("stat.json"),
+        &synth::configured_name(block.module),
+    )?;
+    let mut placement = Placement {
+        target,
+        device: device.name,
+        package: device.package,
+        block: block.name,
+        module: block.module,
+        lut4: None,
+        lut6: None,
+        ff: 0,
+        dsp: 0,
+        bram: 0,
+        carry: 0,
+        logic_cells: None,
+        fits: true,
+        limit: None,
+        fmax_mhz: None,
+        fmax_goal_mhz: device.goal_mhz,
+        critical_path: None,
+        clocks_per_sample: 1 + block.settle_clocks,
+        max_sample_rate_hz: None,
+        folder: format!("{FOLDER}/{}/{}", block.name, target.name()),
+    };
+    if target == Target::Xilinx {
+        placement.lut6 = Some(sum(&cells, |k| k.starts_with("LUT")));
+        placement.ff = sum(&cells, |k| ["FDRE", "FDSE", "FDCE", "FDPE"].contains(&k));
+        placement.dsp = sum(&cells, |k| k.starts_with("DSP48"));
+        placement.bram =
+            sum(&cells, |k| k == "RAMB36E1") + sum(&cells, |k| k == "RAMB18E1").div_ceil(2);
+        placement.carry = sum(&cells, |k| k == "CARRY4");
+        let over = [
+            ("LUTs", placement.lut6.unwrap_or(0), device.luts),
+            ("flip-flops", placement.ff, device.flip_flops),
+            ("DSP48E1", placement.dsp, device.dsp),
+            ("block RAMs", placement.bram, device.bram),
+        ]
+        .into_iter()
+        .find(|(_, used, available)| used > available);
+        if let Some((what, used, available)) = over {
+            placement.fits = false;
+            placement.limit = Some(format!(
+                "{used} {what}, the {} has {available}",
+                device.name
+            ));
+        }
+        return Ok(placement);
+    }
+    placement.lut4 = Some(sum(&cells, |k| k == "SB_LUT4"));
+    placement.ff = sum(&cells, |k| k.starts_with("SB_DFF"));
+    placement.dsp = sum(&cells, |k| k == "SB_MAC16");
+    placement.bram = sum(&cells, |k| k.starts_with("SB_RAM"));
+    placement.carry = sum(&cells, |k| k == "SB_CARRY");
+    // A block that needs more multipliers or RAMs than the device has cannot be placed:
+    // say so without running nextpnr.
+    let over = [
+        ("SB_MAC16", placement.dsp, device.dsp),
+        ("block RAMs", placement.bram, device.bram),
+    ]
+    .into_iter()
+    .find(|(_, used, available)| used > available);
+    if let Some((what, used, available)) = over {
+        placement.fits = false;
+        placement.limit = Some(format!(
+            "{used} {what}, the {} has {available}",
+            device.name
+        ));
+        return Ok(placement);
+    }
+    let log = PathBuf::from(target.name()).join("nextpnr.log");
+    if let Some(printed) = run_tool(dir, "nextpnr-ice40", &nextpnr_args(target))? {
+        let text = std::fs::read_to_string(dir.join(&log)).unwrap_or_default();
+        let Some((kind, used, available)) = over_capacity(&text) else {
+            return Err(Error::Synthesis(format!(
+                "nextpnr-ice40 failed on {} for {}:\n{}\n{printed}",
+                block.name,
+                target.name(),
+                log_tail(&dir.join(&log))
+            )));
+        };
+        placement.fits = false;
+        placement.limit = Some(match kind.as_str() {
+            "ICESTORM_LC" => format!(
+                "{used} logic cells, the {} has {available} ({} LUT4, {} flip-flops, {} carries in the block alone)",
+                device.name,
+                placement.lut4.unwrap_or(0),
+                placement.ff,
+                placement.carry
+            ),
+            other => format!("{used} {other}, the {} has {available}", device.name),
+        });
+        return Ok(placement);
+    }
+    let path = folder.join("report.json");
+    let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
+    let report: serde_json::Value = serde_json::from_str(&text).map_err(|e| {
+        Error::Synthesis(format!("nextpnr wrote unreadable {}: {e}", path.display()))
+    })?;
+    placement.logic_cells = report["utilization"]["ICESTORM_LC"]["used"].as_u64();
+    placement.fmax_mhz = report["fmax"]
+        .as_object()
+        .and_then(|clocks| clocks.values().next())
+        .and_then(|clock| clock["achieved"].as_f64())
+        .map(mhz);
+    placement.critical_path = critical_path_words(&report);
+    placement.max_sample_rate_hz = placement
+        .fmax_mhz
+        .map(|f| (f * 1e6 / f64::from(placement.clocks_per_sample)).round());
+    Ok(placement)
+}
+
+/// Places `names` (from [`BLOCKS`]) of `job` on `targets` in `work`, `jobs` at a time, and
+/// adds every block's design files, scripts, statistics, reports and logs to `package` under
+/// [`FOLDER`]. Results in target order, then block order.
+///
+/// # Errors
+/// A yosys or nextpnr failure other than not fitting ([`Error::Synthesis`]), or an I/O error.
+pub fn place_and_route(
+    job: &Job,
+    roms: &RomImages,
+    names: &[&str],
+    targets: &[Target],
+    jobs: usize,
+    work: &Path,
+    package: &mut Package,
+) -> Result<Vec<Placement>> {
+    let designs: Vec<Block> = names
+        .iter()
+        .map(|name| blocks::find(name).block(job, roms))
+        .collect();
+    let mut design_files = Vec::new();
+    for block in &designs {
+        let dir = work.join(FOLDER).join(block.name);
+        std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+        let mut files = synth::design_files(block);
+        files.push((HARNESS_FILE.into(), harness(block)));
+        for (name, text) in &files {
+            let path = dir.join(name);
+            std::fs::write(&path, text).map_err(|e| Error::io(&path, e))?;
+        }
+        design_files.push(files);
+    }
+    let tasks: Vec<(usize, Target)> = targets
+        .iter()
+        .flat_map(|&t| (0..designs.len()).map(move |b| (b, t)))
+        .collect();
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let results: std::sync::Mutex<Vec<Option<Result<Placement>>>> =
+        std::sync::Mutex::new((0..tasks.len()).map(|_| None).collect());
+    std::thread::scope(|scope| {
+        for _ in 0..jobs.clamp(1, tasks.len().max(1)) {
+            scope.spawn(|| loop {
+                let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                let Some(&(b, target)) = tasks.get(i) else {
+                    break;
+                };
+                let block = &designs[b];
+                let result = place(&work.join(FOLDER).join(block.name), block, target);
+                results.lock().expect("no panic holds the lock")[i] = Some(result);
+            });
+        }
+    });
+    let mut placements = Vec::new();
+    for result in results.into_inner().expect("no panic holds the lock") {
+        placements.push(result.expect("every task ran")?);
+    }
+    for (block, files) in designs.iter().zip(&design_files) {
+        let prefix = format!("{FOLDER}/{}", block.name);
+        for (name, text) in files {
+            package.add(format!("{prefix}/{name}"), text.as_str());
+        }
+        for target in targets {
+            let dir = work.join(FOLDER).join(block.name).join(target.name());
+            // yosys's log is left out (6 MB for the gyro loop): `run.sh` writes it again.
+            for name in [
+                "synth.ys",
+                "run.sh",
+                "stat.json",
+                "report.json",
+                "nextpnr.log",
+            ] {
+                let path = dir.join(name);
+                if !path.exists() {
+                    continue;
+                }
+                let data = std::fs::read(&path).map_err(|e| Error::io(&path, e))?;
+                // nextpnr warns once per port whose share of a failing clock is negative:
+                // thousands of lines the report's critical path sums up.
+                let data = if name == "nextpnr.log" {
+                    String::from_utf8_lossy(&data)
+                        .lines()
+                        .filter(|l| !l.contains("negative timing budget"))
+                        .map(|l| format!("{l}\n"))
+                        .collect::<String>()
+                        .into_bytes()
+                } else {
+                    data
+                };
+                package.add(format!("{prefix}/{}/{name}", target.name()), data);
+            }
+        }
+    }
+    Ok(placements)
+}
+
+/// The place-and-route table in Markdown: one row per block and target.
+pub fn table(placements: &[Placement]) -> String {
+    let mut text = String::from(
+        "| target | block | LUT | FF | DSP | BRAM | logic cells | fits | Fmax (MHz) | clocks/sample | max sample rate |\n\
+         |---|---|---:|---:|---:|---:|---:|---|---:|---:|---:|\n",
+    );
+    for p in placements {
+        let luts = match (p.lut4, p.lut6) {
+            (Some(n), _) => format!("{n} LUT4"),
+            (_, Some(n)) => format!("{n} LUT6"),
+            _ => "—".into(),
+        };
+        let fits = if p.fits {
+            "yes".to_string()
+        } else {
+            format!("no: {}", p.limit.as_deref().unwrap_or("too large"))
+        };
+        let fmax = match (p.fmax_mhz, p.fmax_goal_mhz) {
+            (Some(f), Some(goal)) => {
+                format!("{f:.2} ({} {goal})", if f >= goal { "≥" } else { "<" })
+            }
+            (Some(f), None) => format!("{f:.2}"),
+            _ => "—".into(),
+        };
+        let rate = p
+            .max_sample_rate_hz
+            .map(|r| format!("{:.1} MS/s", r / 1e6))
+            .unwrap_or_else(|| "—".into());
+        let cells = p.logic_cells.map_or_else(
+            || "—".to_string(),
+            |n| {
+                let available = p.target.device().luts;
+                format!(
+                    "{n} of {available} ({:.0} %)",
+                    100.0 * n as f64 / available as f64
+                )
+            },
+        );
+        text.push_str(&format!(
+            "| {} | {} | {luts} | {} | {} | {} | {cells} | {fits} | {fmax} | {} | {rate} |\n",
+            p.target.name(),
+            p.block,
+            p.ff,
+            p.dsp,
+            p.bram,
+            p.clocks_per_sample,
+        ));
+    }
+    text
+}
+
+/// The place-and-route page of the synthesis package (`place_and_route.md`): the table and the
+/// critical paths, what the README's hardware table is copied from.
+pub fn page(placements: &[Placement], provenance_line: &str) -> String {
+    format!(
+        "{provenance_line}\n# Place and route\n\n{}\nCritical paths:\n\n{}",
+        table(placements),
+        critical_paths(placements)
+    )
+}
+
+/// The critical paths, one line per placed block, for the report.
+pub fn critical_paths(placements: &[Placement]) -> String {
+    placements
+        .iter()
+        .filter_map(|p| {
+            p.critical_path
+                .as_ref()
+                .map(|c| format!("- {} on {}: {c}\n", p.block, p.target.name()))
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests;
