@@ -68,7 +68,15 @@ pub fn run(args: Args) -> Result<ExitCode> {
     let out = folder.out.as_path();
     let config = source.load()?;
     let job = Job::new(config)?;
-    let provenance = source.provenance(&job, Output::Synthesis);
+    let mut provenance = source.provenance(&job, Output::Synthesis);
+    if !place.targets.is_empty() {
+        let names = |list: Vec<&str>| list.join(",");
+        provenance.command.push_str(&format!(
+            " --target {} --blocks {}",
+            names(place.targets.iter().map(|t| t.name()).collect()),
+            names(place.blocks.clone())
+        ));
+    }
     let what = if place.targets.is_empty() {
         "synth: yosys on the chain and the gyro loop".to_string()
     } else {
