@@ -369,6 +369,26 @@ fn an_output_error_budget_is_met_by_the_written_config() {
     assert!(manifest["formats"]["switches"].as_u64().unwrap() <= 20);
     assert!(chain["bound_lsb"].as_f64().unwrap() <= 2.0, "{chain}");
     assert!(chain["max_lsb"].as_f64().unwrap() <= chain["bound_lsb"].as_f64().unwrap());
+    // The mean filter's reciprocal word was chosen for the same budget: its block means too.
+    let written = std::fs::read_to_string(&derived).unwrap();
+    let width_line = table
+        .lines()
+        .last()
+        .unwrap()
+        .split("mean_filter.reciprocal_width = ")
+        .nth(1)
+        .unwrap()
+        .split(' ')
+        .next()
+        .unwrap()
+        .to_string();
+    assert!(
+        written.contains(&format!("reciprocal_width = {width_line}")),
+        "{width_line}: {written}"
+    );
+    let filter = &manifest["mean_filter"]["fixed_vs_float"];
+    assert!(filter["max_lsb"].as_f64().unwrap() <= 2.0, "{filter}");
+    assert!(filter["bound_lsb"].as_f64().unwrap() <= 2.0, "{filter}");
     let output = gyrofx(&["formats", "--output-error", "1"]);
     assert_eq!(output.status.code(), Some(2), "{}", text(&output));
     assert!(

@@ -88,6 +88,11 @@ pub struct Budget {
     pub state: Format,
     /// The chain's bound with them, output LSB.
     pub bound_lsb: f64,
+    /// The mean filter's reciprocal ROM word (`mean_filter.reciprocal_width`): the narrowest
+    /// that keeps its block means within the same budget (in °/s) of its float model.
+    pub mean_filter_reciprocal_width: u32,
+    /// The mean filter's bound with it, in its own output LSB.
+    pub mean_filter_bound_lsb: f64,
 }
 
 /// The most guard bits the budget search tries per block.
@@ -130,8 +135,39 @@ fn kf_at(job: &Job, frac: i32, samples: u64, switches: u64) -> Option<gyrofx_mod
     plan_for(&settings, &job.designs).ok()
 }
 
+/// The narrowest reciprocal ROM word of `job`'s mean filter whose bound
+/// ([`gyrofx_model::mean_filter::Plan::error_bound_lsb`]) is within `budget_dps`, and that
+/// bound in the filter's output LSB.
+///
+/// # Errors
+/// Why no width from 4 to 64 bits meets it (the output rounding alone, or the widest word).
+fn mean_filter_reciprocal_for(
+    job: &Job,
+    budget_dps: f64,
+) -> std::result::Result<(u32, f64), String> {
+    let lsb = job.mean_filter.output.lsb();
+    let budget_lsb = budget_dps / lsb;
+    let mut spec = job.settings.mean_filter.clone();
+    let mut best_bound = f64::INFINITY;
+    for width in 4..=64 {
+        spec.reciprocal_width = width;
+        let Ok(plan) = gyrofx_model::mean_filter::Plan::new(&spec) else {
+            continue;
+        };
+        let bound = plan.error_bound_lsb();
+        if bound <= budget_lsb {
+            return Ok((width, bound));
+        }
+        best_bound = best_bound.min(bound);
+    }
+    Err(format!(
+        "a budget the mean filter can meet too: its block means (mean_filter.output_format, LSB {lsb:e} °/s) come within {best_bound:.3} of their LSB at best, {budget_lsb:.3} asked"
+    ))
+}
+
 /// The fewest guard bits (estimator first, then the KF's state) that keep the chain's output
-/// within `budget_lsb` of its float model over the record.
+/// within `budget_lsb` of its float model over the record, and the mean filter's narrowest
+/// reciprocal word for the same error in °/s.
 ///
 /// # Errors
 /// Why the budget is refused: at or below what the fixed roundings give, or not met by any
@@ -187,17 +223,24 @@ pub fn fractions_for(
                         bias: est.bias,
                         state: kf.state,
                         bound_lsb,
+                        mean_filter_reciprocal_width: 0,
+                        mean_filter_bound_lsb: 0.0,
                     },
                 ));
                 break;
             }
         }
     }
-    best.map(|(_, b)| b).ok_or_else(|| {
+    let mut budget = best.map(|(_, b)| b).ok_or_else(|| {
         refuse(format!(
             "a budget that {MAX_GUARD_BITS} guard bits in the estimator and the KF's state can meet for {samples} samples and {switches} switches"
         ))
-    })
+    })?;
+    let (width, bound) =
+        mean_filter_reciprocal_for(job, budget_lsb * chain.kf.output.lsb()).map_err(refuse)?;
+    budget.mean_filter_reciprocal_width = width;
+    budget.mean_filter_bound_lsb = bound;
+    Ok(budget)
 }
 
 /// Sets the format of `key` in `config`: a format key of an analysed node ([`Row::key`]).
@@ -550,6 +593,7 @@ impl Analysis {
             derived.estimator.mean_format = budget.mean.to_string();
             derived.estimator.bias_format = budget.bias.to_string();
             derived.kf.state_format = budget.state.to_string();
+            derived.mean_filter.reciprocal_width = budget.mean_filter_reciprocal_width;
         }
         Job::new(derived.clone()).map_err(|e| Error::Config {
             field: "derived formats".into(),
@@ -596,6 +640,35 @@ mod tests {
                 .unwrap()
                 .fits());
         }
+    }
+
+    /// The mean filter's reciprocal word is the narrowest meeting the budget: one bit narrower
+    /// misses it; a wider budget never asks for a wider word.
+    #[test]
+    fn the_mean_filters_reciprocal_is_the_narrowest_meeting_the_budget() {
+        let job = default_job();
+        let bound_at = |width: u32| {
+            let mut spec = job.settings.mean_filter.clone();
+            spec.reciprocal_width = width;
+            gyrofx_model::mean_filter::Plan::new(&spec)
+                .unwrap()
+                .error_bound_lsb()
+        };
+        let mut previous = u32::MAX;
+        for budget_lsb in [1.6, 2.0, 3.0, 10.0, 1000.0] {
+            let budget = fractions_for(&job, 10_000, 10, budget_lsb).unwrap();
+            let width = budget.mean_filter_reciprocal_width;
+            // The same °/s budget in the filter's LSB (its output format is the KF's here).
+            assert_eq!(job.mean_filter.output.lsb(), job.chain.kf.output.lsb());
+            assert!(budget.mean_filter_bound_lsb <= budget_lsb, "{budget:?}");
+            assert_eq!(budget.mean_filter_bound_lsb, bound_at(width));
+            assert!(width == 4 || bound_at(width - 1) > budget_lsb, "{budget:?}");
+            assert!(width <= previous, "{budget_lsb}: {width} after {previous}");
+            previous = width;
+        }
+        // The filter's own output rounding (0.5 LSB) is below the chain's floor (1.5 LSB), so
+        // any budget the chain accepts the filter can meet.
+        assert!(bound_at(64) < 1.5);
     }
 
     #[test]

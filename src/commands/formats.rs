@@ -120,6 +120,8 @@ pub fn run(args: Args) -> Result<ExitCode> {
                 "estimator.mean_format": b.mean.to_string(),
                 "estimator.bias_format": b.bias.to_string(),
                 "kf.state_format": b.state.to_string(),
+                "mean_filter.reciprocal_width": b.mean_filter_reciprocal_width,
+                "mean_filter_bound_lsb": b.mean_filter_bound_lsb,
             });
         }
         println!("{}", serde_json::to_string_pretty(&json)?);
@@ -127,8 +129,9 @@ pub fn run(args: Args) -> Result<ExitCode> {
         print!("{}", analysis.text());
         if let Some(b) = &budget {
             println!(
-                "for an output error of at most {:.3} LSB (at least {:.3}: the output's and calibrated samples' roundings): mean_format = {}, bias_format = {}, state_format = {}; bound {:.3} LSB",
-                b.budget_lsb, b.floor_lsb, b.mean, b.bias, b.state, b.bound_lsb
+                "for an output error of at most {:.3} LSB (at least {:.3}: the output's and calibrated samples' roundings): mean_format = {}, bias_format = {}, state_format = {}; bound {:.3} LSB; mean_filter.reciprocal_width = {} (bound {:.3} LSB of its output)",
+                b.budget_lsb, b.floor_lsb, b.mean, b.bias, b.state, b.bound_lsb,
+                b.mean_filter_reciprocal_width, b.mean_filter_bound_lsb
             );
         }
     }
