@@ -147,7 +147,7 @@ fn mean_filter_reciprocal_for(
 ) -> std::result::Result<(u32, f64), String> {
     let lsb = job.mean_filter.output.lsb();
     let budget_lsb = budget_dps / lsb;
-    let mut spec = job.settings.mean_filter.clone();
+    let mut spec = job.settings.mean_filter;
     let mut best_bound = f64::INFINITY;
     for width in 4..=64 {
         spec.reciprocal_width = width;
@@ -648,7 +648,7 @@ mod tests {
     fn the_mean_filters_reciprocal_is_the_narrowest_meeting_the_budget() {
         let job = default_job();
         let bound_at = |width: u32| {
-            let mut spec = job.settings.mean_filter.clone();
+            let mut spec = job.settings.mean_filter;
             spec.reciprocal_width = width;
             gyrofx_model::mean_filter::Plan::new(&spec)
                 .unwrap()
