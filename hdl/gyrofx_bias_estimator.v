@@ -24,8 +24,15 @@
  *   ROM_FILE holds G: 2*W words for A's row, then 2*W for B's, each GAIN_W bits.
  *   Power-of-two gains are constants that synthesis reduces to shifts.
  *
- * Latency: bias_a, bias_b, estimated are registers, updated on the ce of a
- *   window's last sample and visible from the next clock. rst is synchronous.
+ * Pipeline: the running sums update on ce; an interval's end runs five
+ *   register stages, one sample at a time: the sums (clock 1), their products
+ *   by RECIP (2), the rounded means stored (3), the gain products (4), the dot
+ *   products (5); the estimates update on the clock after (bias_a, bias_b,
+ *   estimated are valid 6 clocks after the ce of a window's last sample).
+ *   ce at most every 6th clock: a sample's calibration reads the estimates of
+ *   the windows before it. One product, sum or requantizer per clock
+ *   (timing: docs/blocks/estimator.md). rst is synchronous and clears the
+ *   pipeline too.
  */
 module gyrofx_bias_estimator #(
     // gyro samples: width and fraction bits
@@ -110,6 +117,18 @@ initial begin
     end
 end
 
+// The interval's end moving down the pipeline: the sums and which means they end (stage 1),
+// the scaled sums (2), the means stored (3), the gain products (4), the dot products (5).
+reg signed [ACC_W-1:0] total_a_reg = {ACC_W{1'b0}};
+reg signed [ACC_W-1:0] total_b_reg = {ACC_W{1'b0}};
+reg [1:0] done_a_stage = 2'b00;
+reg [1:0] done_b_stage = 2'b00;
+reg [4:0] window_stage = 5'b00000;
+reg [INTERVAL_W-1:0] interval_a_1 = {INTERVAL_W{1'b0}};
+reg [INTERVAL_W-1:0] interval_b_1 = {INTERVAL_W{1'b0}};
+reg [INTERVAL_W-1:0] interval_a_2 = {INTERVAL_W{1'b0}};
+reg [INTERVAL_W-1:0] interval_b_2 = {INTERVAL_W{1'b0}};
+
 // Running sums including the current sample.
 wire signed [ACC_W-1:0] y_a_acc = blank_a ? {ACC_W{1'b0}} : {{(ACC_W-IN_W){y_a[IN_W-1]}}, y_a};
 wire signed [ACC_W-1:0] y_b_acc = blank_b ? {ACC_W{1'b0}} : {{(ACC_W-IN_W){y_b[IN_W-1]}}, y_b};
@@ -118,8 +137,8 @@ wire signed [ACC_W-1:0] total_b = acc_b_reg + y_b_acc;
 
 // Interval means.
 wire signed [RECIP_W-1:0] recip = RECIP;
-wire signed [PRODUCT_W-1:0] scaled_a = total_a * recip;
-wire signed [PRODUCT_W-1:0] scaled_b = total_b * recip;
+reg signed [PRODUCT_W-1:0] scaled_a = {PRODUCT_W{1'b0}};
+reg signed [PRODUCT_W-1:0] scaled_b = {PRODUCT_W{1'b0}};
 wire signed [MEAN_W-1:0] mean_a_new;
 wire signed [MEAN_W-1:0] mean_b_new;
 
@@ -134,25 +153,30 @@ gyrofx_quantize #(
     .ROUNDING(ROUNDING), .SATURATE(SATURATE)
 ) quantize_mean_b (.in(scaled_b), .out(mean_b_new), .overflow());
 
-// Dot products over the means of this window, this sample's new means included.
-wire signed [DOT_W-1:0] dot_a;
-wire signed [DOT_W-1:0] dot_b;
+// Dot products over the means of this window (this sample's new means stored by now).
+wire signed [DOT_W-1:0] dot_a_next;
+wire signed [DOT_W-1:0] dot_b_next;
+reg signed [DOT_W-1:0] dot_a = {DOT_W{1'b0}};
+reg signed [DOT_W-1:0] dot_b = {DOT_W{1'b0}};
 
 genvar j;
 generate
     for (j = 0; j < TERMS; j = j + 1) begin : g_term
-        localparam [31:0] INTERVAL_32 = j / 2;
-        localparam [INTERVAL_W-1:0] INTERVAL = INTERVAL_32[INTERVAL_W-1:0];
         wire signed [MEAN_W-1:0] mean;
         if (j % 2 == 0) begin : g_a
-            assign mean = (done_a && interval_a == INTERVAL) ? mean_a_new : mean_a_reg[j / 2];
+            assign mean = mean_a_reg[j / 2];
         end else begin : g_b
-            assign mean = (done_b && interval_b == INTERVAL) ? mean_b_new : mean_b_reg[j / 2];
+            assign mean = mean_b_reg[j / 2];
         end
         wire signed [GAIN_W-1:0] gain_a = gain_rom[j];
         wire signed [GAIN_W-1:0] gain_b = gain_rom[TERMS + j];
-        wire signed [TERM_W-1:0] term_a = gain_a * mean;
-        wire signed [TERM_W-1:0] term_b = gain_b * mean;
+        reg signed [TERM_W-1:0] term_a = {TERM_W{1'b0}};
+        reg signed [TERM_W-1:0] term_b = {TERM_W{1'b0}};
+        // Loaded on every clock: read only on the clock after the one that loads the window's.
+        always @(posedge clk) begin
+            term_a <= gain_a * mean;
+            term_b <= gain_b * mean;
+        end
         wire signed [DOT_W-1:0] term_a_wide = {{(DOT_W-TERM_W){term_a[TERM_W-1]}}, term_a};
         wire signed [DOT_W-1:0] term_b_wide = {{(DOT_W-TERM_W){term_b[TERM_W-1]}}, term_b};
         // Running sums, chained from block to block.
@@ -168,8 +192,8 @@ generate
     end
 endgenerate
 
-assign dot_a = g_term[TERMS - 1].sum_a;
-assign dot_b = g_term[TERMS - 1].sum_b;
+assign dot_a_next = g_term[TERMS - 1].sum_a;
+assign dot_b_next = g_term[TERMS - 1].sum_b;
 
 wire signed [BIAS_W-1:0] new_a;
 wire signed [BIAS_W-1:0] new_b;
@@ -206,19 +230,37 @@ gyrofx_quantize #(
 wire use_smoothing = estimated_reg && (SMOOTH > 0);
 
 always @(posedge clk) begin
+    done_a_stage <= {done_a_stage[0], ce && done_a};
+    done_b_stage <= {done_b_stage[0], ce && done_b};
+    window_stage <= {window_stage[3:0], ce && window_done};
     if (ce) begin
         acc_a_reg <= done_a ? {ACC_W{1'b0}} : total_a;
         acc_b_reg <= done_b ? {ACC_W{1'b0}} : total_b;
-        if (done_a) mean_a_reg[interval_a] <= mean_a_new;
-        if (done_b) mean_b_reg[interval_b] <= mean_b_new;
-        if (window_done) begin
-            bias_a_reg <= use_smoothing ? smooth_a : new_a;
-            bias_b_reg <= use_smoothing ? smooth_b : new_b;
-            estimated_reg <= 1'b1;
-        end
+    end
+    // The pipeline's data registers load on every clock: each is read only on the clock after
+    // the one that loads the sample's (fewer enables: the iCE40 shares one per logic block).
+    total_a_reg <= total_a;
+    total_b_reg <= total_b;
+    interval_a_1 <= interval_a;
+    interval_b_1 <= interval_b;
+    scaled_a <= total_a_reg * recip;
+    scaled_b <= total_b_reg * recip;
+    interval_a_2 <= interval_a_1;
+    interval_b_2 <= interval_b_1;
+    dot_a <= dot_a_next;
+    dot_b <= dot_b_next;
+    if (done_a_stage[1]) mean_a_reg[interval_a_2] <= mean_a_new;
+    if (done_b_stage[1]) mean_b_reg[interval_b_2] <= mean_b_new;
+    if (window_stage[4]) begin
+        bias_a_reg <= use_smoothing ? smooth_a : new_a;
+        bias_b_reg <= use_smoothing ? smooth_b : new_b;
+        estimated_reg <= 1'b1;
     end
 
     if (rst) begin
+        done_a_stage <= 2'b00;
+        done_b_stage <= 2'b00;
+        window_stage <= 5'b00000;
         acc_a_reg <= {ACC_W{1'b0}};
         acc_b_reg <= {ACC_W{1'b0}};
         for (i = 0; i < INTERVALS; i = i + 1) begin

@@ -20,8 +20,12 @@
 --   ROM_FILE holds G: 2*W words for A's row, then 2*W for B's, each GAIN_W bits.
 --   RECIP is the RECIP_W-bit code of 1/(L - M) (e.g. 18x"1d41d").
 --
--- Latency: bias_a, bias_b, estimated are registers, updated on the ce of a
---   window's last sample and visible from the next clock. rst is synchronous.
+-- Pipeline: the running sums update on ce; an interval's end runs five
+--   register stages, one sample at a time: the sums (clock 1), their products
+--   by RECIP (2), the rounded means stored (3), the gain products (4), the dot
+--   products (5); the estimates update on the clock after (bias_a, bias_b,
+--   estimated are valid 6 clocks after the ce of a window's last sample).
+--   ce at most every 6th clock. rst is synchronous and clears the pipeline too.
 
 library ieee;
 use ieee.std_logic_1164.all;
@@ -117,14 +121,30 @@ architecture rtl of gyrofx_bias_estimator is
     signal bias_b_reg : signed(BIAS_W - 1 downto 0) := (others => '0');
     signal estimated_reg : std_logic := '0';
 
+    type term_array is array (0 to TERMS - 1) of signed(TERM_W - 1 downto 0);
+
     signal total_a : signed(ACC_W - 1 downto 0);
     signal total_b : signed(ACC_W - 1 downto 0);
-    signal scaled_a : signed(PRODUCT_W - 1 downto 0);
-    signal scaled_b : signed(PRODUCT_W - 1 downto 0);
+    -- The interval's end moving down the pipeline: the sums and which means they end
+    -- (stage 1), the scaled sums (2), the means stored (3), the gain products (4), the dot
+    -- products (5).
+    signal total_a_reg : signed(ACC_W - 1 downto 0) := (others => '0');
+    signal total_b_reg : signed(ACC_W - 1 downto 0) := (others => '0');
+    signal done_a_stage : std_logic_vector(1 downto 0) := (others => '0');
+    signal done_b_stage : std_logic_vector(1 downto 0) := (others => '0');
+    signal window_stage : std_logic_vector(4 downto 0) := (others => '0');
+    signal interval_a_1 : unsigned(INTERVAL_W - 1 downto 0) := (others => '0');
+    signal interval_b_1 : unsigned(INTERVAL_W - 1 downto 0) := (others => '0');
+    signal interval_a_2 : unsigned(INTERVAL_W - 1 downto 0) := (others => '0');
+    signal interval_b_2 : unsigned(INTERVAL_W - 1 downto 0) := (others => '0');
+    signal scaled_a : signed(PRODUCT_W - 1 downto 0) := (others => '0');
+    signal scaled_b : signed(PRODUCT_W - 1 downto 0) := (others => '0');
     signal mean_a_new : signed(MEAN_W - 1 downto 0);
     signal mean_b_new : signed(MEAN_W - 1 downto 0);
-    signal dot_a : signed(DOT_W - 1 downto 0);
-    signal dot_b : signed(DOT_W - 1 downto 0);
+    signal term_a_reg : term_array := (others => (others => '0'));
+    signal term_b_reg : term_array := (others => (others => '0'));
+    signal dot_a : signed(DOT_W - 1 downto 0) := (others => '0');
+    signal dot_b : signed(DOT_W - 1 downto 0) := (others => '0');
     signal new_a : signed(BIAS_W - 1 downto 0);
     signal new_b : signed(BIAS_W - 1 downto 0);
     signal smooth_a_sum : signed(SMOOTH_W - 1 downto 0);
@@ -145,10 +165,8 @@ begin
     total_a <= acc_a_reg + (resize(y_a, ACC_W) and (ACC_W - 1 downto 0 => not blank_a));
     total_b <= acc_b_reg + (resize(y_b, ACC_W) and (ACC_W - 1 downto 0 => not blank_b));
 
-    -- Interval means. Only an interval's last sample stores one: multiplying there alone
-    -- keeps simulation fast (numeric_std multiplies bit by bit) for one AND per bit.
-    scaled_a <= total_a * RECIP_CODE when done_a = '1' else (others => '0');
-    scaled_b <= total_b * RECIP_CODE when done_b = '1' else (others => '0');
+    -- Interval means: the scaled sums are registers, multiplied only at an interval's end
+    -- (which keeps GHDL, whose numeric_std multiplies bit by bit, fast).
 
     quantize_mean_a : entity work.gyrofx_quantize
         generic map (
@@ -163,43 +181,6 @@ begin
             ROUNDING => ROUNDING, SATURATE => SATURATE
         )
         port map (value_in => scaled_b, value_out => mean_b_new, overflow => open);
-
-    -- Dot products over the means of this window, this sample's new means included;
-    -- sums wrap at DOT_W bits exactly like the Verilog chain of adders. Only a window's
-    -- last sample uses them: elsewhere they are 0, which spares the simulator 4*W
-    -- multiplies per sample for one AND per bit.
-    dot_products : process (all)
-        variable sum_a : signed(DOT_W - 1 downto 0);
-        variable sum_b : signed(DOT_W - 1 downto 0);
-        variable mean : signed(MEAN_W - 1 downto 0);
-        variable term_a : signed(TERM_W - 1 downto 0);
-        variable term_b : signed(TERM_W - 1 downto 0);
-    begin
-        sum_a := (others => '0');
-        sum_b := (others => '0');
-        for j in 0 to TERMS - 1 loop
-            exit when window_done = '0';
-            if j mod 2 = 0 then
-                if done_a = '1' and interval_a = j / 2 then
-                    mean := mean_a_new;
-                else
-                    mean := mean_a_reg(j / 2);
-                end if;
-            else
-                if done_b = '1' and interval_b = j / 2 then
-                    mean := mean_b_new;
-                else
-                    mean := mean_b_reg(j / 2);
-                end if;
-            end if;
-            term_a := signed(GAINS(j)) * mean;
-            term_b := signed(GAINS(TERMS + j)) * mean;
-            sum_a := sum_a + resize(term_a, DOT_W);
-            sum_b := sum_b + resize(term_b, DOT_W);
-        end loop;
-        dot_a <= sum_a;
-        dot_b <= sum_b;
-    end process;
 
     quantize_new_a : entity work.gyrofx_quantize
         generic map (
@@ -238,34 +219,82 @@ begin
     use_smoothing <= estimated_reg = '1' and SMOOTH > 0;
 
     registers : process (clk)
+        variable sum_a : signed(DOT_W - 1 downto 0);
+        variable sum_b : signed(DOT_W - 1 downto 0);
+        variable mean : signed(MEAN_W - 1 downto 0);
     begin
         if rising_edge(clk) then
+            done_a_stage <= done_a_stage(0) & (ce and done_a);
+            done_b_stage <= done_b_stage(0) & (ce and done_b);
+            window_stage <= window_stage(3 downto 0) & (ce and window_done);
             if ce = '1' then
                 if done_a = '1' then
                     acc_a_reg <= (others => '0');
-                    mean_a_reg(to_integer(interval_a)) <= mean_a_new;
                 else
                     acc_a_reg <= total_a;
                 end if;
                 if done_b = '1' then
                     acc_b_reg <= (others => '0');
-                    mean_b_reg(to_integer(interval_b)) <= mean_b_new;
                 else
                     acc_b_reg <= total_b;
                 end if;
-                if window_done = '1' then
-                    if use_smoothing then
-                        bias_a_reg <= smooth_a;
-                        bias_b_reg <= smooth_b;
+                total_a_reg <= total_a;
+                total_b_reg <= total_b;
+                interval_a_1 <= interval_a;
+                interval_b_1 <= interval_b;
+            end if;
+            if done_a_stage(0) = '1' then
+                scaled_a <= total_a_reg * RECIP_CODE;
+                interval_a_2 <= interval_a_1;
+            end if;
+            if done_b_stage(0) = '1' then
+                scaled_b <= total_b_reg * RECIP_CODE;
+                interval_b_2 <= interval_b_1;
+            end if;
+            if done_a_stage(1) = '1' then
+                mean_a_reg(to_integer(interval_a_2)) <= mean_a_new;
+            end if;
+            if done_b_stage(1) = '1' then
+                mean_b_reg(to_integer(interval_b_2)) <= mean_b_new;
+            end if;
+            -- The gain products of the window's means, then their sums, which wrap at DOT_W
+            -- bits exactly like the Verilog chain of adders.
+            if window_stage(2) = '1' then
+                for j in 0 to TERMS - 1 loop
+                    if j mod 2 = 0 then
+                        mean := mean_a_reg(j / 2);
                     else
-                        bias_a_reg <= new_a;
-                        bias_b_reg <= new_b;
+                        mean := mean_b_reg(j / 2);
                     end if;
-                    estimated_reg <= '1';
+                    term_a_reg(j) <= signed(GAINS(j)) * mean;
+                    term_b_reg(j) <= signed(GAINS(TERMS + j)) * mean;
+                end loop;
+            end if;
+            if window_stage(3) = '1' then
+                sum_a := (others => '0');
+                sum_b := (others => '0');
+                for j in 0 to TERMS - 1 loop
+                    sum_a := sum_a + resize(term_a_reg(j), DOT_W);
+                    sum_b := sum_b + resize(term_b_reg(j), DOT_W);
+                end loop;
+                dot_a <= sum_a;
+                dot_b <= sum_b;
+            end if;
+            if window_stage(4) = '1' then
+                if use_smoothing then
+                    bias_a_reg <= smooth_a;
+                    bias_b_reg <= smooth_b;
+                else
+                    bias_a_reg <= new_a;
+                    bias_b_reg <= new_b;
                 end if;
+                estimated_reg <= '1';
             end if;
 
             if rst = '1' then
+                done_a_stage <= (others => '0');
+                done_b_stage <= (others => '0');
+                window_stage <= (others => '0');
                 acc_a_reg <= (others => '0');
                 acc_b_reg <= (others => '0');
                 mean_a_reg <= (others => (others => '0'));

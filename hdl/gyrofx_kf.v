@@ -19,8 +19,14 @@
  *   Everything before a Q(.) is exact: widths are derived below by the same
  *   rules as the model (add: +1 bit, multiply: widths add).
  *
- * Pipeline: one register stage. rate_out and out_valid are valid 1 clock after
- *   ce. A clock with rst high clears x1, x2 and out_valid (rst wins over ce).
+ * Pipeline: four register stages, one sample at a time: e and the ROM word
+ *   (clock 1), the products g1*e and g2*e (clock 2), the states (clock 3),
+ *   rate_out from the new x1 (clock 4). rate_out and out_valid are valid 4
+ *   clocks after ce; ce at most every 3rd clock (the next e needs the new
+ *   states). Registering e, the products and the output's rounding keeps the
+ *   recursion's path to one product or one sum and requantizer (timing:
+ *   docs/blocks/kf.md). A clock with rst high clears x1, x2, the pipeline and
+ *   out_valid (rst wins over ce).
  *
  * ROM: ROM_FILE ($readmemh), ROM_DEPTH words of G1_W+G2_W bits, word = {g1, g2}.
  *   bw_sel must address a word (< ROM_DEPTH).
@@ -100,21 +106,25 @@ reg signed [STATE_W-1:0] x1_reg = {STATE_W{1'b0}};
 reg signed [STATE_W-1:0] x2_reg = {STATE_W{1'b0}};
 reg signed [OUT_W-1:0] rate_reg = {OUT_W{1'b0}};
 reg valid_reg = 1'b0;
+// The sample's place in the pipeline: [0] e and the gains held, [1] the products, [2] the
+// states updated.
+reg [2:0] stage = 3'b000;
 
 wire [G1_W+G2_W-1:0] rom_word = rom[bw_sel];
-wire signed [G1_W-1:0] g1 = rom_word[G1_W+G2_W-1:G2_W];
-wire signed [G2_W-1:0] g2 = rom_word[G2_W-1:0];
+reg signed [G1_W-1:0] g1 = {G1_W{1'b0}};
+reg signed [G2_W-1:0] g2 = {G2_W{1'b0}};
 
 // e = z - x1 - x2 at STATE_F fraction bits, exact.
 wire signed [E_W-1:0] z_e = {{(E_W-IN_W){z[IN_W-1]}}, z};
 wire signed [E_W-1:0] z_aligned = z_e <<< GUARD;
 wire signed [E_W-1:0] x1_e = {{(E_W-STATE_W){x1_reg[STATE_W-1]}}, x1_reg};
 wire signed [E_W-1:0] x2_e = {{(E_W-STATE_W){x2_reg[STATE_W-1]}}, x2_reg};
-wire signed [E_W-1:0] e = z_aligned - x1_e - x2_e;
+wire signed [E_W-1:0] e_next = z_aligned - x1_e - x2_e;
+reg signed [E_W-1:0] e = {E_W{1'b0}};
 
 // Products, exact.
-wire signed [P1_W-1:0] p1 = g1 * e;
-wire signed [P2_W-1:0] p2 = g2 * e;
+reg signed [P1_W-1:0] p1 = {P1_W{1'b0}};
+reg signed [P2_W-1:0] p2 = {P2_W{1'b0}};
 
 // Sums x_i + g_i*e at the product's fraction, exact.
 wire signed [S1_W-1:0] x1_wide = {{(S1_W-STATE_W){x1_reg[STATE_W-1]}}, x1_reg};
@@ -149,21 +159,32 @@ gyrofx_quantize #(
     .IN_W(STATE_W), .IN_F(STATE_F), .OUT_W(OUT_W), .OUT_F(OUT_F),
     .ROUNDING(ROUNDING), .SATURATE(SATURATE)
 ) quantize_rate (
-    .in(x1_next), .out(rate_next), .overflow()
+    .in(x1_reg), .out(rate_next), .overflow()
 );
 /* verilator lint_on PINCONNECTEMPTY */
 
 always @(posedge clk) begin
-    if (ce) begin
+    stage <= {stage[1:0], ce};
+    // e, the gains and the products load on every clock: each is read only on the clock after
+    // the one that loads the sample's (fewer enables: the iCE40 shares one per logic block).
+    e <= e_next;
+    g1 <= rom_word[G1_W+G2_W-1:G2_W];
+    g2 <= rom_word[G2_W-1:0];
+    p1 <= g1 * e;
+    p2 <= g2 * e;
+    if (stage[1]) begin
         x1_reg <= x1_next;
         x2_reg <= x2_next;
+    end
+    if (stage[2]) begin
         rate_reg <= rate_next;
     end
-    valid_reg <= ce;
+    valid_reg <= stage[2];
 
     if (rst) begin
         x1_reg <= {STATE_W{1'b0}};
         x2_reg <= {STATE_W{1'b0}};
+        stage <= 3'b000;
         valid_reg <= 1'b0;
     end
 end

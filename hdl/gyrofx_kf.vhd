@@ -15,8 +15,12 @@
 --   Everything before a Q(.) is exact: widths are derived below by the same
 --   rules as the model (add: +1 bit, multiply: widths add).
 --
--- Pipeline: one register stage. rate_out and out_valid are valid 1 clock after
---   ce. A clock with rst high clears x1, x2 and out_valid (rst wins over ce).
+-- Pipeline: four register stages, one sample at a time: e and the ROM word
+--   (clock 1), the products g1*e and g2*e (clock 2), the states (clock 3),
+--   rate_out from the new x1 (clock 4). rate_out and out_valid are valid 4
+--   clocks after ce; ce at most every 3rd clock (the next e needs the new
+--   states). A clock with rst high clears x1, x2, the pipeline and out_valid
+--   (rst wins over ce).
 --
 -- ROM: ROM_FILE (read by gyrofx_mem_pkg at elaboration), ROM_DEPTH words of
 --   G1_W+G2_W bits, word = g1 & g2. A bw_sel beyond the ROM selects zero gains
@@ -101,12 +105,16 @@ architecture rtl of gyrofx_kf is
     signal rate_reg : signed(OUT_W - 1 downto 0) := (others => '0');
     signal valid_reg : std_logic := '0';
 
+    -- The sample's place in the pipeline: (0) e and the gains held, (1) the products,
+    -- (2) the states updated.
+    signal stage : std_logic_vector(2 downto 0) := (others => '0');
     signal rom_word : std_logic_vector(WORD_W - 1 downto 0);
-    signal g1 : signed(G1_W - 1 downto 0);
-    signal g2 : signed(G2_W - 1 downto 0);
-    signal e : signed(E_W - 1 downto 0);
-    signal p1 : signed(P1_W - 1 downto 0);
-    signal p2 : signed(P2_W - 1 downto 0);
+    signal g1 : signed(G1_W - 1 downto 0) := (others => '0');
+    signal g2 : signed(G2_W - 1 downto 0) := (others => '0');
+    signal e_next : signed(E_W - 1 downto 0);
+    signal e : signed(E_W - 1 downto 0) := (others => '0');
+    signal p1 : signed(P1_W - 1 downto 0) := (others => '0');
+    signal p2 : signed(P2_W - 1 downto 0) := (others => '0');
     signal s1 : signed(S1_W - 1 downto 0);
     signal s2 : signed(S2_W - 1 downto 0);
     signal x1_next : signed(STATE_W - 1 downto 0);
@@ -125,15 +133,11 @@ begin
         severity failure;
 
     rom_word <= ROM(to_integer(bw_sel)) when to_integer(bw_sel) < ROM_DEPTH else (others => '0');
-    g1 <= signed(rom_word(WORD_W - 1 downto G2_W));
-    g2 <= signed(rom_word(G2_W - 1 downto 0));
 
     -- e = z - x1 - x2 at STATE_F fraction bits, exact.
-    e <= shift_left(resize(z, E_W), GUARD) - resize(x1_reg, E_W) - resize(x2_reg, E_W);
+    e_next <= shift_left(resize(z, E_W), GUARD) - resize(x1_reg, E_W) - resize(x2_reg, E_W);
 
-    -- Products and sums x_i + g_i*e at the product's fraction, exact.
-    p1 <= g1 * e;
-    p2 <= g2 * e;
+    -- Sums x_i + g_i*e at the product's fraction, exact (the products are registers).
     s1 <= shift_left(resize(x1_reg, S1_W), G1_F) + resize(p1, S1_W);
     s2 <= shift_left(resize(x2_reg, S2_W), G2_F) + resize(p2, S2_W);
 
@@ -157,21 +161,34 @@ begin
             IN_W => STATE_W, IN_F => STATE_F, OUT_W => OUT_W, OUT_F => OUT_F,
             ROUNDING => ROUNDING, SATURATE => SATURATE
         )
-        port map (value_in => x1_next, value_out => rate_next, overflow => open);
+        port map (value_in => x1_reg, value_out => rate_next, overflow => open);
 
     registers : process (clk)
     begin
         if rising_edge(clk) then
+            stage <= stage(1 downto 0) & ce;
             if ce = '1' then
+                e <= e_next;
+                g1 <= signed(rom_word(WORD_W - 1 downto G2_W));
+                g2 <= signed(rom_word(G2_W - 1 downto 0));
+            end if;
+            if stage(0) = '1' then
+                p1 <= g1 * e;
+                p2 <= g2 * e;
+            end if;
+            if stage(1) = '1' then
                 x1_reg <= x1_next;
                 x2_reg <= x2_next;
+            end if;
+            if stage(2) = '1' then
                 rate_reg <= rate_next;
             end if;
-            valid_reg <= ce;
+            valid_reg <= stage(2);
 
             if rst = '1' then
                 x1_reg <= (others => '0');
                 x2_reg <= (others => '0');
+                stage <= (others => '0');
                 valid_reg <= '0';
             end if;
         end if;

@@ -26,7 +26,7 @@
  * Timing: ce at most every 5th clock. dac_*, locked_* are valid 4 clocks
  *   after ce and hold until the next sample's; the chain's outputs (mode_a,
  *   mode_b: the modes of the next chain period; out_valid, a one-clock pulse;
- *   rate_out; bias_a, bias_b, estimated) change 5 clocks after the ce of the
+ *   rate_out; bias_a, bias_b, estimated) change 10 clocks after the ce of the
  *   ADC sample that ends a chain period and hold otherwise. A clock with rst
  *   high clears every register.
  *

@@ -18,7 +18,7 @@
 --   enable low holds the chain and runs both loops in normal mode.
 --
 -- Timing: ce at most every 5th clock. dac_*, locked_* are valid 4 clocks after ce; the
---   chain's outputs change 5 clocks after the ce of the ADC sample that ends a chain
+--   chain's outputs change 10 clocks after the ce of the ADC sample that ends a chain
 --   period. A clock with rst high clears every register.
 
 library ieee;

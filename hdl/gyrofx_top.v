@@ -14,14 +14,17 @@
  *
  * Algorithm (per ce): the sequencer describes the current sample; the
  *   calibration removes the current bias estimates and combines the valid
- *   outputs; the KF steps on the combined value when at least one gyro is
- *   valid (its ce is ce & combined_valid); the estimator accumulates the
- *   sample and updates the estimates at a window's end.
+ *   outputs (registered); the KF steps on the combined value when at least
+ *   one gyro is valid (its ce is the registered ce & combined_valid); the
+ *   estimator accumulates the sample and updates the estimates at a window's
+ *   end.
  *
  * Latency: mode_a/mode_b describe the sample to be taken at the next ce
- *   (0 clocks: drive the gyro front end with them); rate_out/out_valid are
- *   valid 1 clock after ce (out_valid low when both gyros were blanked);
- *   bias_a/bias_b/estimated are the estimates after the sample.
+ *   (0 clocks: drive the gyro front end with them); rate_out/out_valid,
+ *   bias_a/bias_b/estimated are valid 6 clocks after ce (out_valid low when
+ *   both gyros were blanked; the estimates are those after the sample).
+ *   ce at most every 6th clock (the estimator's pipeline); the sample rate
+ *   leaves thousands. Timing: docs/blocks/top.md.
  */
 module gyrofx_top #(
     // sequencer
@@ -126,15 +129,42 @@ gyrofx_calibration #(
 );
 /* verilator lint_on PINCONNECTEMPTY */
 
+// The calibration's output is registered: the KF takes it one clock after ce, so the
+// estimator's bias registers never reach the KF's products in one clock.
+reg signed [IN_W-1:0] combined_reg = {IN_W{1'b0}};
+reg [SEL_W-1:0] bw_sel_reg = {SEL_W{1'b0}};
+reg kf_ce = 1'b0;
+always @(posedge clk) begin
+    if (ce) begin
+        combined_reg <= combined;
+        bw_sel_reg <= bw_sel;
+    end
+    kf_ce <= ce && combined_valid;
+    if (rst) kf_ce <= 1'b0;
+end
+
+wire signed [OUT_W-1:0] kf_rate;
+wire kf_valid;
 gyrofx_kf #(
     .IN_W(IN_W), .IN_F(IN_F), .STATE_W(STATE_W), .STATE_F(STATE_F),
     .OUT_W(OUT_W), .OUT_F(OUT_F), .G1_W(G1_W), .G1_F(G1_F), .G2_W(G2_W), .G2_F(G2_F),
     .SEL_W(SEL_W), .ROM_DEPTH(ROM_DEPTH), .ROUNDING(ROUNDING), .SATURATE(SATURATE),
     .ROM_FILE(KF_ROM_FILE)
 ) kf (
-    .clk(clk), .rst(rst), .ce(ce && combined_valid), .bw_sel(bw_sel), .z(combined),
-    .rate_out(rate_out), .out_valid(out_valid)
+    .clk(clk), .rst(rst), .ce(kf_ce), .bw_sel(bw_sel_reg), .z(combined_reg),
+    .rate_out(kf_rate), .out_valid(kf_valid)
 );
+
+// One more register on the rate, so that it comes with the estimates (6 clocks after ce).
+reg signed [OUT_W-1:0] rate_reg = {OUT_W{1'b0}};
+reg valid_reg = 1'b0;
+always @(posedge clk) begin
+    if (kf_valid) rate_reg <= kf_rate;
+    valid_reg <= kf_valid;
+    if (rst) valid_reg <= 1'b0;
+end
+assign rate_out = rate_reg;
+assign out_valid = valid_reg;
 
 endmodule
 

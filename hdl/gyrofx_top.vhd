@@ -10,14 +10,16 @@
 --
 -- Algorithm (per ce): the sequencer describes the current sample; the
 --   calibration removes the current bias estimates and combines the valid
---   outputs; the KF steps on the combined value when at least one gyro is
---   valid (its ce is ce and combined_valid); the estimator accumulates the
---   sample and updates the estimates at a window's end.
+--   outputs (registered); the KF steps on the combined value when at least
+--   one gyro is valid (its ce is the registered ce and combined_valid); the
+--   estimator accumulates the sample and updates the estimates at a window's
+--   end.
 --
 -- Latency: mode_a/mode_b describe the sample to be taken at the next ce
---   (0 clocks: drive the gyro front end with them); rate_out/out_valid are
---   valid 1 clock after ce (out_valid low when both gyros were blanked);
---   bias_a/bias_b/estimated are the estimates after the sample.
+--   (0 clocks: drive the gyro front end with them); rate_out/out_valid,
+--   bias_a/bias_b/estimated are valid 6 clocks after ce (out_valid low when
+--   both gyros were blanked; the estimates are those after the sample).
+--   ce at most every 6th clock (the estimator's pipeline).
 
 library ieee;
 use ieee.std_logic_1164.all;
@@ -99,7 +101,13 @@ architecture rtl of gyrofx_top is
     signal bias_b_now : signed(BIAS_W - 1 downto 0);
     signal combined : signed(IN_W - 1 downto 0);
     signal combined_valid : std_logic;
-    signal kf_ce : std_logic;
+    signal kf_ce : std_logic := '0';
+    signal combined_reg : signed(IN_W - 1 downto 0) := (others => '0');
+    signal bw_sel_reg : unsigned(SEL_W - 1 downto 0) := (others => '0');
+    signal kf_rate : signed(OUT_W - 1 downto 0);
+    signal kf_valid : std_logic;
+    signal rate_reg : signed(OUT_W - 1 downto 0) := (others => '0');
+    signal valid_reg : std_logic := '0';
 
 begin
 
@@ -142,7 +150,20 @@ begin
             combined => combined, combined_valid => combined_valid
         );
 
-    kf_ce <= ce and combined_valid;
+    -- The calibration's output is registered: the KF takes it one clock after ce.
+    calibration_register : process (clk)
+    begin
+        if rising_edge(clk) then
+            if ce = '1' then
+                combined_reg <= combined;
+                bw_sel_reg <= bw_sel;
+            end if;
+            kf_ce <= ce and combined_valid;
+            if rst = '1' then
+                kf_ce <= '0';
+            end if;
+        end if;
+    end process;
 
     kf : entity work.gyrofx_kf
         generic map (
@@ -152,9 +173,26 @@ begin
             ROM_FILE => KF_ROM_FILE
         )
         port map (
-            clk => clk, rst => rst, ce => kf_ce, bw_sel => bw_sel, z => combined,
-            rate_out => rate_out, out_valid => out_valid
+            clk => clk, rst => rst, ce => kf_ce, bw_sel => bw_sel_reg, z => combined_reg,
+            rate_out => kf_rate, out_valid => kf_valid
         );
+
+    -- One more register on the rate, so that it comes with the estimates.
+    output_register : process (clk)
+    begin
+        if rising_edge(clk) then
+            if kf_valid = '1' then
+                rate_reg <= kf_rate;
+            end if;
+            valid_reg <= kf_valid;
+            if rst = '1' then
+                valid_reg <= '0';
+            end if;
+        end if;
+    end process;
+
+    rate_out <= rate_reg;
+    out_valid <= valid_reg;
 
     mode_a <= mode_a_now;
     mode_b <= mode_b_now;

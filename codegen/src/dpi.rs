@@ -113,8 +113,13 @@ fn body(block: &Block) -> (&'static str, String) {
             z = random_code(P_IN_W, k);
             check_call(gyrofx_kf_step(kf, longint'(z), int'(bw_sel), stream_model));
             expect_stream(stream_model, 0);
-            @(posedge clk);"
-                .to_string(),
+            // The next sample after the pipeline's {idle} clocks more (ce every {every}th clock).
+            @(posedge clk);
+            @(negedge clk);
+            ce = 1'b0;
+            repeat ({idle}) @(posedge clk);"
+                .replace("{idle}", &(crate::blocks::kf::SETTLE_CLOCKS - 1).to_string())
+                .replace("{every}", &crate::blocks::kf::SETTLE_CLOCKS.to_string()),
         ),
         "mean_filter" => (
             "filter = gyrofx_mean_filter_new(plan);",
@@ -135,12 +140,16 @@ fn body(block: &Block) -> (&'static str, String) {
             compare(longint'(mode_a), longint'(model_mode_a), \"mode_a\");
             compare(longint'(mode_b), longint'(model_mode_b), \"mode_b\");
             if (valid == 1) expect_stream(stream_model, 0);
+            // The estimates show {settle} clocks after the edge that takes the sample.
             @(posedge clk);
+            @(negedge clk);
+            ce = 1'b0;
+            repeat ({settle}) @(posedge clk);
             #1;
             compare(longint'(bias_a), flip_next(bias_a_model), \"bias_a\");
             compare(longint'(bias_b), bias_b_model, \"bias_b\");
             compare(longint'(estimated), longint'(estimated_model), \"estimated\");"
-                .to_string(),
+                .replace("{settle}", &crate::blocks::top::SETTLE_CLOCKS.to_string()),
         ),
         "sequencer" => (
             "sequencer = gyrofx_sequencer_new(plan);",
@@ -195,11 +204,11 @@ fn body(block: &Block) -> (&'static str, String) {
                 dac_b_x_model, dac_b_y_model, locked_a_model, locked_b_model, model_mode_a, model_mode_b,
                 valid, stream_model, bias_a_model, bias_b_model, estimated_model));
             if (valid == 1) expect_stream(stream_model, 0);
-            // Every output shows 4 clocks after the edge that takes the sample (ce every 5th clock).
+            // Every output shows {settle} clocks after the edge that takes the sample.
             @(posedge clk);
             @(negedge clk);
             ce = 1'b0;
-            repeat (4) @(posedge clk);
+            repeat ({settle}) @(posedge clk);
             #1;
             compare(longint'(dac_a_x), flip_next(dac_a_x_model), \"dac_a_x\");
             compare(longint'(dac_a_y), dac_a_y_model, \"dac_a_y\");
@@ -212,7 +221,7 @@ fn body(block: &Block) -> (&'static str, String) {
             compare(longint'(bias_a), bias_a_model, \"bias_a\");
             compare(longint'(bias_b), bias_b_model, \"bias_b\");
             compare(longint'(estimated), longint'(estimated_model), \"estimated\");"
-                .to_string(),
+                .replace("{settle}", &crate::blocks::system::SETTLE_CLOCKS.to_string()),
         ),
         _ => (
             "sequencer = gyrofx_sequencer_new(plan);\n        estimator = gyrofx_estimator_new(plan);",
@@ -232,12 +241,16 @@ fn body(block: &Block) -> (&'static str, String) {
             check_call(gyrofx_estimator_step(estimator, longint'(y_a), longint'(y_b), model_blank_a,
                 model_blank_b, model_done_a, model_done_b, model_interval_a, model_interval_b,
                 model_window_done, bias_a_model, bias_b_model, estimated_model));
+            // The estimates show {settle} clocks after the edge that takes the sample.
             @(posedge clk);
+            @(negedge clk);
+            ce = 1'b0;
+            repeat ({settle}) @(posedge clk);
             #1;
             compare(longint'(bias_a), flip_next(bias_a_model), \"bias_a\");
             compare(longint'(bias_b), bias_b_model, \"bias_b\");
             compare(longint'(estimated), longint'(estimated_model), \"estimated\");"
-                .to_string(),
+                .replace("{settle}", &crate::blocks::estimator::SETTLE_CLOCKS.to_string()),
         ),
     }
 }

@@ -484,6 +484,51 @@ fn run_tool(dir: &Path, program: &str, args: &[String]) -> Result<Option<String>
     }))
 }
 
+/// How long nextpnr may take on one block before it counts as not routing: a design near the
+/// device's capacity can keep the router going round (seen: router1 on 83 % of an HX8K, 2.8
+/// million iterations without progress).
+pub const NEXTPNR_LIMIT: std::time::Duration = std::time::Duration::from_secs(600);
+
+/// What a run of nextpnr came to.
+enum Routed {
+    /// It finished (placed and routed, or refused the design).
+    Finished(Option<String>),
+    /// Still running at [`NEXTPNR_LIMIT`]: stopped.
+    OutOfTime,
+}
+
+/// Runs nextpnr in `dir` for at most [`NEXTPNR_LIMIT`].
+fn run_nextpnr(dir: &Path, args: &[String]) -> Result<Routed> {
+    let mut child = Command::new("nextpnr-ice40")
+        .args(args)
+        .current_dir(dir)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .map_err(|e| {
+            Error::Synthesis(format!("cannot run nextpnr-ice40 (is it installed?): {e}"))
+        })?;
+    let start = std::time::Instant::now();
+    loop {
+        match child.try_wait() {
+            Ok(Some(status)) => {
+                let mut printed = String::new();
+                if let Some(mut stderr) = child.stderr.take() {
+                    let _ = std::io::Read::read_to_string(&mut stderr, &mut printed);
+                }
+                return Ok(Routed::Finished((!status.success()).then_some(printed)));
+            }
+            Ok(None) if start.elapsed() >= NEXTPNR_LIMIT => {
+                let _ = child.kill();
+                let _ = child.wait();
+                return Ok(Routed::OutOfTime);
+            }
+            Ok(None) => std::thread::sleep(std::time::Duration::from_millis(200)),
+            Err(e) => return Err(Error::Synthesis(format!("waiting for nextpnr-ice40: {e}"))),
+        }
+    }
+}
+
 /// The last lines of a log, for an error message.
 fn log_tail(path: &Path) -> String {
     let text = std::fs::read_to_string(path).unwrap_or_default();
@@ -675,7 +720,21 @@ fn place(dir: &Path, block: &Block, target: Target) -> Result<Placement> {
         return Ok(placement);
     }
     let log = PathBuf::from(target.name()).join("nextpnr.log");
-    if let Some(printed) = run_tool(dir, "nextpnr-ice40", &nextpnr_args(target))? {
+    let printed = match run_nextpnr(dir, &nextpnr_args(target))? {
+        Routed::Finished(printed) => printed,
+        Routed::OutOfTime => {
+            placement.fits = false;
+            placement.limit = Some(format!(
+                "nextpnr-ice40 did not finish placing and routing it in {} s (too congested: {} LUT4, {} flip-flops, {} carries in the block alone)",
+                NEXTPNR_LIMIT.as_secs(),
+                placement.lut4.unwrap_or(0),
+                placement.ff,
+                placement.carry
+            ));
+            return Ok(placement);
+        }
+    };
+    if let Some(printed) = printed {
         let text = std::fs::read_to_string(dir.join(&log)).unwrap_or_default();
         let Some((kind, used, available)) = over_capacity(&text) else {
             return Err(Error::Synthesis(format!(

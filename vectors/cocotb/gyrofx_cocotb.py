@@ -7,7 +7,8 @@ that wrote this package's vectors, built from this package's manifest, so a pass
 bit-exact agreement with the vectors' model. Outputs qualified by a valid flag (`out_valid`,
 `y_valid`) are compared as a stream, whatever the latency; a DUT that keeps the reference RTL's
 timing is also checked on its combinational outputs (before the clock edge that takes the
-sample) and its registered outputs without a valid flag (one clock after the sample).
+sample) and its registered outputs without a valid flag (as many clocks after the sample as the
+RTL's pipeline takes).
 
 Environment: GYROFX_PACKAGE (the package folder; default ..), GYROFX_COCOTB_SAMPLES (random
 samples per test; default per block), GYROFX_COCOTB_FLIP_EXPECTED=<n> flips bit 0 of the n-th

@@ -6,6 +6,10 @@ import cocotb
 
 import gyrofx_cocotb as tb
 
+# Idle clocks the KF's pipeline needs after the edge that takes a sample (`ce` every 3rd clock
+# at most).
+PIPELINE_CLOCKS = 2
+
 
 async def run(dut, stimulus):
     """Drives (z, bw_sel, reset-before) samples; returns the scoreboard."""
@@ -20,7 +24,7 @@ async def run(dut, stimulus):
             kf.reset()
         await tb.drive(dut, {"z": z, "bw_sel": bw_sel})
         scoreboard.expect([kf.step(z, bw_sel)])
-        await tb.take(dut, rng.choice([0, 0, 0, 1, 2]))
+        await tb.take(dut, PIPELINE_CLOCKS + rng.choice([0, 0, 0, 1, 2]))
     await tb.reset(dut, [scoreboard])
     tb.finish([scoreboard])
 

@@ -2,9 +2,9 @@
 """cocotb test of gyrofx_system: the DUT closed around both gyros' simulated resonators (its own
 DAC codes drive them, their ADC codes come back; each resonator's pick-offs follow the mode its
 loop takes). Start-up with `enable` low, then mode reversal under the chain's sequencer through
-an estimator window and a bandwidth change. The DAC codes and lock flags are checked 3 clocks
-after the edge that takes the sample, the chain's modes, bias ports and `estimated` 4 clocks
-after it (the reference RTL's timing; `ce` every 5th clock at most); `rate_out` as a stream
+an estimator window and a bandwidth change. The DAC codes, lock flags, the chain's modes, bias
+ports and `estimated` are checked 9 clocks after the edge that takes the sample (the loop's show
+after 3 and hold; the chain's after the loop's 4 stages and its own pipeline); `rate_out` as a stream
 wherever `out_valid` is 1 (any latency)."""
 
 import cocotb
@@ -12,7 +12,7 @@ import cocotb
 import gyrofx_cocotb as tb
 
 # Clocks after the edge that takes a sample before all its outputs show (the RTL's pipeline).
-OUTPUT_CLOCKS = 4
+OUTPUT_CLOCKS = 9
 ADC_PORTS = ["adc_a_x", "adc_a_y", "adc_b_x", "adc_b_y"]
 REGISTERED = ["dac_a_x", "dac_a_y", "dac_b_x", "dac_b_y", "locked_a", "locked_b", "mode_a", "mode_b",
               "bias_a", "bias_b", "estimated"]

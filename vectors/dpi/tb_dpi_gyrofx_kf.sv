@@ -138,7 +138,11 @@ initial begin
             z = random_code(P_IN_W, k);
             check_call(gyrofx_kf_step(kf, longint'(z), int'(bw_sel), stream_model));
             expect_stream(stream_model, 0);
+            // The next sample after the pipeline's 2 clocks more (ce every 3th clock).
             @(posedge clk);
+            @(negedge clk);
+            ce = 1'b0;
+            repeat (2) @(posedge clk);
         if ($urandom_range(3, 0) == 0) begin
             @(negedge clk);
             ce = 1'b0;

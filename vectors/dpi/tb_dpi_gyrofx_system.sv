@@ -320,11 +320,11 @@ initial begin
                 dac_b_x_model, dac_b_y_model, locked_a_model, locked_b_model, model_mode_a, model_mode_b,
                 valid, stream_model, bias_a_model, bias_b_model, estimated_model));
             if (valid == 1) expect_stream(stream_model, 0);
-            // Every output shows 4 clocks after the edge that takes the sample (ce every 5th clock).
+            // Every output shows 9 clocks after the edge that takes the sample.
             @(posedge clk);
             @(negedge clk);
             ce = 1'b0;
-            repeat (4) @(posedge clk);
+            repeat (9) @(posedge clk);
             #1;
             compare(longint'(dac_a_x), flip_next(dac_a_x_model), "dac_a_x");
             compare(longint'(dac_a_y), dac_a_y_model, "dac_a_y");

@@ -177,7 +177,11 @@ initial begin
             compare(longint'(mode_a), longint'(model_mode_a), "mode_a");
             compare(longint'(mode_b), longint'(model_mode_b), "mode_b");
             if (valid == 1) expect_stream(stream_model, 0);
+            // The estimates show 5 clocks after the edge that takes the sample.
             @(posedge clk);
+            @(negedge clk);
+            ce = 1'b0;
+            repeat (5) @(posedge clk);
             #1;
             compare(longint'(bias_a), flip_next(bias_a_model), "bias_a");
             compare(longint'(bias_b), bias_b_model, "bias_b");

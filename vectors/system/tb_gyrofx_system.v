@@ -23,7 +23,7 @@ module tb_gyrofx_system;
 
 localparam integer CLOCK_PERIOD_NS = 10;
 // 64-bit: long vector sets overflow a 32-bit integer.
-localparam [63:0] TIMEOUT_NS = 64'd308100 * CLOCK_PERIOD_NS;
+localparam [63:0] TIMEOUT_NS = 64'd528100 * CLOCK_PERIOD_NS;
 
 reg clk = 1'b0;
 always #(CLOCK_PERIOD_NS / 2) clk <= ~clk;
@@ -390,7 +390,7 @@ initial begin
         rst = 1'b0;
         ce = 1'b0;
         // The pipeline's latency: registered outputs settle these clocks later.
-        repeat (4) @(negedge clk);
+        repeat (9) @(negedge clk);
         if (!masked && dac_a_x !== expected_dac_a_x) begin
             mismatches = mismatches + 1;
             if (first_mismatch < 0) first_mismatch = index;

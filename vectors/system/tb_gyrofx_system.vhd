@@ -191,7 +191,7 @@ architecture sim of tb_gyrofx_system is
     constant P_B_LOCK_A_R : std_logic_vector := 64x"68db574"; -- lock limit of the filtered amplitude error
     constant VECTOR_COUNT : natural := 44000;
     constant CLOCK_PERIOD : time := 10 ns;
-    constant TIMEOUT : time := 308100 * CLOCK_PERIOD;
+    constant TIMEOUT : time := 528100 * CLOCK_PERIOD;
 
     signal clk : std_logic := '0';
     signal rst : std_logic := '1';
@@ -535,7 +535,7 @@ begin
             rst <= '0';
             ce <= '0';
             -- The pipeline's latency: registered outputs settle these clocks later.
-            for settle in 1 to 4 loop
+            for settle in 1 to 9 loop
                 wait until falling_edge(clk);
             end loop;
             if not masked then

@@ -51,8 +51,9 @@ pub const STARTUP_S: f64 = 0.1;
 pub const RATE_DPS: f64 = 10.0;
 
 /// Clocks from the `ce` of an ADC sample to the chain's registered outputs, less the one the
-/// testbench always allows: the loop's four stages, then the chain's register.
-const SETTLE_CLOCKS: u32 = 4;
+/// testbench always allows: the loop's four stages, then the chain's six
+/// ([`super::top::SETTLE_CLOCKS`] + 1).
+pub const SETTLE_CLOCKS: u32 = 4 + super::top::SETTLE_CLOCKS;
 
 /// The system vectors' schedule: the configured one with L = [`INTERVAL_LENGTH`] and
 /// M = [`BLANK`]; B runs [`BLANK`] samples behind A when the configured schedule staggers.

@@ -15,6 +15,11 @@ use crate::vectors::{Results, Run};
 /// The top block.
 pub struct Top;
 
+/// Clocks after the one that follows `ce` before the chain's registered outputs show the
+/// sample: the estimator's pipeline ([`super::estimator::SETTLE_CLOCKS`]); the rate comes as
+/// late (calibration register, the KF's pipeline, one output register).
+pub const SETTLE_CLOCKS: u32 = super::estimator::SETTLE_CLOCKS;
+
 /// `gyrofx_top`'s parameters for `plan`, its ROMs read from `gain_rom_file` and
 /// `kf_rom_file`: the submodules' parameters, each once — the sequencer's schedule, the
 /// estimator's formats (its W and interval width are the sequencer's) and the KF's (its input
@@ -84,6 +89,7 @@ impl RtlBlock for Top {
         let gains = roms.entry(estimator::ROM);
         let coefficients = roms.entry(kf::ROM);
         block.params = chain_params(&job.chain, &gains.0, &coefficients.0);
+        block.settle_clocks = SETTLE_CLOCKS;
         block.extra = vec!["float_rate_dps", "ideal_rate_dps", "true_rate_dps"];
         block.roms.push(gains);
         block.roms.push(coefficients);
@@ -114,6 +120,8 @@ impl RtlBlock for Top {
             json!({
                 "rounding": est.rounding.name(),
                 "overflow": est.overflow.name(),
+                "latency_clocks": SETTLE_CLOCKS + 1,
+                "min_clocks_per_sample": SETTLE_CLOCKS + 1,
                 "fixed_vs_float": run.chain_stats,
             }),
         ))

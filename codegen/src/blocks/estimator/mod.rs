@@ -16,6 +16,12 @@ use crate::vectors::{Results, Run};
 /// The estimator block.
 pub struct Estimator;
 
+/// Clocks after the one that follows `ce` before the estimates show a window's end: the
+/// estimator's pipeline (sums, products by 1/(L − M), means, gain products, dot products;
+/// `hdl/gyrofx_bias_estimator.v`). A sample's calibration reads the estimates, so samples come
+/// at most every `SETTLE_CLOCKS + 1` clocks.
+pub const SETTLE_CLOCKS: u32 = 5;
+
 /// Name of its gain ROM.
 pub const ROM: &str = "estimator_gains";
 
@@ -97,6 +103,7 @@ impl RtlBlock for Estimator {
             .params
             .push(Param::string("ROM_FILE", &rom.0, "gain ROM"));
         block.roms.push(rom);
+        block.settle_clocks = SETTLE_CLOCKS;
         block
     }
 
@@ -128,6 +135,8 @@ impl RtlBlock for Estimator {
                     "stagger": est.schedule.stagger,
                 },
                 "rate_order": est.rate_order,
+                "latency_clocks": SETTLE_CLOCKS + 1,
+                "min_clocks_per_sample": SETTLE_CLOCKS + 1,
                 "formats": {
                     "input": est.input.to_string(),
                     "accumulator": est.accumulator.to_string(),

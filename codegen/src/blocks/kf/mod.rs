@@ -20,6 +20,10 @@ use crate::vectors::{Results, Run};
 /// The KF block.
 pub struct Kf;
 
+/// Clocks after the one that follows `ce` before `rate_out` and `out_valid` show the sample:
+/// the KF's pipeline (e, products, states, output rounding; `hdl/gyrofx_kf.v`).
+pub const SETTLE_CLOCKS: u32 = 3;
+
 /// Name of its coefficient ROM.
 pub const ROM: &str = "kf_coefficients";
 
@@ -94,6 +98,7 @@ impl RtlBlock for Kf {
                 Output::gated(Signal::new("rate_out", kf.output), "out_valid"),
             ],
         );
+        block.settle_clocks = SETTLE_CLOCKS;
         block.params = params(kf);
         block.params.extend(mode_params(kf.rounding, kf.overflow));
         let rom = roms.entry(ROM);
@@ -142,7 +147,8 @@ impl RtlBlock for Kf {
                     "sum_x2": kf.sum[1].to_string(),
                 },
                 "guard_bits": kf.guard_bits(),
-                "latency_clocks": 1,
+                "latency_clocks": SETTLE_CLOCKS + 1,
+                "min_clocks_per_sample": SETTLE_CLOCKS,
                 "designs": report::designs(&job.designs, kf),
                 "coefficients": report::coefficients(kf),
                 "rom": {"file": RomFormat::Mem.file_name(&rom.rom.name), "depth": kf.rom.len(), "word_bits": rom.rom.width(), "all_formats": ROM_FOLDER,
