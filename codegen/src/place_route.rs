@@ -618,6 +618,22 @@ fn mhz(value: f64) -> f64 {
     (value * 100.0).round() / 100.0
 }
 
+/// Marks `placement` as not fitting when one of `counts` (what, used, available) exceeds the
+/// device's, naming the first; returns whether it did.
+fn refuse_over_capacity(
+    placement: &mut Placement,
+    counts: &[(&str, u64, u64)],
+    device: &str,
+) -> bool {
+    let Some((what, used, available)) = counts.iter().find(|(_, used, available)| used > available)
+    else {
+        return false;
+    };
+    placement.fits = false;
+    placement.limit = Some(format!("{used} {what}, the {device} has {available}"));
+    true
+}
+
 /// Places one block on one target in `dir` (the block's folder, holding its design files and
 /// harness).
 fn place(dir: &Path, block: &Block, target: Target) -> Result<Placement> {
@@ -681,21 +697,13 @@ fn place(dir: &Path, block: &Block, target: Target) -> Result<Placement> {
         placement.bram =
             sum(&cells, |k| k == "RAMB36E1") + sum(&cells, |k| k == "RAMB18E1").div_ceil(2);
         placement.carry = sum(&cells, |k| k == "CARRY4");
-        let over = [
+        let counts = [
             ("LUTs", placement.lut6.unwrap_or(0), device.luts),
             ("flip-flops", placement.ff, device.flip_flops),
             ("DSP48E1", placement.dsp, device.dsp),
             ("block RAMs", placement.bram, device.bram),
-        ]
-        .into_iter()
-        .find(|(_, used, available)| used > available);
-        if let Some((what, used, available)) = over {
-            placement.fits = false;
-            placement.limit = Some(format!(
-                "{used} {what}, the {} has {available}",
-                device.name
-            ));
-        }
+        ];
+        refuse_over_capacity(&mut placement, &counts, device.name);
         return Ok(placement);
     }
     placement.lut4 = Some(sum(&cells, |k| k == "SB_LUT4"));
@@ -705,18 +713,11 @@ fn place(dir: &Path, block: &Block, target: Target) -> Result<Placement> {
     placement.carry = sum(&cells, |k| k == "SB_CARRY");
     // A block that needs more multipliers or RAMs than the device has cannot be placed:
     // say so without running nextpnr.
-    let over = [
+    let counts = [
         ("SB_MAC16", placement.dsp, device.dsp),
         ("block RAMs", placement.bram, device.bram),
-    ]
-    .into_iter()
-    .find(|(_, used, available)| used > available);
-    if let Some((what, used, available)) = over {
-        placement.fits = false;
-        placement.limit = Some(format!(
-            "{used} {what}, the {} has {available}",
-            device.name
-        ));
+    ];
+    if refuse_over_capacity(&mut placement, &counts, device.name) {
         return Ok(placement);
     }
     let log = PathBuf::from(target.name()).join("nextpnr.log");
