@@ -1,5 +1,6 @@
 // A C++ Verilator harness that checks gyrofx_kf against gyrofx's C API directly (no DPI):
 // the model is stepped beside the DUT and every out_valid-qualified rate_out is compared.
+// A sample every 3rd clock: the KF's pipeline takes one sample at a time (docs/blocks/kf.md).
 //
 // Build and run it from a generated package's kf/ folder (ROM paths are relative to it), with
 // the package's parameter wrapper as the top level:
@@ -67,8 +68,10 @@ int main(int argc, char **argv) {
     std::deque<int64_t> expected;
     uint64_t state = 0x9e3779b97f4a7c15ULL;
     long compared = 0, mismatches = 0;
-    for (long k = 0; k < samples + 4; ++k) {
-        const bool sample = k < samples;
+    const long clocks_per_sample = 3;
+    for (long t = 0; t < clocks_per_sample * samples + 8; ++t) {
+        const long k = t / clocks_per_sample;
+        const bool sample = t % clocks_per_sample == 0 && k < samples;
         int64_t z = random_code(state, in_width);
         if ((k / 64) % 2 == 1) z >>= 8;
         const int bw_sel = static_cast<int>((k / 500) % 3);
