@@ -5,7 +5,7 @@
 //!
 //! Outputs qualified by a valid flag are compared as a stream (a queue of expected values),
 //! whatever the latency; combinational outputs before the clock edge that takes the sample,
-//! registered outputs without a valid flag one clock after it. Each testbench prints
+//! registered outputs without a valid flag after the block's pipeline. Each testbench prints
 //! `PASS n=<N>` or `FAIL mismatches=<M> n=<N>` and exits non-zero on a mismatch or a refused
 //! model call. Plusargs: `+samples=<n>`, `+seed=<n>`, `+flip=<k>` (flip bit 0 of the k-th
 //! expected value: the testbench must then fail).
