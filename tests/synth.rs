@@ -282,6 +282,10 @@ fn check_place_and_route(synth: &Path, log: &str) {
         .parse::<u64>()
         .unwrap();
     assert!(kf["ff"].as_u64().unwrap() > 2 * state + out, "{kf}");
+    // A KF sample every 3rd clock (docs/blocks/kf.md: the next e needs the new states only; the
+    // C++ Verilator harness in tests/dpi.rs drives it so), the sequencer's every clock.
+    assert_eq!(kf["clocks_per_sample"], 3, "{kf}");
+    assert_eq!(placements[0]["clocks_per_sample"], 1, "{}", placements[0]);
     // The harness's shift registers are not the block's: the combinational calibration, whose
     // inputs and outputs the harness registers, has no flip-flop of its own.
     let calibration = &placements[1];
@@ -305,6 +309,29 @@ fn check_place_and_route(synth: &Path, log: &str) {
     }
     let error = fails(&["synth", "--out", "x", "--blocks", "kf"]);
     assert!(error.contains("--target"), "{error}");
+
+    // Without a working nextpnr-ice40 an iCE40 target is refused before any synthesis, and
+    // nothing is written.
+    let tools = synth.with_file_name("no-nextpnr");
+    std::fs::create_dir_all(&tools).unwrap();
+    std::os::unix::fs::symlink("/bin/false", tools.join("nextpnr-ice40")).unwrap();
+    let path = format!("{}:{}", tools.display(), std::env::var("PATH").unwrap());
+    let out = synth.with_file_name("refused");
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_gyrofx"))
+        .args([
+            "synth",
+            "--out",
+            out.to_str().unwrap(),
+            "--target",
+            "ice40-up5k",
+        ])
+        .env("PATH", path)
+        .output()
+        .unwrap();
+    let error = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{error}");
+    assert!(error.contains("ice40-up5k needs nextpnr-ice40"), "{error}");
+    assert!(!out.exists());
 }
 
 fn flip_flops(generic_json: &Path) -> u64 {

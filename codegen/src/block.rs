@@ -250,6 +250,10 @@ pub struct Block {
     pub settle_clocks: u32,
     /// Whether the module has `clk`, `rst` and `ce` ports (a combinational block has none).
     pub clocked: bool,
+    /// The fewest clocks from one sample's `ce` to the next one's where the pipeline frees its
+    /// first stage before its outputs show (the KF: 3 with 4 clocks of latency); `None`:
+    /// `1 + settle_clocks` ([`Block::clocks_per_sample`]).
+    pub sample_spacing: Option<u32>,
 }
 
 impl Block {
@@ -273,6 +277,11 @@ impl Block {
         ports.extend(self.inputs.iter().map(|s| port("input", s)));
         ports.extend(self.outputs.iter().map(|o| port("output", &o.signal)));
         ports
+    }
+
+    /// The fewest clocks from one sample's `ce` to the next one's.
+    pub fn clocks_per_sample(&self) -> u32 {
+        self.sample_spacing.unwrap_or(1 + self.settle_clocks)
     }
 
     /// `clk`, `rst`, `ce`, or none for a combinational block.
@@ -309,6 +318,7 @@ impl Block {
             written: Vec::new(),
             settle_clocks: 0,
             clocked: true,
+            sample_spacing: None,
         }
     }
 

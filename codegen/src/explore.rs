@@ -555,12 +555,7 @@ impl Exploration {
         }
         Job::new(config.clone())?;
         let c = m.cost();
-        let formats: Vec<String> = row
-            .candidate
-            .formats
-            .iter()
-            .map(|(k, f)| format!("{k} = {f}"))
-            .collect();
+        let formats = row.candidate.assignments(" = ");
         Ok(Some(format!(
             "# written by gyrofx explore: candidate {} of {}, the cheapest (fewest DSP48E1, then LUTs, then\n\
              # flip-flops) whose {} is at most {} with no quantizer overflow{}, over {} samples:\n\

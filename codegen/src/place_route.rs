@@ -152,6 +152,24 @@ impl Serialize for Target {
     }
 }
 
+/// Checks that the tools `targets` need run, before any synthesis: a missing nextpnr-ice40
+/// would otherwise show only after minutes of yosys.
+///
+/// # Errors
+/// [`Error::Synthesis`] naming the missing program and the target that needs it.
+pub fn check_tools(targets: &[Target]) -> Result<()> {
+    let Some(ice40) = targets.iter().find(|t| **t != Target::Xilinx) else {
+        return Ok(());
+    };
+    match Command::new("nextpnr-ice40").arg("--version").output() {
+        Ok(output) if output.status.success() => Ok(()),
+        _ => Err(Error::Synthesis(format!(
+            "--target {} needs nextpnr-ice40, which does not run here (install the Debian package nextpnr-ice40)",
+            ice40.name()
+        ))),
+    }
+}
+
 /// Parses a comma-separated list of [`BLOCKS`] (`all`: every one), in [`BLOCKS`]'s order.
 ///
 /// # Errors
@@ -235,7 +253,7 @@ pub struct Placement {
 /// captured when `capture` is high and shifted out on `serial_out` otherwise. Every port bit
 /// thus reaches a pin, and nothing the block computes can be optimized away.
 pub fn harness(block: &Block) -> String {
-    let clocked = block.clock_ports().len() == 3;
+    let clocked = block.clocked;
     let mut inputs: Vec<(String, u32)> = Vec::new();
     if clocked {
         inputs.push(("rst".into(), 1));
@@ -394,7 +412,7 @@ fn nextpnr_args(target: Target) -> Vec<String> {
         _ => "--hx8k",
     };
     let goal = device.goal_mhz.unwrap_or(12.0);
-    [
+    vec![
         part.to_string(),
         "--package".into(),
         device.package.into(),
@@ -411,7 +429,6 @@ fn nextpnr_args(target: Target) -> Vec<String> {
         "-l".into(),
         format!("{folder}/nextpnr.log"),
     ]
-    .to_vec()
 }
 
 /// The shell script that re-derives a target's figures, run from the block's folder.
@@ -686,7 +703,7 @@ fn place(dir: &Path, block: &Block, target: Target) -> Result<Placement> {
         fmax_mhz: None,
         fmax_goal_mhz: device.goal_mhz,
         critical_path: None,
-        clocks_per_sample: 1 + block.settle_clocks,
+        clocks_per_sample: block.clocks_per_sample(),
         max_sample_rate_hz: None,
         folder: format!("{FOLDER}/{}/{}", block.name, target.name()),
     };

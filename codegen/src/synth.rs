@@ -556,6 +556,7 @@ pub fn synthesize(
     place: &PlaceRequest,
 ) -> Result<Synthesis> {
     output_folder::check(out, Kind::Synth, replace)?;
+    place_route::check_tools(&place.targets)?;
     let roms = RomImages::new(job, provenance);
     let top = blocks::find(TOP_BLOCK).block(job, &roms);
     let gyro_loop = blocks::find(LOOP_BLOCK).block(job, &roms);

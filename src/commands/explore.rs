@@ -158,12 +158,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
 
     let metric = target.metric;
     for row in &exploration.rows {
-        let formats: Vec<String> = row
-            .candidate
-            .formats
-            .iter()
-            .map(|(k, f)| format!("{k}={f}"))
-            .collect();
+        let formats = row.candidate.assignments("=");
         let mark = if exploration.best == Some(row.candidate.index) {
             "*"
         } else {

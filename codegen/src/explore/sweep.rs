@@ -183,6 +183,16 @@ pub struct Candidate {
     pub formats: Vec<(&'static str, Format)>,
 }
 
+impl Candidate {
+    /// Its formats as `key<separator>format`, in the sweep's key order.
+    pub fn assignments(&self, separator: &str) -> Vec<String> {
+        self.formats
+            .iter()
+            .map(|(key, format)| format!("{key}{separator}{format}"))
+            .collect()
+    }
+}
+
 /// The keys a sweep may set: every analysed node's key that sets that node's format alone (as
 /// `gyrofx formats --write` does), the mean filter's left out (it sits beside the chain).
 pub fn explorable_keys(analysis: &Analysis) -> Vec<&'static str> {

@@ -99,6 +99,8 @@ impl RtlBlock for Kf {
             ],
         );
         block.settle_clocks = SETTLE_CLOCKS;
+        // The next sample's `e` needs only the new states, not the rounded output.
+        block.sample_spacing = Some(SETTLE_CLOCKS);
         block.params = params(kf);
         block.params.extend(mode_params(kf.rounding, kf.overflow));
         let rom = roms.entry(ROM);
