@@ -18,5 +18,6 @@ pub mod plant;
 pub mod range;
 pub mod resonator;
 pub mod sequencer;
+pub mod serial;
 pub mod stimulus;
 pub mod system;
