@@ -2,7 +2,7 @@
 //! in compile order (a unit before its users), and the sources one module needs.
 
 /// The reference RTL, embedded so that every package is self-contained.
-pub const RTL_SOURCES: [(&str, &str); 13] = [
+pub const RTL_SOURCES: [(&str, &str); 15] = [
     (
         "gyrofx_quantize.v",
         include_str!("../../hdl/gyrofx_quantize.v"),
@@ -21,6 +21,14 @@ pub const RTL_SOURCES: [(&str, &str); 13] = [
         include_str!("../../hdl/gyrofx_calibration.v"),
     ),
     ("gyrofx_top.v", include_str!("../../hdl/gyrofx_top.v")),
+    (
+        "gyrofx_serial_engine.v",
+        include_str!("../../hdl/gyrofx_serial_engine.v"),
+    ),
+    (
+        "gyrofx_top_serial.v",
+        include_str!("../../hdl/gyrofx_top_serial.v"),
+    ),
     (
         "gyrofx_mean_filter.v",
         include_str!("../../hdl/gyrofx_mean_filter.v"),

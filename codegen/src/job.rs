@@ -36,6 +36,8 @@ pub struct Job {
     /// Recorded gyro outputs that drive the chain instead of the plant (`generate
     /// --recording`), checked against the config by [`Job::with_recording`].
     pub recording: Option<std::sync::Arc<Recording>>,
+    /// The chain compiled for `gyrofx_top_serial`, with `architecture = "serial"`.
+    pub serial: Option<gyrofx_model::serial::Program>,
 }
 
 /// Designs one filter per bandwidth of `settings` at `fs_hz` for the noise model (°/√h, °/h/√h).
@@ -127,6 +129,16 @@ impl Job {
             }
             None => None,
         };
+        let serial = match settings.architecture {
+            crate::config::Architecture::Parallel => None,
+            crate::config::Architecture::Serial => Some(
+                gyrofx_model::serial::compile(&chain).map_err(|e| Error::Config {
+                    field: "architecture".into(),
+                    value: "\"serial\"".into(),
+                    allowed: e.to_string(),
+                })?,
+            ),
+        };
         Ok(Job {
             config,
             settings,
@@ -136,6 +148,7 @@ impl Job {
             gyro_loops,
             system_chain,
             recording: None,
+            serial,
         })
     }
 

@@ -10,6 +10,7 @@ use gyrofx_model::fx::Format;
 use gyrofx_model::gyro_loop;
 use gyrofx_model::kf::{Plan, COEFFICIENT_NAMES};
 use gyrofx_model::mean_filter;
+use gyrofx_model::serial;
 
 mod parsing;
 mod writing;
@@ -126,6 +127,84 @@ impl Rom {
             }],
             codes: plan.rom.iter().map(|c| vec![*c]).collect(),
             notes,
+        }
+    }
+
+    /// The serial engine's program (`gyrofx_serial_engine`), from address 0 to its `End`; the
+    /// fields of `gyrofx_model::serial::isa::Instruction`.
+    pub fn serial_program(program: &serial::Program) -> Rom {
+        let unsigned = |width| Format {
+            signed: false,
+            width,
+            frac: 0,
+        };
+        let layout = program.layout;
+        let all = &program.sample;
+        Rom {
+            name: "serial_program".into(),
+            description: format!(
+                "serial engine program: {} instructions from 0 (4 clocks each)",
+                program.sample.len()
+            ),
+            fields: [
+                ("op", 4),
+                ("cond", 4),
+                ("ram_index", 2),
+                ("by_bw_sel", 1),
+                ("address", layout.address_bits),
+                ("coefficient", layout.coefficient_bits),
+            ]
+            .into_iter()
+            .map(|(name, width)| Field {
+                name: name.into(),
+                format: unsigned(width),
+            })
+            .collect(),
+            codes: all
+                .iter()
+                .map(|i| {
+                    vec![
+                        i128::from(i.op as u8),
+                        i128::from(i.cond as u8),
+                        i128::from(i.ram_index as u8),
+                        i128::from(i.coefficient_by_bw_sel),
+                        i128::from(i.address),
+                        i128::from(i.coefficient),
+                    ]
+                })
+                .collect(),
+            notes: all
+                .iter()
+                .map(|i| format!("{:?} if {:?}", i.op, i.cond))
+                .collect(),
+        }
+    }
+
+    /// The serial engine's coefficient limbs (16-bit signed words; the KF's gains from
+    /// address 0, one power-of-two region per `bw_sel`, then the constants).
+    pub fn serial_coefficients(program: &serial::Program) -> Rom {
+        Rom {
+            name: "serial_coefficients".into(),
+            description:
+                "serial engine coefficient limbs (s16.0: 15-bit limbs, the top one signed)".into(),
+            fields: vec![Field {
+                name: "limb".into(),
+                format: Format {
+                    signed: true,
+                    width: 16,
+                    frac: 0,
+                },
+            }],
+            codes: program
+                .coefficients
+                .iter()
+                .map(|c| vec![i128::from(*c)])
+                .collect(),
+            notes: program
+                .coefficients
+                .iter()
+                .map(|c| format!("{c}"))
+                .collect(),
         }
     }
 

@@ -3,12 +3,14 @@
 //! with the float, ideal and true rates beside the fixed output in the CSV.
 
 use gyrofx_model::chain::Plan;
+use gyrofx_model::serial::Program;
 use serde_json::json;
 
 use super::{estimator, flag, kf, mode_bit, mode_params, sequencer};
 use super::{ChainSample, RomImages, RtlBlock, VectorBuilder};
 use crate::block::{Block, Output, Param, Signal};
 use crate::job::Job;
+use crate::rom::Rom;
 use crate::stats::Accumulator;
 use crate::vectors::{Results, Run};
 
@@ -51,6 +53,74 @@ pub fn chain_params(plan: &Plan, gain_rom_file: &str, kf_rom_file: &str) -> Vec<
     params
 }
 
+/// `gyrofx_top_serial`'s parameters: the sequencer's, the port widths, the engine's memories
+/// and widths from the compiled `program`, its ROM files, the rounding.
+pub fn serial_params(
+    plan: &Plan,
+    program: &Program,
+    program_file: &str,
+    coefficient_file: &str,
+) -> Vec<Param> {
+    let est = &plan.estimator;
+    let int = |name: &str, value: usize, comment: &str| Param::integer(name, value as i64, comment);
+    let mut params = sequencer::params(&est.schedule);
+    params.extend([
+        int("IN_W", est.input.width as usize, "gyro sample width"),
+        int("OUT_W", plan.kf.output.width as usize, "rate output width"),
+        int("BIAS_W", est.bias.width as usize, "bias output width"),
+        int("SEL_W", plan.kf.select_width() as usize, "bw_sel width"),
+        int(
+            "ACC_W",
+            program.accumulator_bits as usize,
+            "column accumulator width",
+        ),
+        int(
+            "ADDR_W",
+            program.layout.address_bits as usize,
+            "data RAM address width",
+        ),
+        int(
+            "COEF_ADDR_W",
+            program.layout.coefficient_bits as usize,
+            "coefficient ROM address width",
+        ),
+        int("RAM_DEPTH", program.ram_words.max(1), "data RAM words"),
+        int(
+            "COEF_DEPTH",
+            program.coefficients.len().max(1),
+            "coefficient ROM words",
+        ),
+        int("PROGRAM_DEPTH", program.sample.len(), "program ROM words"),
+        int(
+            "RAM_INDEX_SHIFT",
+            program.ram_index_shift as usize,
+            "interval index stride (log2 words)",
+        ),
+        int(
+            "COEF_INDEX_SHIFT",
+            program.coefficient_index_shift as usize,
+            "bw_sel stride (log2 words)",
+        ),
+        int(
+            "ROUNDING",
+            est.rounding.rtl_code() as usize,
+            "0 floor, 1 ceil, 2 zero, 3 nearest, 4 round, 5 convergent",
+        ),
+    ]);
+    params.push(Param::string("PROGRAM_FILE", program_file, "program ROM"));
+    params.push(Param::string(
+        "COEFFICIENT_FILE",
+        coefficient_file,
+        "coefficient ROM",
+    ));
+    params
+}
+
+/// ROM names of the serial engine.
+pub const SERIAL_PROGRAM_ROM: &str = "serial_program";
+/// The serial engine's coefficient ROM.
+pub const SERIAL_COEFFICIENT_ROM: &str = "serial_coefficients";
+
 impl RtlBlock for Top {
     fn name(&self) -> &'static str {
         "top"
@@ -58,6 +128,16 @@ impl RtlBlock for Top {
 
     fn module(&self) -> &'static str {
         "gyrofx_top"
+    }
+
+    fn roms(&self, job: &Job) -> Vec<Rom> {
+        match &job.serial {
+            Some(program) => vec![
+                Rom::serial_program(program),
+                Rom::serial_coefficients(program),
+            ],
+            None => Vec::new(),
+        }
     }
 
     fn title(&self) -> &'static str {
@@ -86,11 +166,22 @@ impl RtlBlock for Top {
                 Output::registered(Signal::flag("estimated")),
             ],
         );
+        block.extra = vec!["float_rate_dps", "ideal_rate_dps", "true_rate_dps"];
+        if let Some(program) = &job.serial {
+            let code = roms.entry(SERIAL_PROGRAM_ROM);
+            let limbs = roms.entry(SERIAL_COEFFICIENT_ROM);
+            block.module = "gyrofx_top_serial";
+            block.title = "the whole mode-reversal chain, time-multiplexed";
+            block.params = serial_params(&job.chain, program, &code.0, &limbs.0);
+            block.settle_clocks = program.settle_clocks();
+            block.roms.push(code);
+            block.roms.push(limbs);
+            return block;
+        }
         let gains = roms.entry(estimator::ROM);
         let coefficients = roms.entry(kf::ROM);
         block.params = chain_params(&job.chain, &gains.0, &coefficients.0);
         block.settle_clocks = SETTLE_CLOCKS;
-        block.extra = vec!["float_rate_dps", "ideal_rate_dps", "true_rate_dps"];
         block.roms.push(gains);
         block.roms.push(coefficients);
         block
@@ -115,16 +206,31 @@ impl RtlBlock for Top {
         run: &Run,
     ) -> Option<(&'static str, serde_json::Value)> {
         let est = &job.chain.estimator;
-        Some((
-            "chain",
-            json!({
-                "rounding": est.rounding.name(),
-                "overflow": est.overflow.name(),
-                "latency_clocks": SETTLE_CLOCKS + 1,
-                "min_clocks_per_sample": SETTLE_CLOCKS + 1,
-                "fixed_vs_float": run.chain_stats,
-            }),
-        ))
+        let (architecture, settle) = match &job.serial {
+            Some(program) => ("serial", program.settle_clocks()),
+            None => ("parallel", SETTLE_CLOCKS),
+        };
+        let mut chain = json!({
+            "rounding": est.rounding.name(),
+            "overflow": est.overflow.name(),
+            "architecture": architecture,
+            "latency_clocks": settle + 1,
+            "min_clocks_per_sample": settle + 1,
+            "fixed_vs_float": run.chain_stats,
+        });
+        if let Some(program) = &job.serial {
+            chain["serial"] = json!({
+                "module": "gyrofx_top_serial",
+                "instructions": program.sample.len(),
+                "clocks_per_instruction": gyrofx_model::serial::isa::CLOCKS_PER_INSTRUCTION,
+                "ram_words": program.ram_words,
+                "state_words": program.state_words,
+                "coefficient_words": program.coefficients.len(),
+                "accumulator_bits": program.accumulator_bits,
+                "program_word_bits": program.layout.word_bits(),
+            });
+        }
+        Some(("chain", chain))
     }
 }
 

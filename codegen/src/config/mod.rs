@@ -47,6 +47,8 @@ pub struct Config {
     pub rounding: String,
     /// Overflow mode name of every quantization point.
     pub overflow: String,
+    /// The chain's RTL: `"parallel"` (`gyrofx_top`) or `"serial"` (`gyrofx_top_serial`).
+    pub architecture: String,
     /// The true rate.
     pub stimulus: StimulusConfig,
     /// Gyro A's errors.
@@ -92,6 +94,18 @@ pub struct Settings {
     pub kf: KfSettings,
     /// The mean filter (its input format is the KF's).
     pub mean_filter: MeanFilterSpec,
+    /// The chain's architecture.
+    pub architecture: Architecture,
+}
+
+/// How the chain's RTL computes a sample.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Architecture {
+    /// `gyrofx_top`: every block in parallel, a sample every few clocks.
+    Parallel,
+    /// `gyrofx_top_serial`: one shared multiplier run by a program, a sample every few
+    /// thousand clocks.
+    Serial,
 }
 
 /// The names of the presets, in the order `gyrofx init --preset` lists them.
@@ -394,6 +408,17 @@ impl Config {
                 "wrap or saturate",
             )
         })?;
+        let architecture = match self.architecture.as_str() {
+            "parallel" => Architecture::Parallel,
+            "serial" => Architecture::Serial,
+            other => {
+                return Err(Error::config(
+                    "architecture",
+                    format!("{other:?}"),
+                    "\"parallel\" or \"serial\"",
+                ))
+            }
+        };
         let source = self.stimulus.validate()?;
         let fs_hz = self.stimulus.fs_hz;
         let plant = self.plant.validate(fs_hz, &self.gyro_a, &self.gyro_b)?;
@@ -424,6 +449,7 @@ impl Config {
             estimator,
             kf,
             mean_filter,
+            architecture,
         })
     }
 }

@@ -70,22 +70,21 @@ pub const OUTPUT_BIAS_B: u16 = 2;
 /// the RTL takes as parameters.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Program {
-    /// The per-sample program (ends with [`Op::End`]); it starts at address 0.
+    /// The per-sample program (from address 0 to its [`Op::End`]); on the first sample since
+    /// reset it clears the state first.
     pub sample: Vec<Instruction>,
-    /// The reset program, which clears the state (ends with [`Op::End`]); it starts right
-    /// after the sample program.
-    pub reset: Vec<Instruction>,
     /// Coefficient ROM words (16-bit signed limbs).
     pub coefficients: Vec<i16>,
     /// Data RAM words used (state first, then temporaries).
     pub ram_words: usize,
-    /// Data RAM words holding state (cleared by the reset program).
+    /// Data RAM words holding state (cleared by the first sample since reset).
     pub state_words: usize,
     /// Left shift of an interval index added to a RAM address.
     pub ram_index_shift: u32,
     /// Left shift of `bw_sel` added to a coefficient address.
     pub coefficient_index_shift: u32,
-    /// Bits of the column accumulator: the largest sum any column can reach, signed.
+    /// Bits of the column accumulator: the largest sum any column can reach, signed (at
+    /// least 17, so that a limb and its sign fit).
     pub accumulator_bits: u32,
     /// Limbs of an input sample, of the rate output and of a bias output.
     pub input_limbs: u32,
@@ -104,25 +103,16 @@ pub struct Program {
 }
 
 impl Program {
-    /// Clocks from `ce` to the outputs of a sample (and to the next `ce`'s earliest): every
-    /// instruction of the sample program, executed or not, takes
-    /// [`CLOCKS_PER_INSTRUCTION`].
-    pub fn clocks_per_sample(&self) -> u32 {
+    /// Clocks after the `ce` clock until the outputs show the sample: every instruction of
+    /// the sample program, executed or not, takes [`CLOCKS_PER_INSTRUCTION`]. The next `ce`
+    /// may come one clock later.
+    pub fn settle_clocks(&self) -> u32 {
         CLOCKS_PER_INSTRUCTION * self.sample.len() as u32
     }
 
-    /// The program ROM's words: the sample program, then the reset program.
+    /// The program ROM's words.
     pub fn rom_words(&self) -> Vec<u64> {
-        self.sample
-            .iter()
-            .chain(&self.reset)
-            .map(|i| i.encode(&self.layout))
-            .collect()
-    }
-
-    /// Address of the reset program.
-    pub fn reset_address(&self) -> usize {
-        self.sample.len()
+        self.sample.iter().map(|i| i.encode(&self.layout)).collect()
     }
 }
 
@@ -653,6 +643,13 @@ pub fn compile(plan: &Plan) -> Result<Program, CompileError> {
     let bias = [0, 1].map(|_| c.value(est.bias.width, est.bias.frac));
     let x = [0, 1].map(|_| c.value(kf.state.width, kf.state.frac));
     let state_words = c.ram_top;
+    // The first sample since reset clears the state first: reset itself is instant.
+    c.cond = Cond::Fresh;
+    c.push(Op::Zero, 0, 0);
+    for a in 0..state_words {
+        c.push(Op::Emit, a as u16, 0);
+    }
+    c.cond = Cond::Always;
 
     // The KF's gains: one region per ROM word, bw_sel's stride a power of two.
     let gain_limbs = [0, 1].map(|i| limbs_of(kf.coefficient[i].width));
@@ -814,7 +811,6 @@ pub fn compile(plan: &Plan) -> Result<Program, CompileError> {
             let s = est.smoothing_shift;
             let new = c.value(est.bias.width, est.bias.frac);
             c.quantize("estimator.bias", dot, est.bias, new.address, RamIndex::None)?;
-            c.cond = Cond::WindowEstimated;
             let keep = c.constant((1i128 << s) - 1);
             let one = c.constant(1);
             let smoothed = c.materialize(
@@ -824,15 +820,18 @@ pub fn compile(plan: &Plan) -> Result<Program, CompileError> {
                 ],
                 est.bias.frac + s as i32,
             );
+            let t = c.value(est.bias.width, est.bias.frac);
             c.quantize(
                 "estimator.smoothing",
                 smoothed,
                 est.bias,
-                bias_g.address,
+                t.address,
                 RamIndex::None,
             )?;
-            c.cond = Cond::WindowFirst;
-            c.materialize_into(&[term(Source::Ram(new), one)], bias_g);
+            // The first window takes the new estimate, later ones the smoothed one.
+            c.materialize_into(&[term(Source::Ram(new), one.clone())], bias_g);
+            c.cond = Cond::WindowEstimated;
+            c.materialize_into(&[term(Source::Ram(t), one)], bias_g);
             c.cond = Cond::Window;
         }
         c.ram_top = state_words;
@@ -846,14 +845,6 @@ pub fn compile(plan: &Plan) -> Result<Program, CompileError> {
     }
     c.push(Op::End, 0, 0);
     let sample = std::mem::take(&mut c.code);
-
-    // Reset: every state word cleared.
-    c.push(Op::Zero, 0, 0);
-    for a in 0..state_words {
-        c.push(Op::Emit, a as u16, 0);
-    }
-    c.push(Op::End, 0, 0);
-    let reset = std::mem::take(&mut c.code);
 
     for (memory, words) in [
         ("data RAM", c.ram_high),
@@ -869,19 +860,21 @@ pub fn compile(plan: &Plan) -> Result<Program, CompileError> {
     }
     let input_limbs = limbs_of(est.input.width);
     // The input limbs share the RAM address field.
+    // One bit over the run-time indexes, which the RTL zero-extends to an address.
     let layout = Layout {
-        address_bits: address_bits(c.ram_high.max(2 * input_limbs as usize)),
-        coefficient_bits: address_bits(c.coefficients.len().max(3)),
+        address_bits: address_bits(c.ram_high.max(2 * input_limbs as usize))
+            .max(address_bits(est.schedule.intervals) + 1),
+        coefficient_bits: address_bits(c.coefficients.len().max(3))
+            .max(address_bits(kf.rom.len()) + 1),
     };
     Ok(Program {
         sample,
-        reset,
         coefficients: c.coefficients,
         ram_words: c.ram_high,
         state_words,
         ram_index_shift,
         coefficient_index_shift,
-        accumulator_bits: signed_bits(c.bound_high),
+        accumulator_bits: signed_bits(c.bound_high).max(17),
         input_limbs,
         rate_limbs: limbs_of(kf.output.width),
         bias_limbs: limbs_of(est.bias.width),

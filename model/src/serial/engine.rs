@@ -31,6 +31,7 @@ pub struct Engine<'a> {
     high_ones: bool,
     fits: bool,
     estimated: bool,
+    fresh: bool,
     shadow: [u128; 3],
     ports: [i64; 3],
 }
@@ -49,29 +50,18 @@ impl<'a> Engine<'a> {
             high_ones: true,
             fits: false,
             estimated: false,
+            fresh: true,
             shadow: [0; 3],
             ports: [0; 3],
         }
     }
 
-    /// `rst`: the outputs clear at once, the reset program clears the state.
+    /// `rst`: the outputs clear at once; the next sample clears the state first.
     pub fn reset(&mut self) {
         self.ports = [0; 3];
         self.shadow = [0; 3];
         self.estimated = false;
-        let slot = Slot {
-            mode_a: 1,
-            mode_b: 1,
-            blank_a: false,
-            blank_b: false,
-            interval_a: 0,
-            interval_b: 0,
-            done_a: false,
-            done_b: false,
-            window_done: false,
-        };
-        let program = self.program;
-        self.run(&program.reset, [0, 0], 0, &slot);
+        self.fresh = true;
     }
 
     /// One sample: the gyro codes `y`, the KF's ROM address `bw_sel`, the sequencer's `slot`.
@@ -94,6 +84,7 @@ impl<'a> Engine<'a> {
             window: slot.window_done,
             mode_positive: [slot.mode_a > 0, slot.mode_b > 0],
             estimated: self.estimated,
+            fresh: self.fresh,
         };
         let limit = 1i128 << (p.accumulator_bits - 1);
         for ins in code {
@@ -177,6 +168,7 @@ impl<'a> Engine<'a> {
                             self.ports[port] = value as i64;
                         }
                     }
+                    self.fresh = false;
                     return any;
                 }
             }

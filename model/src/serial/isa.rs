@@ -54,7 +54,7 @@ pub enum Op {
     /// `estimated ← 1` (read by the conditions from the next instruction on).
     SetEstimated = 14,
     /// The program's end: the output registers show the new values (`out_valid` pulses when
-    /// the rate was updated).
+    /// the rate was updated); the sample is no longer the first since reset.
     End = 15,
 }
 
@@ -93,8 +93,8 @@ pub enum Cond {
     AnyValid = 13,
     /// The window ends and an earlier window produced estimates (smoothing applies).
     WindowEstimated = 14,
-    /// The window ends and is the first since reset.
-    WindowFirst = 15,
+    /// The first sample since reset: the program clears the state before it uses it.
+    Fresh = 15,
 }
 
 /// The sample's flags the conditions read.
@@ -110,6 +110,8 @@ pub struct Flags {
     pub mode_positive: [bool; 2],
     /// A window produced estimates before this instruction.
     pub estimated: bool,
+    /// No sample since reset.
+    pub fresh: bool,
 }
 
 impl Cond {
@@ -131,7 +133,7 @@ impl Cond {
             Cond::OnlyB => !f.valid[0] && f.valid[1],
             Cond::AnyValid => f.valid[0] || f.valid[1],
             Cond::WindowEstimated => f.window && f.estimated,
-            Cond::WindowFirst => f.window && !f.estimated,
+            Cond::Fresh => f.fresh,
         }
     }
 }

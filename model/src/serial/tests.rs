@@ -130,9 +130,8 @@ fn the_default_program_is_small() {
     let p = crate::examples::chain_plan(150, 10, 0, 0, Rounding::Nearest);
     let program = compile(&p).expect("compiles");
     eprintln!(
-        "{} + {} instructions, {} RAM words ({} state), {} coefficients, {}-bit accumulator, {}-bit words",
+        "{} instructions, {} RAM words ({} state), {} coefficients, {}-bit accumulator, {}-bit words",
         program.sample.len(),
-        program.reset.len(),
         program.ram_words,
         program.state_words,
         program.coefficients.len(),
