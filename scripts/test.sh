@@ -88,6 +88,8 @@ done
 verilator --lint-only -Wall --top-module gyrofx_gyro_loop hdl/gyrofx_gyro_loop.v hdl/gyrofx_nco.v \
     hdl/gyrofx_demodulator.v hdl/gyrofx_pi.v hdl/gyrofx_cic.v hdl/gyrofx_quantize.v
 verilator --lint-only -Wall --top-module gyrofx_system hdl/*.v
+verilator --lint-only -Wall --top-module gyrofx_top_serial hdl/gyrofx_top_serial.v \
+    hdl/gyrofx_serial_engine.v hdl/gyrofx_sequencer.v
 echo "== ghdl -a --std=08 -Werror (hdl/, compile order)"
 ghdl_work="$(mktemp -d)"
 ghdl -a --std=08 -Werror -Wunused -Wbinding -Wbody -Wspecs --workdir="$ghdl_work" \

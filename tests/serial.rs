@@ -1,0 +1,96 @@
+//! `architecture = "serial"`: the time-multiplexed chain (`gyrofx_top_serial`) passes the same
+//! top vectors bit-exact in every simulator, a flipped bit fails it, and bad values are
+//! refused.
+
+mod common;
+
+use common::*;
+
+/// Short intervals so that 1 300 samples hold five windows (estimates, smoothing, resets of
+/// the accumulators), B staggered.
+const SERIAL: &str = "samples = 1300\narchitecture = \"serial\"\n[sequencer]\ninterval_length = 60\nblank = 30\nstagger = 7\n";
+
+fn generate(dir: &std::path::Path, config: &str) -> String {
+    let path = dir.join("serial.toml");
+    std::fs::write(&path, config).unwrap();
+    let out = dir.join("pkg");
+    ok(&[
+        "generate",
+        "--config",
+        path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    out.to_string_lossy().into_owned()
+}
+
+fn manifest(out: &str) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(format!("{out}/manifest.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn the_serial_top_passes_the_top_vectors_in_every_simulator_and_a_flipped_bit_fails() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = generate(dir.path(), SERIAL);
+    let m = manifest(&out);
+    let chain = &m["chain"];
+    assert_eq!(chain["architecture"], "serial");
+    let instructions = chain["serial"]["instructions"].as_u64().unwrap();
+    // 4 clocks an instruction, outputs the clock after the last.
+    assert_eq!(
+        chain["latency_clocks"].as_u64().unwrap(),
+        4 * instructions + 1
+    );
+    let top = std::path::Path::new(&out).join("top");
+    assert!(top.join("tb_gyrofx_top_serial.v").exists());
+    assert!(top.join("serial_program.mem").exists());
+    assert!(!top.join("tb_gyrofx_top.v").exists());
+    for sim in ["iverilog", "verilator"] {
+        let log = ok(&["verify", "--out", &out, "--sim", sim, "--blocks", "top"]);
+        assert!(log.contains("PASS n=1301"), "{sim}: {log}");
+    }
+    let (signal, sample) = flip_checked_bit(std::path::Path::new(&out), "top", 700);
+    for sim in ["iverilog", "verilator"] {
+        let log = fails(&["verify", "--out", &out, "--sim", sim, "--blocks", "top"]);
+        assert!(
+            log.contains(&format!("MISMATCH sample {sample} signal {signal}")),
+            "{sim}: {log}"
+        );
+    }
+}
+
+#[test]
+fn wrap_convergent_and_smoothing_run_bit_exact_in_the_serial_top() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = SERIAL.replacen(
+        "[sequencer]",
+        "rounding = \"convergent\"\noverflow = \"wrap\"\n[sequencer]",
+        1,
+    ) + "[estimator]\nsmoothing_shift = 2\n";
+    let out = generate(dir.path(), &config);
+    let log = ok(&[
+        "verify", "--out", &out, "--sim", "iverilog", "--blocks", "top",
+    ]);
+    assert!(log.contains("PASS n=1301"), "{log}");
+}
+
+#[test]
+fn an_unknown_architecture_is_refused_by_name_with_nothing_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bad.toml");
+    std::fs::write(&path, "architecture = \"pipelined\"\n").unwrap();
+    let out = dir.path().join("pkg");
+    let err = fails(&[
+        "generate",
+        "--config",
+        path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        err.contains("architecture") && err.contains("pipelined") && err.contains("serial"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
