@@ -309,7 +309,8 @@ always @(posedge clk) begin
         mode_b_reg <= mode_b;
     end
     if (execute) begin
-        pc <= pc + {{(PC_W-1){1'b0}}, 1'b1};
+        // End keeps pc on itself: the idle engine fetches no word past the program.
+        if (op != OP_END) pc <= pc + {{(PC_W-1){1'b0}}, 1'b1};
         if (op == OP_END) begin
             running <= 1'b0;
             fresh <= 1'b0;

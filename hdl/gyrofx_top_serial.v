@@ -39,6 +39,8 @@ module gyrofx_top_serial #(
     parameter integer OUT_W = 24,
     parameter integer BIAS_W = 28,
     parameter integer SEL_W = 2,
+    // KF gain words: bw_sel must be below ROM_DEPTH
+    parameter integer ROM_DEPTH = 3,
     // the engine (gyrofx_serial_engine): written by gyrofx for the config
     parameter integer ACC_W = 32,
     parameter integer ADDR_W = 6,
@@ -67,6 +69,13 @@ module gyrofx_top_serial #(
     output wire signed [BIAS_W-1:0] bias_b,
     output wire                     estimated
 );
+
+initial begin
+    if (ROM_DEPTH < 1 || ROM_DEPTH > (1 << SEL_W)) begin
+        $display("%m: ROM_DEPTH (%0d) must be 1..2^SEL_W (%0d)", ROM_DEPTH, 1 << SEL_W);
+        $finish;
+    end
+end
 
 wire busy;
 wire take = ce && !busy;

@@ -96,7 +96,8 @@ ghdl -a --std=08 -Werror -Wunused -Wbinding -Wbody -Wspecs --workdir="$ghdl_work
     hdl/gyrofx_mem_pkg.vhd hdl/gyrofx_quantize.vhd hdl/gyrofx_kf.vhd hdl/gyrofx_sequencer.vhd \
     hdl/gyrofx_bias_estimator.vhd hdl/gyrofx_calibration.vhd hdl/gyrofx_top.vhd \
     hdl/gyrofx_mean_filter.vhd hdl/gyrofx_nco.vhd hdl/gyrofx_demodulator.vhd hdl/gyrofx_pi.vhd \
-    hdl/gyrofx_cic.vhd hdl/gyrofx_gyro_loop.vhd hdl/gyrofx_system.vhd hdl/gyrofx_testbench_pkg.vhd
+    hdl/gyrofx_cic.vhd hdl/gyrofx_gyro_loop.vhd hdl/gyrofx_system.vhd hdl/gyrofx_serial_engine.vhd \
+    hdl/gyrofx_top_serial.vhd hdl/gyrofx_testbench_pkg.vhd
 rm -rf "$ghdl_work"
 echo "== cargo test"
 # The C library's archive (libgyrofx_capi.a) is an artifact of a plain build, not of the test

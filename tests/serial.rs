@@ -1,6 +1,7 @@
 //! `architecture = "serial"`: the time-multiplexed chain (`gyrofx_top_serial`) passes the same
-//! top vectors bit-exact in every simulator, a flipped bit fails it, and bad values are
-//! refused.
+//! top vectors bit-exact in Icarus, Verilator and GHDL and against the C model through DPI-C, a
+//! flipped bit fails every testbench, and bad values are refused. (Its cocotb test:
+//! `python/tests/test_cocotb.py`.)
 
 mod common;
 
@@ -46,13 +47,48 @@ fn the_serial_top_passes_the_top_vectors_in_every_simulator_and_a_flipped_bit_fa
     assert!(top.join("tb_gyrofx_top_serial.v").exists());
     assert!(top.join("serial_program.mem").exists());
     assert!(!top.join("tb_gyrofx_top.v").exists());
-    for sim in ["iverilog", "verilator"] {
+    for sim in SIMULATORS {
         let log = ok(&["verify", "--out", &out, "--sim", sim, "--blocks", "top"]);
         assert!(log.contains("PASS n=1301"), "{sim}: {log}");
     }
+    // The model through DPI-C, live, a sample every SETTLE + 1 clocks.
+    let exe = std::env::current_exe().unwrap();
+    let library = exe
+        .parent()
+        .unwrap()
+        .parent()
+        .unwrap()
+        .join("libgyrofx_capi.a");
+    assert!(
+        library.is_file(),
+        "{} is missing: cargo build -p gyrofx-capi",
+        library.display()
+    );
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_gyrofx"))
+        .args(["verify", "--out", &out, "--sim", "dpi", "--blocks", "top"])
+        .env("GYROFX_CAPI_LIB", &library)
+        .output()
+        .unwrap();
+    let log = String::from_utf8_lossy(&output.stdout).into_owned()
+        + &String::from_utf8_lossy(&output.stderr);
+    assert!(
+        output.status.success() && log.contains("dpi: passed"),
+        "{log}"
+    );
+
     let (signal, sample) = flip_checked_bit(std::path::Path::new(&out), "top", 700);
-    for sim in ["iverilog", "verilator"] {
-        let log = fails(&["verify", "--out", &out, "--sim", sim, "--blocks", "top"]);
+    for sim in SIMULATORS {
+        let log = fails(&[
+            "verify",
+            "--out",
+            &out,
+            "--sim",
+            sim,
+            "--blocks",
+            "top",
+            "--max-mismatches",
+            "1",
+        ]);
         assert!(
             log.contains(&format!("MISMATCH sample {sample} signal {signal}")),
             "{sim}: {log}"

@@ -55,7 +55,10 @@ pub fn files(blocks: &[Block], provenance: &Provenance) -> Vec<(String, String)>
             .find(|(name, _)| *name == block.name)
             .map(|(_, text)| *text)
             .expect("tested blocks have a test");
-        files.push((format!("{FOLDER}/test_{}.py", block.name), python(test)));
+        files.push((
+            format!("{FOLDER}/test_{}.py", block.name),
+            python(&with_pipeline(test, block)),
+        ));
         files.push((
             format!("{FOLDER}/cocotb_{}.v", block.module),
             wrapper(block, provenance),
@@ -66,6 +69,27 @@ pub fn files(blocks: &[Block], provenance: &Provenance) -> Vec<(String, String)>
         ));
     }
     files
+}
+
+/// `test` with its pipeline constants set from `block`, the one source of its timing:
+/// `OUTPUT_CLOCKS` (clocks after the edge that takes a sample until the registered outputs show
+/// it) and `PIPELINE_CLOCKS` (idle clocks between samples at the fastest spacing).
+fn with_pipeline(test: &str, block: &Block) -> String {
+    let mut text: String = test
+        .lines()
+        .map(|line| {
+            if line.starts_with("OUTPUT_CLOCKS = ") {
+                format!("OUTPUT_CLOCKS = {}", block.settle_clocks)
+            } else if line.starts_with("PIPELINE_CLOCKS = ") {
+                format!("PIPELINE_CLOCKS = {}", block.clocks_per_sample() - 1)
+            } else {
+                line.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    text.push('\n');
+    text
 }
 
 /// `cocotb_<module>`: the block's module with this package's parameters, the test's top level.

@@ -149,7 +149,7 @@ fn body(block: &Block) -> (&'static str, String) {
             compare(longint'(bias_a), flip_next(bias_a_model), \"bias_a\");
             compare(longint'(bias_b), bias_b_model, \"bias_b\");
             compare(longint'(estimated), longint'(estimated_model), \"estimated\");"
-                .replace("{settle}", &crate::blocks::top::SETTLE_CLOCKS.to_string()),
+                .replace("{settle}", &block.settle_clocks.to_string()),
         ),
         "sequencer" => (
             "sequencer = gyrofx_sequencer_new(plan);",

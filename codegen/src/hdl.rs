@@ -77,7 +77,7 @@ pub fn verilog_sources_of(module: &str) -> Vec<&'static (&'static str, &'static 
 
 /// The reference RTL in VHDL-2008, in compile order (packages first), and the package the VHDL
 /// testbenches share (last: simulation only).
-pub const VHDL_SOURCES: [(&str, &str); 15] = [
+pub const VHDL_SOURCES: [(&str, &str); 17] = [
     (
         "gyrofx_mem_pkg.vhd",
         include_str!("../../hdl/gyrofx_mem_pkg.vhd"),
@@ -118,6 +118,14 @@ pub const VHDL_SOURCES: [(&str, &str); 15] = [
     (
         "gyrofx_system.vhd",
         include_str!("../../hdl/gyrofx_system.vhd"),
+    ),
+    (
+        "gyrofx_serial_engine.vhd",
+        include_str!("../../hdl/gyrofx_serial_engine.vhd"),
+    ),
+    (
+        "gyrofx_top_serial.vhd",
+        include_str!("../../hdl/gyrofx_top_serial.vhd"),
     ),
     (
         "gyrofx_testbench_pkg.vhd",

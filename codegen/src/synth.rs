@@ -398,12 +398,13 @@ fn report(
     provenance: &Provenance,
 ) -> String {
     format!(
-        "<!-- {} -->\n# Synthesis check: {TOP}\n\n{}\n\
+        "<!-- {} -->\n# Synthesis check: {}\n\n{}\n\
          # Synthesis check: {LOOP_TOP} (gyro A; files in `{LOOP_FOLDER}/`)\n\n{}\n\
          An estimate before place and route: the ROMs are small enough to map to LUTs, and \
          `synth_xilinx` splits a product wider than 25x18 over several DSP48E1s. A sensor \
          board runs two loops beside the chain.\n",
         provenance.line("").trim_start(),
+        top.module,
         report_section(top, &synthesis.chain),
         report_section(gyro_loop, &synthesis.gyro_loop),
     ) + &place_route_section(&synthesis.placements)
@@ -437,7 +438,7 @@ fn place_route_section(placements: &[place_route::Placement]) -> String {
 /// What `gyrofx synth` measured: the chain and one gyro's loop.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct Synthesis {
-    /// `gyrofx_top`.
+    /// The chain: `gyrofx_top`, or `gyrofx_top_serial` with `architecture = "serial"`.
     pub chain: Resources,
     /// `gyrofx_gyro_loop` (gyro A's parameters).
     pub gyro_loop: Resources,
@@ -621,7 +622,7 @@ pub fn synthesize(
         "version": provenance.version,
         "config_sha256": provenance.config_sha256,
         "config": job.config,
-        "top": TOP,
+        "top": top.module,
         "parameters": parameters_of(&top),
         "resources": synthesis.chain,
         "gyro_loop": {
@@ -632,7 +633,7 @@ pub fn synthesize(
             "resources": synthesis.gyro_loop,
         },
     "netlists": [
-            {"block": TOP_BLOCK, "module": TOP, "files": netlist_files(TOP)},
+            {"block": TOP_BLOCK, "module": top.module, "files": netlist_files(top.module)},
             {"block": LOOP_BLOCK, "module": LOOP_TOP, "files": netlist_files(LOOP_TOP).map(|f| format!("{LOOP_FOLDER}/{f}"))},
         ],
         "netlist_cells": "yosys's internal gate library: simulate with its simcells.v",

@@ -57,6 +57,22 @@ def test_one_flipped_expected_bit_fails_it(package, block):
     assert any(line.startswith(f"FAIL mismatches={scoreboards} ") for line in summary(result)), summary(result)
 
 
+def test_the_serial_top_passes_it_and_a_flipped_bit_fails_it(tmp_path):
+    # architecture = "serial": gyrofx_top_serial, its latency (thousands of clocks) written
+    # into the test by gyrofx.
+    config = tmp_path / "serial.toml"
+    config.write_text('architecture = "serial"\n[sequencer]\ninterval_length = 60\nblank = 30\n')
+    folder = tmp_path / "out"
+    run_cli("generate", "--config", str(config), "--out", str(folder), "--samples", "800", "--quiet")
+    assert "OUTPUT_CLOCKS = 5\n" not in (folder / "cocotb" / "test_top.py").read_text()
+    result = make(folder, "cocotb-top", GYROFX_COCOTB_SAMPLES="400")
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    assert all(line.startswith("PASS n=") for line in summary(result)), summary(result)
+    result = make(folder, "cocotb-top", GYROFX_COCOTB_SAMPLES="400", GYROFX_COCOTB_FLIP_EXPECTED="40")
+    assert result.returncode != 0
+    assert any(line.startswith("FAIL mismatches=2 ") for line in summary(result)), summary(result)
+
+
 def test_a_mutated_rtl_line_fails_it(package, tmp_path):
     mutant = tmp_path / "mutant"
     shutil.copytree(package, mutant)

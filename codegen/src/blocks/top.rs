@@ -70,6 +70,11 @@ pub fn serial_params(
         int("BIAS_W", est.bias.width as usize, "bias output width"),
         int("SEL_W", plan.kf.select_width() as usize, "bw_sel width"),
         int(
+            "ROM_DEPTH",
+            plan.kf.rom.len(),
+            "KF gain words (bw_sel < ROM_DEPTH)",
+        ),
+        int(
             "ACC_W",
             program.accumulator_bits as usize,
             "column accumulator width",

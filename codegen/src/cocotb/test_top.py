@@ -1,13 +1,15 @@
-"""cocotb test of gyrofx_top (sequencer, estimator, calibration, KF): `rate_out` checked against
-the gyrofx chain model wherever `out_valid` is 1 (any latency); the modes before each clock edge
-and the bias ports 5 clocks after the edge that takes each sample (the reference RTL's pipeline;
-`ce` every 6th clock at most)."""
+"""cocotb test of the chain (gyrofx_top, or gyrofx_top_serial with architecture = "serial":
+sequencer, estimator, calibration, KF): `rate_out` checked against the gyrofx chain model
+wherever `out_valid` is 1 (any latency); the modes before each clock edge and the bias ports
+OUTPUT_CLOCKS clocks after the edge that takes each sample (the RTL's latency; `ce` one clock
+later at the earliest)."""
 
 import cocotb
 
 import gyrofx_cocotb as tb
 
-# Clocks after the edge that takes a sample before the estimates show it (the RTL's pipeline).
+# Clocks after the edge that takes a sample before the estimates show it (the RTL's latency;
+# gyrofx writes this package's value).
 OUTPUT_CLOCKS = 5
 
 
