@@ -179,12 +179,16 @@ async def take_and_wait(dut, clocks):
 
 
 async def idle(dut, clocks):
-    """`clocks` clocks with ce low (a long wait, as the serial chain's, in one timer)."""
+    """`clocks` clocks with ce low: it ends after the `clocks`-th rising edge (a long wait, as the
+    serial chain's, passes most of them in one timer)."""
     if clocks > 4:
-        # A quarter period past a falling edge: no edge to race with when the timer fires.
         await FallingEdge(dut.clk)
-        await Timer((clocks - 2) * CLOCK_PERIOD_NS + CLOCK_PERIOD_NS / 4, unit="ns")
-        clocks = 1
+        dut.ce.value = 0
+        # To a quarter period before the last falling edge (no edge to race with), then the
+        # last rising edge.
+        await Timer((clocks - 1) * CLOCK_PERIOD_NS - CLOCK_PERIOD_NS // 4, unit="ns")
+        await RisingEdge(dut.clk)
+        return
     for _ in range(clocks):
         await FallingEdge(dut.clk)
         dut.ce.value = 0
