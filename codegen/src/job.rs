@@ -88,6 +88,21 @@ pub fn plan_for(settings: &KfSettings, designs: &[Design]) -> Result<Plan> {
 }
 
 impl Job {
+    /// This job with `architecture = "serial"`: the chain compiled for `gyrofx_top_serial`
+    /// (itself when it already is).
+    ///
+    /// # Errors
+    /// [`Error::Config`] when the chain has no serial program.
+    pub fn serial_variant(&self) -> Result<Job> {
+        let mut job = self.clone();
+        if job.serial.is_none() {
+            job.serial = Some(compile_serial(&job.chain)?);
+            job.config.architecture = "serial".into();
+            job.settings.architecture = crate::config::Architecture::Serial;
+        }
+        Ok(job)
+    }
+
     /// Validates `config` and resolves it.
     ///
     /// # Errors
@@ -256,6 +271,15 @@ impl RateSource {
             RateSource::Recorded(values) => values[k],
         }
     }
+}
+
+/// The chain's serial program; a chain it cannot hold is a config error on `architecture`.
+fn compile_serial(chain: &chain::Plan) -> Result<gyrofx_model::serial::Program> {
+    gyrofx_model::serial::compile(chain).map_err(|e| Error::Config {
+        field: "architecture".into(),
+        value: "\"serial\"".into(),
+        allowed: e.to_string(),
+    })
 }
 
 #[cfg(test)]

@@ -23,18 +23,24 @@ use crate::job::Job;
 use crate::package::Package;
 use crate::synth;
 
-/// The blocks placed, in the package's order: the chain's blocks, the chain, the mean filter
-/// beside it and one gyro's loop (the system, two loops and the chain, is left out: it is
-/// larger than the loop that already does not fit).
+/// The blocks placed, in the package's order: the chain's blocks, the chain, the chain in the
+/// serial architecture ([`SERIAL_TOP`]), the mean filter beside it and one gyro's loop (the
+/// system, two loops and the chain, is left out: it is larger than the loop that already does
+/// not fit).
 pub const BLOCKS: &[&str] = &[
     "sequencer",
     "estimator",
     "calibration",
     "kf",
     "top",
+    SERIAL_TOP,
     "mean_filter",
     "gyro_loop",
 ];
+
+/// `gyrofx_top_serial` compiled from the job's chain whatever its `architecture`, so that one
+/// run measures both architectures (with `architecture = "serial"`, `top` is the same design).
+pub const SERIAL_TOP: &str = "top_serial";
 
 /// The harness module around a placed block.
 pub const HARNESS: &str = "gyrofx_place_route_harness";
@@ -793,25 +799,44 @@ fn place(dir: &Path, block: &Block, target: Target) -> Result<Placement> {
     Ok(placement)
 }
 
-/// Places `names` (from [`BLOCKS`]) of `job` on `targets` in `work`, `jobs` at a time, and
-/// adds every block's design files, scripts, statistics, reports and logs to `package` under
-/// [`FOLDER`]. Results in target order, then block order.
+/// `rate` (samples/s) in MS/s, kS/s or S/s, whichever keeps it above 1.
+fn sample_rate(rate: f64) -> String {
+    if rate >= 1e6 {
+        format!("{:.1} MS/s", rate / 1e6)
+    } else if rate >= 1e3 {
+        format!("{:.1} kS/s", rate / 1e3)
+    } else {
+        format!("{rate:.0} S/s")
+    }
+}
+
+/// Places the blocks `request` names (from [`BLOCKS`]) of `job` on its targets in `work`, its
+/// `jobs` at a time, and adds every block's design files, scripts, statistics, reports and logs
+/// to `package` under [`FOLDER`]. Results in target order, then block order.
 ///
 /// # Errors
 /// A yosys or nextpnr failure other than not fitting ([`Error::Synthesis`]), or an I/O error.
 pub fn place_and_route(
     job: &Job,
     roms: &RomImages,
-    names: &[&str],
-    targets: &[Target],
-    jobs: usize,
+    provenance: &crate::writers::Provenance,
+    request: &synth::PlaceRequest,
     work: &Path,
     package: &mut Package,
 ) -> Result<Vec<Placement>> {
-    let designs: Vec<Block> = names
-        .iter()
-        .map(|name| blocks::find(name).block(job, roms))
-        .collect();
+    let (names, targets, jobs) = (&request.blocks, &request.targets, request.jobs);
+    let mut designs: Vec<Block> = Vec::new();
+    for name in names {
+        if *name == SERIAL_TOP {
+            let serial = job.serial_variant()?;
+            let serial_roms = RomImages::new(&serial, provenance);
+            let mut block = blocks::find("top").block(&serial, &serial_roms);
+            block.name = SERIAL_TOP;
+            designs.push(block);
+        } else {
+            designs.push(blocks::find(name).block(job, roms));
+        }
+    }
     let mut design_files = Vec::new();
     for block in &designs {
         let dir = work.join(FOLDER).join(block.name);
@@ -913,7 +938,7 @@ pub fn table(placements: &[Placement]) -> String {
         };
         let rate = p
             .max_sample_rate_hz
-            .map(|r| format!("{:.1} MS/s", r / 1e6))
+            .map(sample_rate)
             .unwrap_or_else(|| "—".into());
         let cells = p.logic_cells.map_or_else(
             || "—".to_string(),

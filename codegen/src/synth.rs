@@ -581,15 +581,8 @@ pub fn synthesize(
 
     let mut package = Package::new(Kind::Synth, Vec::new());
     if !place.targets.is_empty() {
-        synthesis.placements = place_route::place_and_route(
-            job,
-            &roms,
-            &place.blocks,
-            &place.targets,
-            place.jobs,
-            work.path(),
-            &mut package,
-        )?;
+        synthesis.placements =
+            place_route::place_and_route(job, &roms, provenance, place, work.path(), &mut package)?;
     }
     package.add(
         "report.md",
