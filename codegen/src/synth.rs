@@ -438,7 +438,11 @@ fn place_route_section(placements: &[place_route::Placement]) -> String {
 /// What `gyrofx synth` measured: the chain and one gyro's loop.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct Synthesis {
-    /// The chain: `gyrofx_top`, or `gyrofx_top_serial` with `architecture = "serial"`.
+    /// The chain's module: `gyrofx_top`, or `gyrofx_top_serial` with
+    /// `architecture = "serial"`.
+    #[serde(skip)]
+    pub chain_module: &'static str,
+    /// The chain.
     pub chain: Resources,
     /// `gyrofx_gyro_loop` (gyro A's parameters).
     pub gyro_loop: Resources,
@@ -574,6 +578,7 @@ pub fn synthesize(
         (chain, looped.join().expect("synthesis does not panic"))
     });
     let mut synthesis = Synthesis {
+        chain_module: top.module,
         chain: chain?,
         gyro_loop: looped?,
         placements: Vec::new(),

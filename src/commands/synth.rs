@@ -8,7 +8,7 @@ use anyhow::Result;
 use gyrofx_codegen::generate::Output;
 use gyrofx_codegen::job::Job;
 use gyrofx_codegen::place_route::{self, Target};
-use gyrofx_codegen::synth::{synthesize, PlaceRequest, LOOP_TOP, TOP};
+use gyrofx_codegen::synth::{synthesize, PlaceRequest, LOOP_TOP};
 
 use super::options::{count, ConfigSource, OutputFolder};
 use super::usage;
@@ -91,10 +91,14 @@ pub fn run(args: Args) -> Result<ExitCode> {
     spinner.finish_and_clear();
     let synthesis = synthesis?;
     println!(
-        "synthesis check passed: {TOP}, {LOOP_TOP}; report in {}",
+        "synthesis check passed: {}, {LOOP_TOP}; report in {}",
+        synthesis.chain_module,
         out.join("report.md").display()
     );
-    for (module, resources) in [(TOP, &synthesis.chain), (LOOP_TOP, &synthesis.gyro_loop)] {
+    for (module, resources) in [
+        (synthesis.chain_module, &synthesis.chain),
+        (LOOP_TOP, &synthesis.gyro_loop),
+    ] {
         let (g, x) = (&resources.generic, &resources.xilinx);
         println!(
             "{module} generic: {} cells, {} flip-flops, {} multipliers; xilinx 7-series: {} LUTs, {} flip-flops, {} DSP48E1, {} block RAM",

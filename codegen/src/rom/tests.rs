@@ -103,12 +103,18 @@ fn a_corrupted_file_does_not_parse_as_the_rom() {
 fn the_serial_program_rom_holds_the_encoded_instructions() {
     let plan = examples::chain_plan(40, 5, 3, 1, gyrofx_model::fx::Rounding::Convergent);
     let program = gyrofx_model::serial::compile(&plan).unwrap();
-    let text = write(&Rom::serial_program(&program), RomFormat::Mem, &provenance());
+    let text = write(
+        &Rom::serial_program(&program),
+        RomFormat::Mem,
+        &provenance(),
+    );
     let words: Vec<u64> = text
         .lines()
         .filter(|l| !l.starts_with("//") && !l.trim().is_empty())
         .map(|l| u64::from_str_radix(l.trim(), 16).unwrap())
         .collect();
     assert_eq!(words, program.rom_words());
-    assert!(words.iter().any(|w| w >> (program.layout.word_bits() - 4) == 15));
+    assert!(words
+        .iter()
+        .any(|w| w >> (program.layout.word_bits() - 4) == 15));
 }
