@@ -123,7 +123,7 @@ impl Costs {
             }
             let resources = synth::cost(&inputs).map_err(|e| Failure::Synthesis(e.to_string()))?;
             self.synthesized.fetch_add(1, Ordering::Relaxed);
-            write(&self.folder, &path, design, &resources).map_err(Failure::Cache)?;
+            write(&self.folder, &path, module(job, design), &resources).map_err(Failure::Cache)?;
             Ok(resources)
         });
         match outcome {
@@ -137,9 +137,10 @@ impl Costs {
     }
 }
 
-/// The module name of `design`.
-fn module(design: Design) -> &'static str {
+/// The module name of `design` of `job` (the chain's follows its `architecture`).
+fn module(job: &Job, design: Design) -> &'static str {
     match design {
+        Design::Chain if job.serial.is_some() => "gyrofx_top_serial",
         Design::Chain => synth::TOP,
         Design::GyroLoop => synth::LOOP_TOP,
     }
@@ -156,14 +157,14 @@ fn read(path: &Path) -> Option<Resources> {
 fn write(
     folder: &Path,
     path: &Path,
-    design: Design,
+    module: &str,
     resources: &Resources,
 ) -> std::result::Result<(), String> {
     use std::io::Write as _;
     let json = serde_json::json!({
         "tool": "gyrofx",
         "version": env!("CARGO_PKG_VERSION"),
-        "module": module(design),
+        "module": module,
         "resources": resources,
     });
     let fail =
@@ -200,7 +201,7 @@ mod tests {
                 carry4: 8,
             },
         };
-        write(dir.path(), &path, Design::Chain, &resources).unwrap();
+        write(dir.path(), &path, synth::TOP, &resources).unwrap();
         assert_eq!(read(&path), Some(resources));
         std::fs::write(&path, "{\"resources\": {\"generic\": {}}}").unwrap();
         assert_eq!(read(&path), None);
