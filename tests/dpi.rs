@@ -7,7 +7,7 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use common::{generate_default, run_tool, text};
+use common::{capi_library as library, generate_default, run_tool, text};
 use gyrofx_codegen::config::Config;
 use gyrofx_codegen::golden;
 use gyrofx_codegen::job::Job;
@@ -15,19 +15,6 @@ use gyrofx_codegen::job::Job;
 /// The repository.
 fn repository() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// `libgyrofx_capi.a` of this build (the workspace builds it beside the test binaries' folder).
-fn library() -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    let profile = exe.parent().and_then(Path::parent).unwrap();
-    let library = profile.join("libgyrofx_capi.a");
-    assert!(
-        library.is_file(),
-        "{} is missing: cargo build -p gyrofx-capi makes it (scripts/test.sh does, before the tests)",
-        library.display()
-    );
-    library
 }
 
 #[test]

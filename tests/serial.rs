@@ -52,18 +52,7 @@ fn the_serial_top_passes_the_top_vectors_in_every_simulator_and_a_flipped_bit_fa
         assert!(log.contains("PASS n=1301"), "{sim}: {log}");
     }
     // The model through DPI-C, live, a sample every SETTLE + 1 clocks.
-    let exe = std::env::current_exe().unwrap();
-    let library = exe
-        .parent()
-        .unwrap()
-        .parent()
-        .unwrap()
-        .join("libgyrofx_capi.a");
-    assert!(
-        library.is_file(),
-        "{} is missing: cargo build -p gyrofx-capi",
-        library.display()
-    );
+    let library = capi_library();
     let output = std::process::Command::new(env!("CARGO_BIN_EXE_gyrofx"))
         .args(["verify", "--out", &out, "--sim", "dpi", "--blocks", "top"])
         .env("GYROFX_CAPI_LIB", &library)

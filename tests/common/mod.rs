@@ -189,3 +189,16 @@ pub fn hex_sha256(data: &[u8]) -> String {
         .unwrap()
         .to_string()
 }
+
+/// `libgyrofx_capi.a` of this build (the workspace builds it beside the test binaries' folder).
+pub fn capi_library() -> PathBuf {
+    let exe = std::env::current_exe().unwrap();
+    let profile = exe.parent().and_then(Path::parent).unwrap();
+    let library = profile.join("libgyrofx_capi.a");
+    assert!(
+        library.is_file(),
+        "{} is missing: cargo build -p gyrofx-capi makes it (scripts/test.sh does, before the tests)",
+        library.display()
+    );
+    library
+}

@@ -177,16 +177,7 @@ struct Term {
 /// Limbs of `value` (low limbs 0..2^15, the top signed), as few as hold it.
 fn split(value: i128) -> Vec<i16> {
     let k = limbs_of(signed_bits(value.unsigned_abs()));
-    (0..k)
-        .map(|i| {
-            let shifted = value >> (LIMB_BITS * i);
-            if i + 1 < k {
-                (shifted & ((1 << LIMB_BITS) - 1)) as i16
-            } else {
-                shifted as i16
-            }
-        })
-        .collect()
+    (0..k).map(|i| limb_at(value, i, k)).collect()
 }
 
 struct Compiler {
