@@ -47,11 +47,13 @@
 //! kept sum, plus the output rounding), checked by a property test.
 //!
 //! Vectors: `vectors/mean_filter/`; model: [`FixedMeanFilter`], golden model:
-//! [`FloatMeanFilter`].
+//! [`FloatMeanFilter`]; the schedule of the sequential RTL (`gyrofx_mean_filter_serial`, one
+//! division per block and two comparisons per sample): [`serial`].
 
 mod fixed;
 mod float;
 mod plan;
+pub mod serial;
 
 pub use fixed::{block_mean, BlockMean, FixedMeanFilter};
 pub use float::FloatMeanFilter;

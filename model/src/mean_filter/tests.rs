@@ -196,3 +196,109 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn the_serial_division_floors_and_flags_a_remainder_at_every_edge() {
+    // Every sum of an s9 register, windows that divide it and windows that do not.
+    for window in [2u32, 3, 7, 20, 255] {
+        for sum in -256i128..256 {
+            let (floor, inexact) = serial::floor_divide(sum, 9, window);
+            let divisor = i128::from(window);
+            assert_eq!(floor, sum.div_euclid(divisor), "{sum}/{window}");
+            assert_eq!(inexact, sum.rem_euclid(divisor) != 0, "{sum}/{window}");
+        }
+    }
+}
+
+#[test]
+fn the_serial_bounds_keep_exactly_the_samples_the_deviation_test_keeps() {
+    let plan = Plan::new(&spec(20, 0.3)).unwrap();
+    let r = plan.threshold_code;
+    // A sum that 20 does not divide (mean 1000.35) and one it does (mean −1000).
+    for sum in [20_007i128, -20_000] {
+        let (low, high) = serial::kept_range(&plan, sum);
+        for x in low - 3..=high + 3 {
+            let kept = (20 * x - sum).abs() <= 20 * r;
+            assert_eq!(kept, (low..=high).contains(&x), "sum {sum}, x {x}");
+        }
+        assert!((20 * low - sum).abs() <= 20 * r && (20 * (low - 1) - sum).abs() > 20 * r);
+    }
+}
+
+#[test]
+fn the_serial_shift_and_add_product_is_the_product() {
+    for operand in [0i128, 1, -1, 5, -7, (1 << 28) - 1, -(1 << 28)] {
+        for reciprocal in [0i128, 1, 3, 0x0a_aaab, (1 << 24) - 1, 1 << 23] {
+            assert_eq!(
+                serial::shift_add_product(operand, reciprocal, 25),
+                operand * reciprocal,
+                "{operand} * {reciprocal}"
+            );
+        }
+    }
+}
+
+#[test]
+fn the_serial_latency_counts_every_phase() {
+    // s24.14 input, L = 20: SUM_W = 29, RECIP_W = 18 (the spec's).
+    let plan = Plan::new(&spec(20, 0.3)).unwrap();
+    assert_eq!(plan.sum.width, 29);
+    assert_eq!(
+        serial::latency_clocks(&plan),
+        1 + (29 - 1) + 1 + 20 + 1 + 1 + (18 - 1) + 1
+    );
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    /// The serial schedule (one division, bounds, shift-and-add product) gives the parallel
+    /// filter's block means bit for bit: random formats, windows up to 1024, thresholds from 0
+    /// to the whole range, every rounding and overflow mode, full-scale and clustered blocks.
+    #[test]
+    fn the_serial_schedule_matches_the_parallel_filter_bit_for_bit(
+        input_width in 4u32..=40,
+        output_width in 4u32..=40,
+        output_frac_shift in -4i32..=4,
+        window in 2u32..=1024,
+        threshold_fraction in 0.0f64..=1.0,
+        reciprocal_width in 12u32..=64,
+        rounding in proptest::sample::select(Rounding::ALL.to_vec()),
+        saturate in any::<bool>(),
+        seed in any::<u64>(),
+        spread_shift in 0u32..=40,
+    ) {
+        let input = Format::signed(input_width, input_width as i32 / 2).unwrap();
+        let output = Format::signed(output_width, input.frac + output_frac_shift).unwrap();
+        let plan = Plan::new(&Spec {
+            input,
+            output,
+            window,
+            threshold_dps: threshold_fraction * input.max_value(),
+            reciprocal_width,
+            rounding,
+            overflow: if saturate { Overflow::Saturate } else { Overflow::Wrap },
+        });
+        // Narrow reciprocals for long windows are refused (1/L rounds to 0): nothing to test.
+        let Ok(plan) = plan else { return Ok(()); };
+        let (low, high) = (input.min_code(), input.max_code());
+        let spread = (high >> spread_shift.min(input_width - 1)).max(1);
+        let center = (seed as i128 % (high + 1)).clamp(low + spread, high - spread);
+        let mut state = seed | 1;
+        let block: Vec<i64> = (0..window)
+            .map(|i| {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                let x = match (seed >> 3) % 4 {
+                    0 if i % 2 == 0 => high,
+                    0 => low,
+                    1 => [high, low][(state % 2) as usize],
+                    _ => center + (state >> 4) as i128 % (2 * spread + 1) - spread,
+                };
+                x.clamp(low, high) as i64
+            })
+            .collect();
+        prop_assert_eq!(serial::block_mean(&plan, &block), block_mean(&plan, &block));
+    }
+}
