@@ -20,7 +20,8 @@
  *   ROM[n] = 1/n for n = 1..WINDOW and ROM[0] = 1/WINDOW (every sample rejected:
  *   the plain mean). Every sample of a block is compared in parallel, in the
  *   clock of its last ce: WINDOW adders and comparators; fine for paper 003's
- *   WINDOW = 20, a sequential variant would suit windows of hundreds.
+ *   WINDOW = 20. gyrofx_mean_filter_serial computes the same means one step a
+ *   clock (architecture = "serial").
  *
  * Latency: y, kept and y_valid are registered: y_valid pulses 1 clock after a
  *   block's last ce. A clock with rst high starts a new block and clears

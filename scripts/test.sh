@@ -82,7 +82,7 @@ echo "== cargo clippy --all-targets -D warnings"
 cargo clippy --workspace --all-targets --quiet -- -D warnings
 echo "== verilator --lint-only -Wall (hdl/)"
 verilator --lint-only -Wall --top-module gyrofx_top hdl/*.v
-for module in gyrofx_mean_filter gyrofx_nco gyrofx_demodulator gyrofx_pi gyrofx_cic; do
+for module in gyrofx_mean_filter gyrofx_mean_filter_serial gyrofx_nco gyrofx_demodulator gyrofx_pi gyrofx_cic; do
     verilator --lint-only -Wall --top-module "$module" "hdl/$module.v" hdl/gyrofx_quantize.v
 done
 verilator --lint-only -Wall --top-module gyrofx_gyro_loop hdl/gyrofx_gyro_loop.v hdl/gyrofx_nco.v \
@@ -95,7 +95,7 @@ ghdl_work="$(mktemp -d)"
 ghdl -a --std=08 -Werror -Wunused -Wbinding -Wbody -Wspecs --workdir="$ghdl_work" \
     hdl/gyrofx_mem_pkg.vhd hdl/gyrofx_quantize.vhd hdl/gyrofx_kf.vhd hdl/gyrofx_sequencer.vhd \
     hdl/gyrofx_bias_estimator.vhd hdl/gyrofx_calibration.vhd hdl/gyrofx_top.vhd \
-    hdl/gyrofx_mean_filter.vhd hdl/gyrofx_nco.vhd hdl/gyrofx_demodulator.vhd hdl/gyrofx_pi.vhd \
+    hdl/gyrofx_mean_filter.vhd hdl/gyrofx_mean_filter_serial.vhd hdl/gyrofx_nco.vhd hdl/gyrofx_demodulator.vhd hdl/gyrofx_pi.vhd \
     hdl/gyrofx_cic.vhd hdl/gyrofx_gyro_loop.vhd hdl/gyrofx_system.vhd hdl/gyrofx_serial_engine.vhd \
     hdl/gyrofx_top_serial.vhd hdl/gyrofx_testbench_pkg.vhd
 rm -rf "$ghdl_work"

@@ -2,7 +2,7 @@
 //! in compile order (a unit before its users), and the sources one module needs.
 
 /// The reference RTL, embedded so that every package is self-contained.
-pub const RTL_SOURCES: [(&str, &str); 15] = [
+pub const RTL_SOURCES: [(&str, &str); 16] = [
     (
         "gyrofx_quantize.v",
         include_str!("../../hdl/gyrofx_quantize.v"),
@@ -32,6 +32,10 @@ pub const RTL_SOURCES: [(&str, &str); 15] = [
     (
         "gyrofx_mean_filter.v",
         include_str!("../../hdl/gyrofx_mean_filter.v"),
+    ),
+    (
+        "gyrofx_mean_filter_serial.v",
+        include_str!("../../hdl/gyrofx_mean_filter_serial.v"),
     ),
     ("gyrofx_nco.v", include_str!("../../hdl/gyrofx_nco.v")),
     (
@@ -77,7 +81,7 @@ pub fn verilog_sources_of(module: &str) -> Vec<&'static (&'static str, &'static 
 
 /// The reference RTL in VHDL-2008, in compile order (packages first), and the package the VHDL
 /// testbenches share (last: simulation only).
-pub const VHDL_SOURCES: [(&str, &str); 17] = [
+pub const VHDL_SOURCES: [(&str, &str); 18] = [
     (
         "gyrofx_mem_pkg.vhd",
         include_str!("../../hdl/gyrofx_mem_pkg.vhd"),
@@ -103,6 +107,10 @@ pub const VHDL_SOURCES: [(&str, &str); 17] = [
     (
         "gyrofx_mean_filter.vhd",
         include_str!("../../hdl/gyrofx_mean_filter.vhd"),
+    ),
+    (
+        "gyrofx_mean_filter_serial.vhd",
+        include_str!("../../hdl/gyrofx_mean_filter_serial.vhd"),
     ),
     ("gyrofx_nco.vhd", include_str!("../../hdl/gyrofx_nco.vhd")),
     (
@@ -160,6 +168,10 @@ mod tests {
         assert_eq!(
             names("gyrofx_mean_filter"),
             ["gyrofx_quantize.v", "gyrofx_mean_filter.v"]
+        );
+        assert_eq!(
+            names("gyrofx_mean_filter_serial"),
+            ["gyrofx_quantize.v", "gyrofx_mean_filter_serial.v"]
         );
         assert_eq!(names("gyrofx_sequencer"), ["gyrofx_sequencer.v"]);
         assert_eq!(
