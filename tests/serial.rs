@@ -155,3 +155,128 @@ fn other_formats_and_modes_run_bit_exact_in_the_serial_top() {
         assert!(log.contains("PASS n=901"), "{rounding}/{overflow}: {log}");
     }
 }
+
+/// `architecture = "serial"` makes the mean filter beside the chain `gyrofx_mean_filter_serial`:
+/// its own vectors (the parallel filter's, at the sequential latency) pass bit-exact in every
+/// simulator and against the C model through DPI-C, and a flipped bit fails them.
+#[test]
+fn the_serial_mean_filter_passes_its_vectors_in_every_simulator_and_a_flipped_bit_fails() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = generate(dir.path(), SERIAL);
+    let m = manifest(&out);
+    let mf = &m["mean_filter"];
+    assert_eq!(mf["architecture"], "serial");
+    assert_eq!(mf["module"], "gyrofx_mean_filter_serial");
+    // Division over the sum's magnitude bits, bounds, the scan, the ROM read, the load, the
+    // multiply over the reciprocal's magnitude bits, the output; counting the ce's clock.
+    let width = |node: &str| {
+        let format: String = mf["formats"][node].as_str().unwrap().into();
+        format[1..format.find('.').unwrap()].parse::<u64>().unwrap()
+    };
+    let window = mf["window"].as_u64().unwrap();
+    let latency = 1 + (width("sum") - 1) + 1 + window + 1 + 1 + (width("reciprocal") - 1) + 1;
+    assert_eq!(mf["latency_clocks"].as_u64().unwrap(), latency);
+    assert_eq!(mf["min_clocks_per_sample"].as_u64().unwrap(), latency);
+    let folder = std::path::Path::new(&out).join("mean_filter");
+    assert!(folder.join("tb_gyrofx_mean_filter_serial.v").exists());
+    assert!(folder.join("tb_gyrofx_mean_filter_serial.vhd").exists());
+    assert!(!folder.join("tb_gyrofx_mean_filter.v").exists());
+    let lines = m["blocks"]["mean_filter"]["vectors"].as_u64().unwrap();
+    for sim in SIMULATORS {
+        let log = ok(&[
+            "verify",
+            "--out",
+            &out,
+            "--sim",
+            sim,
+            "--blocks",
+            "mean_filter",
+        ]);
+        assert!(log.contains(&format!("PASS n={lines}")), "{sim}: {log}");
+    }
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_gyrofx"))
+        .args([
+            "verify",
+            "--out",
+            &out,
+            "--sim",
+            "dpi",
+            "--blocks",
+            "mean_filter",
+        ])
+        .env("GYROFX_CAPI_LIB", capi_library())
+        .output()
+        .unwrap();
+    let log = String::from_utf8_lossy(&output.stdout).into_owned()
+        + &String::from_utf8_lossy(&output.stderr);
+    assert!(
+        output.status.success() && log.contains("dpi: passed"),
+        "{log}"
+    );
+
+    let (signal, sample) = flip_checked_bit(std::path::Path::new(&out), "mean_filter", 600);
+    for sim in SIMULATORS {
+        let log = fails(&[
+            "verify",
+            "--out",
+            &out,
+            "--sim",
+            sim,
+            "--blocks",
+            "mean_filter",
+            "--max-mismatches",
+            "1",
+        ]);
+        assert!(
+            log.contains(&format!("MISMATCH sample {sample} signal {signal}")),
+            "{sim}: {log}"
+        );
+    }
+}
+
+/// The sequential mean filter at other windows, formats and modes: an odd window, a window of
+/// hundreds (a 33-bit sum), a threshold of 0 (only samples on the mean kept), narrow
+/// reciprocals; in Icarus against the vectors of each.
+#[test]
+fn other_windows_formats_and_modes_run_bit_exact_in_the_serial_mean_filter() {
+    let cases = [
+        (
+            "convergent",
+            "wrap",
+            "[mean_filter]\nwindow = 7\nthreshold_dps = 0.05\nreciprocal_width = 12\n",
+        ),
+        (
+            "floor",
+            "saturate",
+            "[mean_filter]\nwindow = 300\nthreshold_dps = 1.5\noutput_format = \"s20.12\"\n",
+        ),
+        (
+            "ceil",
+            "saturate",
+            "[mean_filter]\nwindow = 2\nthreshold_dps = 0.0\nreciprocal_width = 40\n",
+        ),
+    ];
+    for (rounding, overflow, table) in cases {
+        let dir = tempfile::tempdir().unwrap();
+        let config = format!(
+            "samples = 900\narchitecture = \"serial\"\nrounding = \"{rounding}\"\noverflow = \"{overflow}\"\n{table}"
+        );
+        let out = generate(dir.path(), &config);
+        let lines = manifest(&out)["blocks"]["mean_filter"]["vectors"]
+            .as_u64()
+            .unwrap();
+        let log = ok(&[
+            "verify",
+            "--out",
+            &out,
+            "--sim",
+            "iverilog",
+            "--blocks",
+            "mean_filter",
+        ]);
+        assert!(
+            log.contains(&format!("PASS n={lines}")),
+            "{rounding}/{overflow}: {log}"
+        );
+    }
+}

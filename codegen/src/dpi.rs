@@ -127,7 +127,19 @@ fn body(block: &Block) -> (&'static str, String) {
             check_call(gyrofx_mean_filter_step(filter, longint'(x), valid, stream_model, model_kept));
             if (valid == 1) expect_stream(stream_model, model_kept);
             @(posedge clk);"
-                .to_string(),
+                .to_string()
+                + &if block.settle_clocks > 0 {
+                    // The sequential filter: the next sample once a block's mean is out.
+                    format!(
+                        "
+            @(negedge clk);
+            ce = 1'b0;
+            repeat ({}) @(posedge clk);",
+                        block.settle_clocks
+                    )
+                } else {
+                    String::new()
+                },
         ),
         "top" => (
             "chain = gyrofx_chain_new(plan);",

@@ -24,7 +24,8 @@ use crate::package::Package;
 use crate::synth;
 
 /// The blocks placed, in the package's order: the chain's blocks, the chain, the chain in the
-/// serial architecture ([`SERIAL_TOP`]), the mean filter beside it and one gyro's loop (the
+/// serial architecture ([`SERIAL_TOP`]), the mean filter beside it in both architectures
+/// ([`SERIAL_MEAN_FILTER`]) and one gyro's loop (the
 /// system, two loops and the chain, is left out: it is larger than the loop that already does
 /// not fit).
 pub const BLOCKS: &[&str] = &[
@@ -35,12 +36,16 @@ pub const BLOCKS: &[&str] = &[
     "top",
     SERIAL_TOP,
     "mean_filter",
+    SERIAL_MEAN_FILTER,
     "gyro_loop",
 ];
 
 /// `gyrofx_top_serial` compiled from the job's chain whatever its `architecture`, so that one
 /// run measures both architectures (with `architecture = "serial"`, `top` is the same design).
 pub const SERIAL_TOP: &str = "top_serial";
+
+/// `gyrofx_mean_filter_serial` with the job's mean filter whatever its `architecture`.
+pub const SERIAL_MEAN_FILTER: &str = "mean_filter_serial";
 
 /// The harness module around a placed block.
 pub const HARNESS: &str = "gyrofx_place_route_harness";
@@ -826,12 +831,22 @@ pub fn place_and_route(
 ) -> Result<Vec<Placement>> {
     let (names, targets, jobs) = (&request.blocks, &request.targets, request.jobs);
     let mut designs: Vec<Block> = Vec::new();
+    let mut serial: Option<(Job, RomImages)> = None;
     for name in names {
-        if *name == SERIAL_TOP {
-            let serial = job.serial_variant()?;
-            let serial_roms = RomImages::new(&serial, provenance);
-            let mut block = blocks::find("top").block(&serial, &serial_roms);
-            block.name = SERIAL_TOP;
+        let of = match *name {
+            SERIAL_TOP => Some("top"),
+            SERIAL_MEAN_FILTER => Some("mean_filter"),
+            _ => None,
+        };
+        if let Some(of) = of {
+            if serial.is_none() {
+                let job = job.serial_variant()?;
+                let roms = RomImages::new(&job, provenance);
+                serial = Some((job, roms));
+            }
+            let (serial_job, serial_roms) = serial.as_ref().expect("set above");
+            let mut block = blocks::find(of).block(serial_job, serial_roms);
+            block.name = *name;
             designs.push(block);
         } else {
             designs.push(blocks::find(name).block(job, roms));

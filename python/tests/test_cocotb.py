@@ -57,9 +57,9 @@ def test_one_flipped_expected_bit_fails_it(package, block):
     assert any(line.startswith(f"FAIL mismatches={scoreboards} ") for line in summary(result)), summary(result)
 
 
-def test_the_serial_top_passes_it_and_a_flipped_bit_fails_it(tmp_path):
-    # architecture = "serial": gyrofx_top_serial, its latency (thousands of clocks) written
-    # into the test by gyrofx.
+def test_the_serial_blocks_pass_it_and_a_flipped_bit_fails_it(tmp_path):
+    # architecture = "serial": gyrofx_top_serial and gyrofx_mean_filter_serial, their latency
+    # written into the tests by gyrofx.
     config = tmp_path / "serial.toml"
     config.write_text('architecture = "serial"\n[sequencer]\ninterval_length = 60\nblank = 30\n')
     folder = tmp_path / "out"
@@ -71,6 +71,15 @@ def test_the_serial_top_passes_it_and_a_flipped_bit_fails_it(tmp_path):
     result = make(folder, "cocotb-top", GYROFX_COCOTB_SAMPLES="400", GYROFX_COCOTB_FLIP_EXPECTED="40")
     assert result.returncode != 0
     assert any(line.startswith("FAIL mismatches=2 ") for line in summary(result)), summary(result)
+    # The sequential mean filter beside it: the next sample after its latency.
+    assert (folder / "cocotb" / "cocotb_gyrofx_mean_filter_serial.v").exists()
+    assert "PIPELINE_CLOCKS = 0\n" not in (folder / "cocotb" / "test_mean_filter.py").read_text()
+    result = make(folder, "cocotb-mean_filter", GYROFX_COCOTB_SAMPLES="1000")
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    assert all(line.startswith("PASS n=") for line in summary(result)), summary(result)
+    result = make(folder, "cocotb-mean_filter", GYROFX_COCOTB_SAMPLES="1000", GYROFX_COCOTB_FLIP_EXPECTED="40")
+    assert result.returncode != 0
+    assert any(line.startswith("FAIL mismatches=1 ") for line in summary(result)), summary(result)
 
 
 def test_a_mutated_rtl_line_fails_it(package, tmp_path):

@@ -28,7 +28,9 @@ pub struct Args {
     #[arg(long, value_name = "LIST")]
     target: Option<String>,
     /// The blocks placed with --target, comma-separated (default: all of sequencer,
-    /// estimator, calibration, kf, top, mean_filter, gyro_loop).
+    /// estimator, calibration, kf, top, top_serial, mean_filter, mean_filter_serial,
+    /// gyro_loop; the _serial ones are the config's chain and mean filter in the serial
+    /// architecture).
     #[arg(long, value_name = "LIST", requires = "target")]
     blocks: Option<String>,
     /// yosys and nextpnr runs at a time for --target (default: the available cores).

@@ -4,11 +4,12 @@
 
 pub mod config;
 
-use gyrofx_model::mean_filter::{FixedMeanFilter, FloatMeanFilter, Plan};
+use gyrofx_model::mean_filter::{serial, FixedMeanFilter, FloatMeanFilter, Plan};
 use serde_json::json;
 
 use super::{mode_params, ChainSample, RomImages, RtlBlock, VectorBuilder};
 use crate::block::{Block, Output, Param, Signal};
+use crate::config::Architecture;
 use crate::job::Job;
 use crate::rom::{Rom, RomFormat, ROM_FOLDER};
 use crate::stats::Accumulator;
@@ -16,6 +17,10 @@ use crate::vectors::{Results, Run};
 
 /// The mean-filter block.
 pub struct MeanFilter;
+
+/// The module with `architecture = "serial"`: one step a clock, no multiplier
+/// (`hdl/gyrofx_mean_filter_serial.v`, `gyrofx_model::mean_filter::serial`).
+pub const SERIAL_MODULE: &str = "gyrofx_mean_filter_serial";
 
 /// Name of its reciprocal ROM.
 pub const ROM: &str = "mean_filter_reciprocals";
@@ -76,17 +81,30 @@ impl RtlBlock for MeanFilter {
             plan.sum.width.into(),
             format!("block sum: {}", plan.sum),
         ));
-        block.params.push(Param::integer(
-            "DEV_W",
-            plan.deviation.width.into(),
-            format!("L*x - sum: {}", plan.deviation),
-        ));
-        block.params.push(Param::bits(
-            "SCALED_THRESHOLD",
-            plan.deviation.width,
-            plan.scaled_threshold as u128,
-            format!("L*r in input LSB (r = {} °/s)", plan.threshold_dps()),
-        ));
+        if job.settings.architecture == Architecture::Serial {
+            block.module = SERIAL_MODULE;
+            block.title = "mean filter with gross-error rejection (paper 003), sequential";
+            block.params.push(Param::bits(
+                "THRESHOLD",
+                plan.input.width,
+                plan.threshold_code as u128,
+                format!("r in input LSB ({} °/s)", plan.threshold_dps()),
+            ));
+            // The registered outputs show a block's mean this many clocks after its last ce.
+            block.settle_clocks = serial::latency_clocks(plan) - 1;
+        } else {
+            block.params.push(Param::integer(
+                "DEV_W",
+                plan.deviation.width.into(),
+                format!("L*x - sum: {}", plan.deviation),
+            ));
+            block.params.push(Param::bits(
+                "SCALED_THRESHOLD",
+                plan.deviation.width,
+                plan.scaled_threshold as u128,
+                format!("L*r in input LSB (r = {} °/s)", plan.threshold_dps()),
+            ));
+        }
         block
             .params
             .extend(Param::format("RECIP", plan.reciprocal, "reciprocals 1/n"));
@@ -123,6 +141,15 @@ impl RtlBlock for MeanFilter {
     ) -> Option<(&'static str, serde_json::Value)> {
         let mf = &job.mean_filter;
         let rom = roms.get(ROM);
+        // Parallel: a sample every clock, the mean 1 clock after a block's last; serial: the
+        // next ce or rst no sooner than the mean.
+        let (architecture, module, latency, min_spacing) = match job.settings.architecture {
+            Architecture::Parallel => ("parallel", self.module(), 1, 1),
+            Architecture::Serial => {
+                let latency = serial::latency_clocks(mf);
+                ("serial", SERIAL_MODULE, latency, latency)
+            }
+        };
         Some((
             "mean_filter",
             json!({
@@ -141,7 +168,10 @@ impl RtlBlock for MeanFilter {
                 "rom": {"file": RomFormat::Mem.file_name(&rom.rom.name), "depth": mf.rom.len(), "word_bits": rom.rom.width(), "all_formats": ROM_FOLDER,
                         "order": "address = samples kept n: 1/n; address 0: 1/L (every sample rejected)"},
                 "stimulus": "gyro A's ADC samples with a gross error of 8 r every 53rd sample, the chain's reset, then directed blocks (samples at exactly r, at r + 1 LSB, all rejected, full scale, a full-scale spike)",
-                "latency_clocks": 1,
+                "architecture": architecture,
+                "module": module,
+                "latency_clocks": latency,
+                "min_clocks_per_sample": min_spacing,
                 "fixed_vs_float": run.mean_filter_stats,
             }),
         ))
