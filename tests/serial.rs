@@ -30,6 +30,46 @@ fn manifest(out: &str) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(format!("{out}/manifest.json")).unwrap()).unwrap()
 }
 
+/// `block` of the package at `out` passes its `lines` vectors in Icarus, Verilator and GHDL and
+/// against the C model through DPI-C (live, its samples spaced by the block's latency), and
+/// one expected bit flipped from sample `from` on fails every simulator at that sample.
+fn passes_everywhere_and_a_flipped_bit_fails(out: &str, block: &str, lines: u64, from: usize) {
+    for sim in SIMULATORS {
+        let log = ok(&["verify", "--out", out, "--sim", sim, "--blocks", block]);
+        assert!(log.contains(&format!("PASS n={lines}")), "{sim}: {log}");
+    }
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_gyrofx"))
+        .args(["verify", "--out", out, "--sim", "dpi", "--blocks", block])
+        .env("GYROFX_CAPI_LIB", capi_library())
+        .output()
+        .unwrap();
+    let log = String::from_utf8_lossy(&output.stdout).into_owned()
+        + &String::from_utf8_lossy(&output.stderr);
+    assert!(
+        output.status.success() && log.contains("dpi: passed"),
+        "{log}"
+    );
+
+    let (signal, sample) = flip_checked_bit(std::path::Path::new(out), block, from);
+    for sim in SIMULATORS {
+        let log = fails(&[
+            "verify",
+            "--out",
+            out,
+            "--sim",
+            sim,
+            "--blocks",
+            block,
+            "--max-mismatches",
+            "1",
+        ]);
+        assert!(
+            log.contains(&format!("MISMATCH sample {sample} signal {signal}")),
+            "{sim}: {log}"
+        );
+    }
+}
+
 #[test]
 fn the_serial_top_passes_the_top_vectors_in_every_simulator_and_a_flipped_bit_fails() {
     let dir = tempfile::tempdir().unwrap();
@@ -47,42 +87,7 @@ fn the_serial_top_passes_the_top_vectors_in_every_simulator_and_a_flipped_bit_fa
     assert!(top.join("tb_gyrofx_top_serial.v").exists());
     assert!(top.join("serial_program.mem").exists());
     assert!(!top.join("tb_gyrofx_top.v").exists());
-    for sim in SIMULATORS {
-        let log = ok(&["verify", "--out", &out, "--sim", sim, "--blocks", "top"]);
-        assert!(log.contains("PASS n=1301"), "{sim}: {log}");
-    }
-    // The model through DPI-C, live, a sample every SETTLE + 1 clocks.
-    let library = capi_library();
-    let output = std::process::Command::new(env!("CARGO_BIN_EXE_gyrofx"))
-        .args(["verify", "--out", &out, "--sim", "dpi", "--blocks", "top"])
-        .env("GYROFX_CAPI_LIB", &library)
-        .output()
-        .unwrap();
-    let log = String::from_utf8_lossy(&output.stdout).into_owned()
-        + &String::from_utf8_lossy(&output.stderr);
-    assert!(
-        output.status.success() && log.contains("dpi: passed"),
-        "{log}"
-    );
-
-    let (signal, sample) = flip_checked_bit(std::path::Path::new(&out), "top", 700);
-    for sim in SIMULATORS {
-        let log = fails(&[
-            "verify",
-            "--out",
-            &out,
-            "--sim",
-            sim,
-            "--blocks",
-            "top",
-            "--max-mismatches",
-            "1",
-        ]);
-        assert!(
-            log.contains(&format!("MISMATCH sample {sample} signal {signal}")),
-            "{sim}: {log}"
-        );
-    }
+    passes_everywhere_and_a_flipped_bit_fails(&out, "top", 1301, 700);
 }
 
 #[test]
@@ -182,56 +187,7 @@ fn the_serial_mean_filter_passes_its_vectors_in_every_simulator_and_a_flipped_bi
     assert!(folder.join("tb_gyrofx_mean_filter_serial.vhd").exists());
     assert!(!folder.join("tb_gyrofx_mean_filter.v").exists());
     let lines = m["blocks"]["mean_filter"]["vectors"].as_u64().unwrap();
-    for sim in SIMULATORS {
-        let log = ok(&[
-            "verify",
-            "--out",
-            &out,
-            "--sim",
-            sim,
-            "--blocks",
-            "mean_filter",
-        ]);
-        assert!(log.contains(&format!("PASS n={lines}")), "{sim}: {log}");
-    }
-    let output = std::process::Command::new(env!("CARGO_BIN_EXE_gyrofx"))
-        .args([
-            "verify",
-            "--out",
-            &out,
-            "--sim",
-            "dpi",
-            "--blocks",
-            "mean_filter",
-        ])
-        .env("GYROFX_CAPI_LIB", capi_library())
-        .output()
-        .unwrap();
-    let log = String::from_utf8_lossy(&output.stdout).into_owned()
-        + &String::from_utf8_lossy(&output.stderr);
-    assert!(
-        output.status.success() && log.contains("dpi: passed"),
-        "{log}"
-    );
-
-    let (signal, sample) = flip_checked_bit(std::path::Path::new(&out), "mean_filter", 600);
-    for sim in SIMULATORS {
-        let log = fails(&[
-            "verify",
-            "--out",
-            &out,
-            "--sim",
-            sim,
-            "--blocks",
-            "mean_filter",
-            "--max-mismatches",
-            "1",
-        ]);
-        assert!(
-            log.contains(&format!("MISMATCH sample {sample} signal {signal}")),
-            "{sim}: {log}"
-        );
-    }
+    passes_everywhere_and_a_flipped_bit_fails(&out, "mean_filter", lines, 600);
 }
 
 /// The sequential mean filter at other windows, formats and modes: an odd window, a window of

@@ -74,7 +74,12 @@ pub fn block_mean(plan: &Plan, block: &[i64]) -> BlockMean {
     } else {
         (kept as usize, kept_sum)
     };
-    let product = total * plan.rom[address];
+    quantized_mean(plan, total * plan.rom[address], kept)
+}
+
+/// The block's result from its exact product `operand · ROM[kept]` (format `plan.product`):
+/// the one quantization point.
+pub(super) fn quantized_mean(plan: &Plan, product: i128, kept: u32) -> BlockMean {
     let q = requantize(
         product,
         plan.product.frac,

@@ -35,9 +35,8 @@
 //! so `y_valid` pulses [`latency_clocks`] clocks after the block's last `ce` (counting the
 //! clock of that `ce` as the first, as the parallel filter's 1).
 
-use super::fixed::BlockMean;
+use super::fixed::{quantized_mean, BlockMean};
 use super::plan::Plan;
-use crate::fx::requantize;
 
 /// Clocks from a block's last `ce` until `y_valid` pulses (the parallel filter's 1):
 /// `1 + (SUM_W − 1) + 1 + L + 1 + 1 + (RECIP_W − 1) + 1 = SUM_W + L + RECIP_W + 3`. It is also the
@@ -117,16 +116,5 @@ pub fn block_mean(plan: &Plan, block: &[i64]) -> BlockMean {
     }
     let operand = if kept == 0 { sum } else { kept_sum };
     let product = shift_add_product(operand, plan.rom[kept as usize], plan.reciprocal.width);
-    let q = requantize(
-        product,
-        plan.product.frac,
-        plan.output,
-        plan.rounding,
-        plan.overflow,
-    );
-    BlockMean {
-        y: q.code as i64,
-        kept,
-        overflowed: q.overflowed,
-    }
+    quantized_mean(plan, product, kept)
 }
