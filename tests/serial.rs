@@ -182,6 +182,9 @@ fn the_serial_mean_filter_passes_its_vectors_in_every_simulator_and_a_flipped_bi
     let latency = 1 + (width("sum") - 1) + 1 + window + 1 + 1 + (width("reciprocal") - 1) + 1;
     assert_eq!(mf["latency_clocks"].as_u64().unwrap(), latency);
     assert_eq!(mf["min_clocks_per_sample"].as_u64().unwrap(), latency);
+    // The samples are compared with a kept range one bit wider than the sum, not a deviation.
+    assert!(mf["formats"]["deviation"].is_null(), "{mf}");
+    assert_eq!(width("kept_range"), width("sum") + 1);
     let folder = std::path::Path::new(&out).join("mean_filter");
     assert!(folder.join("tb_gyrofx_mean_filter_serial.v").exists());
     assert!(folder.join("tb_gyrofx_mean_filter_serial.vhd").exists());

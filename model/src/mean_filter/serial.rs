@@ -22,21 +22,21 @@
 //! | phase | clocks | what |
 //! |-------|--------|------|
 //! | divide | `SUM_W − 1` | one quotient bit a clock (the dividend is loaded by the last `ce`) |
-//! | bounds | 1 | `lo`, `hi`; reads sample 0 |
-//! | scan | `L` | keep `lo ≤ x ≤ hi`: count, kept sum; reads the next sample |
+//! | bounds | 1 | `kept_low`, `kept_high`; reads sample 0 |
+//! | scan | `L` | keep `kept_low ≤ x ≤ kept_high`: count, kept sum; reads the next sample |
 //! | reciprocal | 1 | reads `ROM[n]` |
 //! | load | 1 | the reciprocal's `RECIP_W − 1` magnitude bits into the product's low half (its sign bit is 0) |
 //! | multiply | `RECIP_W − 1` | shift and add, lowest bit first: `high = (high + bit·operand) >> 1`, the bit shifted out into the low half (operand: the kept sum; `n = 0`: the plain sum) |
 //! | output | 1 | `y = Q({high, low})`, `kept = n`, `y_valid` |
 //!
-//! The adder of the multiply is `SUM_W + 1` bits wide, not the product's `SUM_W + RECIP_W`:
-//! `|high| ≤ |operand|` after every step.
-//!
 //! so `y_valid` pulses [`latency_clocks`] clocks after the block's last `ce` (counting the
-//! clock of that `ce` as the first, as the parallel filter's 1).
+//! clock of that `ce` as the first, as the parallel filter's 1). The adder of the multiply is
+//! `SUM_W + 1` bits wide, not the product's `SUM_W + RECIP_W`: `|high| ≤ |operand|` after
+//! every step.
 
 use super::fixed::{quantized_mean, BlockMean};
 use super::plan::Plan;
+use crate::fx::Format;
 
 /// Clocks from a block's last `ce` until `y_valid` pulses (the parallel filter's 1):
 /// `1 + (SUM_W − 1) + 1 + L + 1 + 1 + (RECIP_W − 1) + 1 = SUM_W + L + RECIP_W + 3`. It is also the
@@ -44,6 +44,13 @@ use super::plan::Plan;
 /// RAM; a reset stops the block being processed).
 pub fn latency_clocks(plan: &Plan) -> u32 {
     plan.sum.width + plan.window + plan.reciprocal.width + 3
+}
+
+/// The kept range's bounds (and the product's high half): `SUM_W + 1` bits, as `sum`'s
+/// fraction, enough for `floor(sum/L) ± r` and for `high + operand`.
+pub fn kept_range_format(plan: &Plan) -> Format {
+    Format::intermediate(true, plan.sum.width + 1, plan.sum.frac)
+        .expect("the plan's product already holds more bits")
 }
 
 /// `floor(sum / window)` and whether the division left a remainder, as the RTL computes them:

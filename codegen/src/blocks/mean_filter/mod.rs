@@ -141,18 +141,26 @@ impl RtlBlock for MeanFilter {
     ) -> Option<(&'static str, serde_json::Value)> {
         let mf = &job.mean_filter;
         let rom = roms.get(ROM);
-        // Parallel: a sample every clock, the mean 1 clock after a block's last; serial: the
-        // next ce or rst no sooner than the mean.
-        let (architecture, module, latency, min_spacing) = match job.settings.architecture {
-            Architecture::Parallel => ("parallel", self.module(), 1, 1),
-            Architecture::Serial => {
-                let latency = serial::latency_clocks(mf);
-                ("serial", SERIAL_MODULE, latency, latency)
-            }
-        };
-        Some((
-            "mean_filter",
-            json!({
+        // Parallel: a sample every clock, the mean 1 clock after a block's last, every sample
+        // compared by its deviation L·x − sum. Serial: the next ce or rst no sooner than the
+        // mean, the samples compared with a kept range.
+        let (architecture, module, latency, min_spacing, (compared, compared_format)) =
+            match job.settings.architecture {
+                Architecture::Parallel => {
+                    ("parallel", self.module(), 1, 1, ("deviation", mf.deviation))
+                }
+                Architecture::Serial => {
+                    let latency = serial::latency_clocks(mf);
+                    (
+                        "serial",
+                        SERIAL_MODULE,
+                        latency,
+                        latency,
+                        ("kept_range", serial::kept_range_format(mf)),
+                    )
+                }
+            };
+        let section = json!({
                 "window": mf.window,
                 "threshold_dps": job.config.mean_filter.threshold_dps,
                 "threshold_quantized_dps": mf.threshold_dps(),
@@ -161,7 +169,7 @@ impl RtlBlock for MeanFilter {
                     "input": mf.input.to_string(),
                     "output": mf.output.to_string(),
                     "sum": mf.sum.to_string(),
-                    "deviation": mf.deviation.to_string(),
+                    compared: compared_format.to_string(),
                     "reciprocal": mf.reciprocal.to_string(),
                     "product": mf.product.to_string(),
                 },
@@ -173,8 +181,8 @@ impl RtlBlock for MeanFilter {
                 "latency_clocks": latency,
                 "min_clocks_per_sample": min_spacing,
                 "fixed_vs_float": run.mean_filter_stats,
-            }),
-        ))
+        });
+        Some(("mean_filter", section))
     }
 }
 
