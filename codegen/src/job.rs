@@ -10,7 +10,7 @@ use gyrofx_model::mean_filter;
 
 use crate::config::{Config, GyroLoop, KfSettings, Settings, Source};
 use crate::error::{Error, Result};
-use crate::input::read_column;
+use crate::input::read_column_prefix;
 use crate::recording::Recording;
 
 /// A resolved job.
@@ -228,9 +228,10 @@ impl Job {
     }
 }
 
-/// The first `samples` values of `column` in the CSV file at `path`.
+/// The first `samples` values of `column` in the CSV file at `path` (the rows after them are
+/// not read).
 fn recorded_rate(path: &std::path::Path, column: &str, samples: usize) -> Result<Vec<f64>> {
-    let mut values = read_column(path, column)?;
+    let values = read_column_prefix(path, column, samples)?;
     if values.len() < samples {
         return Err(crate::error::Error::Input {
             path: path.to_path_buf(),
@@ -242,7 +243,6 @@ fn recorded_rate(path: &std::path::Path, column: &str, samples: usize) -> Result
             ),
         });
     }
-    values.truncate(samples);
     Ok(values)
 }
 

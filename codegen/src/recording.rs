@@ -178,7 +178,7 @@ impl Recording {
         };
         let mut wanted: Vec<&str> = names.iter().map(String::as_str).collect();
         wanted.extend(mode_column.as_deref());
-        let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+        let file = crate::input::open(path)?;
         let hashing = std::io::BufReader::new(Hashing {
             inner: file,
             hasher: Sha256::new(),

@@ -77,11 +77,8 @@ pub fn run(args: Args) -> Result<ExitCode> {
         .collect();
     for (path, column) in series {
         let (values, skipped) = read_column_with_gaps(path, column)?;
-        if skipped > 0 && !json {
-            eprintln!(
-                "{}: skipped {skipped} rows with an empty {column} cell",
-                path.display()
-            );
+        if let Some(note) = super::options::gaps_note(path, column, skipped).filter(|_| !json) {
+            eprintln!("{note}");
         }
         if values.len() < 4 {
             bail!(

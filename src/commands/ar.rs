@@ -13,7 +13,7 @@ use super::options::CsvColumn;
 // The CSV flags are the shared ones, worded for AR; without a trailing period, as clap shows a
 // one-sentence doc comment.
 #[derive(clap::Args)]
-#[command(mut_arg("input", |a| a.help("CSV file with a header line; `#` lines and empty cells are skipped")))]
+#[command(mut_arg("input", |a| a.help("CSV file with a header line; `#` lines are skipped, and rows with an empty cell or blank rows are skipped and counted")))]
 #[command(mut_arg("column", |a| a.help("Column to model")))]
 pub struct Args {
     #[command(flatten)]
@@ -34,13 +34,17 @@ pub fn run(args: Args) -> Result<ExitCode> {
         json,
     } = args;
     let column = &csv.column;
-    let (values, _) = csv.read_with_gaps()?;
+    let (values, skipped) = csv.read_with_gaps()?;
+    if let Some(note) = super::options::gaps_note(&csv.input, column, skipped) {
+        eprintln!("{note}");
+    }
     let models = ar::fit_orders(&values, max_order)
         .map_err(|e| anyhow::anyhow!("{}, column {column}: {e}", csv.input.display()))?;
     let chosen = ar::select_by_aic(&models).order;
     if json {
         let value = serde_json::json!({
             "samples": values.len(),
+            "skipped_empty_cells": skipped,
             "aic_order": chosen,
             "models": models.iter().map(|m| serde_json::json!({
                 "order": m.order,

@@ -79,6 +79,9 @@ pub fn run(args: Args) -> Result<ExitCode> {
         }
     }
     let (values, skipped) = csv.read_with_gaps()?;
+    if let Some(note) = super::options::gaps_note(&csv.input, &csv.column, skipped) {
+        eprintln!("{note}");
+    }
     if window < 4 || window > values.len() {
         usage!(
             "--window {window} is not allowed: it must be 4..={} samples (the record's length)",

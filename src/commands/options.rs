@@ -35,10 +35,24 @@ impl CsvColumn {
         Ok(read_column(&self.input, &self.column)?)
     }
 
-    /// The column's values without its empty cells, and how many rows were skipped for one.
+    /// The column's values without its gaps (empty cells, blank rows), and how many rows were
+    /// skipped for one.
     pub fn read_with_gaps(&self) -> Result<(Vec<f64>, usize)> {
         Ok(read_column_with_gaps(&self.input, &self.column)?)
     }
+}
+
+/// The note that `skipped` rows of `column` in `path` were gaps (an empty cell or a blank row)
+/// and left out, so that the samples after them moved up; `None` when none were.
+pub fn gaps_note(path: &std::path::Path, column: &str, skipped: usize) -> Option<String> {
+    let rows = if skipped == 1 { "row" } else { "rows" };
+    (skipped > 0).then(|| {
+        format!(
+            "{}: skipped {skipped} {rows} without a {column} value (an empty cell or a blank \
+             row): the samples after each gap are taken as following it directly",
+            path.display()
+        )
+    })
 }
 
 // The sample rate of a recorded series (allan, davar).

@@ -325,7 +325,7 @@ impl Config {
             overlays.push((preset(name)?.to_string(), format!("preset {name}")));
         }
         if let Some(path) = path {
-            let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+            let text = crate::input::read_text(path)?;
             overlays.push((text, path.display().to_string()));
         }
         let refs: Vec<(&str, &str)> = overlays
