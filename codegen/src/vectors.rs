@@ -483,9 +483,9 @@ enum Gyros {
         normal: Box<[FixedClosedLoop; 2]>,
         scale: f64,
         /// The saturations of `reversed` (whose outputs feed the chain) on the record.
-        counts: [GyroLoopCounts; 2],
+        counts: Box<[GyroLoopCounts; 2]>,
         /// `reversed`'s running counts at the last chain sample.
-        last: [LoopOverflows; 2],
+        last: Box<[LoopOverflows; 2]>,
     },
     /// Recorded outputs (`generate --recording`): already in the sequencer's modes; the
     /// report's "without reversal" rows show the same record.
@@ -565,12 +565,12 @@ impl Gyros {
                 let reversed = Box::new([closed(0)?, closed(1)?]);
                 let normal = reversed.clone();
                 // The start-up is not the record: its saturations are left out.
-                let last = reversed.each_ref().map(|gyro| gyro.gyro.overflows());
+                let last = Box::new(reversed.each_ref().map(|gyro| gyro.gyro.overflows()));
                 Gyros::Resonator {
                     reversed,
                     normal,
                     scale: libm::ldexp(1.0, input.frac),
-                    counts: Default::default(),
+                    counts: Box::default(),
                     last,
                 }
             }
@@ -646,8 +646,8 @@ impl Gyros {
                 };
                 let [reversed_a, reversed_b] = &mut **reversed;
                 let [normal_a, normal_b] = &mut **normal;
-                let [counts_a, counts_b] = counts;
-                let [last_a, last_b] = last;
+                let [counts_a, counts_b] = &mut **counts;
+                let [last_a, last_b] = &mut **last;
                 let (a, b) = std::thread::scope(|scope| {
                     let b = scope.spawn(|| run(1, reversed_b, normal_b, counts_b, last_b));
                     let a = run(0, reversed_a, normal_a, counts_a, last_a);
@@ -684,7 +684,7 @@ impl Gyros {
     /// plants).
     fn loop_counts(&self) -> [GyroLoopCounts; 2] {
         match self {
-            Gyros::Resonator { counts, .. } => *counts,
+            Gyros::Resonator { counts, .. } => **counts,
             Gyros::Rate { .. } | Gyros::Recorded { .. } => Default::default(),
         }
     }
