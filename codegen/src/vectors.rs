@@ -12,7 +12,8 @@ use gyrofx_model::analysis::allan::OverlappingStream;
 use gyrofx_model::chain::{FixedChain, FloatChain};
 use gyrofx_model::estimator::OverflowCounts as EstimatorOverflows;
 use gyrofx_model::fx::Format;
-use gyrofx_model::gyro_loop::closed::{ClosedLoop, FixedClosedLoop, LoopUnderTest};
+use gyrofx_model::gyro_loop::closed::{ClosedLoop, FixedClosedLoop, FixedHarness, LoopUnderTest};
+use gyrofx_model::gyro_loop::gyro::LoopOverflows;
 use gyrofx_model::kf::OverflowCounts;
 use gyrofx_model::plant::GyroStream;
 use gyrofx_model::resonator::Mode;
@@ -45,16 +46,41 @@ pub struct Overflows {
     pub kf_directed: KfCounts,
     /// The mean filter's output (its full-scale blocks may round past the range).
     pub mean_filter: u64,
+    /// The resonator-level gyros' fixed loops (A, B) on the record; zeros for the other plants.
+    pub gyro_loop: [GyroLoopCounts; 2],
+}
+
+/// One resonator-level gyro's loop saturations and wraps on the record (the start-up before
+/// it not included), node by node, split by the sequencer's blanking of the chain sample they
+/// fell in.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct GyroLoopCounts {
+    /// In chain samples the estimator takes: they reach the chain's output.
+    pub used: LoopOverflows,
+    /// In blanked chain samples (the transient after a mode switch, which the sequencer
+    /// blanks because it may exceed the output range): not counted among the run's overflows.
+    pub blanked: LoopOverflows,
 }
 
 impl Overflows {
     /// The quantization points that overflowed or saturated on the chain run's data, with
-    /// their counts, by signal name. The directed test segments (the KF's full-scale segment,
-    /// the mean filter's blocks) saturate on purpose and are not among them.
+    /// their counts, by signal name, the resonator-level loops' nodes first (`loop A
+    /// rate_output`, ...). The directed test segments (the KF's full-scale segment, the mean
+    /// filter's blocks) saturate on purpose and are not among them, nor are the loops'
+    /// saturations in the switch transients the sequencer blanks ([`GyroLoopCounts::blanked`]).
     pub fn in_chain_run(&self) -> Vec<(String, u64)> {
         let e = &self.estimator;
         let k = &self.kf_chain;
-        [
+        let loops = ["A", "B"]
+            .into_iter()
+            .zip(&self.gyro_loop)
+            .flat_map(|(gyro, counts)| {
+                counts
+                    .used
+                    .saturated()
+                    .map(move |(node, n)| (format!("loop {gyro} {}", node.name()), n))
+            });
+        let chain = [
             ("ADC A", self.adc[0]),
             ("ADC B", self.adc[1]),
             ("interval mean A", e.mean[0]),
@@ -70,8 +96,8 @@ impl Overflows {
         ]
         .into_iter()
         .filter(|(_, n)| *n > 0)
-        .map(|(name, n)| (name.to_string(), n))
-        .collect()
+        .map(|(name, n)| (name.to_string(), n));
+        loops.chain(chain).collect()
     }
 }
 
@@ -337,12 +363,14 @@ fn run_with(
         let last = (first + GYRO_BATCH).min(n);
         batch.rates.clear();
         batch.modes.clear();
+        batch.blanked.clear();
         for k in first..last {
             if reset_at == Some(k) {
                 sequencer.reset();
             }
             let slot = sequencer.advance();
             batch.modes.push([slot.mode_a, slot.mode_b]);
+            batch.blanked.push([slot.blank_a, slot.blank_b]);
             batch.rates.push(rate.at(k));
         }
         gyros.simulate(&mut batch, progress)?;
@@ -419,6 +447,7 @@ fn run_with(
             kf_chain: fixed.kf().overflow_counts().into(),
             kf_directed: results.kf_directed.expect(REGISTERED),
             mean_filter: results.mean_filter_overflows.expect(REGISTERED),
+            gyro_loop: gyros.loop_counts(),
         },
         ties: results.ties.expect(REGISTERED),
         report: report.finish(),
@@ -434,6 +463,8 @@ fn run_with(
 struct GyroBatch {
     rates: Vec<f64>,
     modes: Vec<[i8; 2]>,
+    /// Whether the sequencer blanks A's and B's sample.
+    blanked: Vec<[bool; 2]>,
     codes: Vec<[i64; 2]>,
     raw: Vec<[f64; 2]>,
 }
@@ -451,6 +482,10 @@ enum Gyros {
         reversed: Box<[FixedClosedLoop; 2]>,
         normal: Box<[FixedClosedLoop; 2]>,
         scale: f64,
+        /// The saturations of `reversed` (whose outputs feed the chain) on the record.
+        counts: Box<[GyroLoopCounts; 2]>,
+        /// `reversed`'s running counts at the last chain sample.
+        last: Box<[LoopOverflows; 2]>,
     },
     /// Recorded outputs (`generate --recording`): already in the sequencer's modes; the
     /// report's "without reversal" rows show the same record.
@@ -526,13 +561,17 @@ impl Gyros {
                 }
             }
             Some(loops) => {
-                let closed = |g: usize| started_loop(&loops[g], g, seed, rate0);
+                let closed = |g: usize| started_loop::<FixedHarness>(&loops[g], g, seed, rate0);
                 let reversed = Box::new([closed(0)?, closed(1)?]);
                 let normal = reversed.clone();
+                // The start-up is not the record: its saturations are left out.
+                let last = Box::new(reversed.each_ref().map(|gyro| gyro.gyro.overflows()));
                 Gyros::Resonator {
                     reversed,
                     normal,
                     scale: libm::ldexp(1.0, input.frac),
+                    counts: Box::default(),
+                    last,
                 }
             }
         })
@@ -571,30 +610,47 @@ impl Gyros {
                 reversed,
                 normal,
                 scale,
+                counts,
+                last,
             } => {
                 let scale = *scale;
-                let (rates, modes) = (&batch.rates, &batch.modes);
-                let run =
-                    |g: usize, reversed: &mut FixedClosedLoop, normal: &mut FixedClosedLoop| {
-                        let mut out = Vec::with_capacity(len);
-                        for (k, (omega, mode)) in rates.iter().zip(modes).enumerate() {
-                            if k % PROGRESS_STEP == PROGRESS_STEP - 1 {
-                                progress.advance(2 * PROGRESS_STEP as u64);
-                            }
-                            let output = reversed
-                                .step_chain(*omega, loop_mode(mode[g]))
-                                .output
-                                .rate_dps;
-                            let raw = normal.step_chain(*omega, Mode::Normal).output.rate_dps;
-                            out.push(((output * scale).round() as i64, raw));
+                let (rates, modes, blanked) = (&batch.rates, &batch.modes, &batch.blanked);
+                let run = |g: usize,
+                           reversed: &mut FixedClosedLoop,
+                           normal: &mut FixedClosedLoop,
+                           counts: &mut GyroLoopCounts,
+                           last: &mut LoopOverflows| {
+                    let mut out = Vec::with_capacity(len);
+                    for (k, (omega, mode)) in rates.iter().zip(modes).enumerate() {
+                        if k % PROGRESS_STEP == PROGRESS_STEP - 1 {
+                            progress.advance(2 * PROGRESS_STEP as u64);
                         }
-                        out
-                    };
+                        let output = reversed
+                            .step_chain(*omega, loop_mode(mode[g]))
+                            .output
+                            .rate_dps;
+                        // Booked to the chain sample they fell in, so that a switch
+                        // transient's are told apart from those the chain takes in.
+                        let now = reversed.gyro.overflows();
+                        let stretch = if blanked[k][g] {
+                            &mut counts.blanked
+                        } else {
+                            &mut counts.used
+                        };
+                        stretch.add(&now.since(last));
+                        *last = now;
+                        let raw = normal.step_chain(*omega, Mode::Normal).output.rate_dps;
+                        out.push(((output * scale).round() as i64, raw));
+                    }
+                    out
+                };
                 let [reversed_a, reversed_b] = &mut **reversed;
                 let [normal_a, normal_b] = &mut **normal;
+                let [counts_a, counts_b] = &mut **counts;
+                let [last_a, last_b] = &mut **last;
                 let (a, b) = std::thread::scope(|scope| {
-                    let b = scope.spawn(|| run(1, reversed_b, normal_b));
-                    let a = run(0, reversed_a, normal_a);
+                    let b = scope.spawn(|| run(1, reversed_b, normal_b, counts_b, last_b));
+                    let a = run(0, reversed_a, normal_a, counts_a, last_a);
                     (a, b.join().expect("the loop simulation does not panic"))
                 });
                 for ((code_a, raw_a), (code_b, raw_b)) in a.into_iter().zip(b) {
@@ -622,6 +678,15 @@ impl Gyros {
             }
         }
         Ok(())
+    }
+
+    /// The resonator-level gyros' loop saturations on the record so far (zeros for the other
+    /// plants).
+    fn loop_counts(&self) -> [GyroLoopCounts; 2] {
+        match self {
+            Gyros::Resonator { counts, .. } => **counts,
+            Gyros::Rate { .. } | Gyros::Recorded { .. } => Default::default(),
+        }
     }
 
     /// ADC saturations of gyro A and B so far (the pick-offs' for resonator-level gyros).

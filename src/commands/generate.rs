@@ -170,8 +170,9 @@ pub fn run(args: Args) -> Result<ExitCode> {
         );
     }
     let o = &run.overflows;
+    let loops = loop_overflows(&job, o);
     println!(
-        "overflows: ADC {:?}, means {:?}, biases {:?}, calibrated {:?}, combined {}, KF x1 {} x2 {} rate_hat {} (directed segment: x1 {} x2 {} rate_hat {})",
+        "overflows: ADC {:?}, means {:?}, biases {:?}, calibrated {:?}, combined {}, KF x1 {} x2 {} rate_hat {} (directed segment: x1 {} x2 {} rate_hat {}){loops}",
         o.adc, o.estimator.mean, o.estimator.bias, o.estimator.calibrated, o.estimator.combined,
         o.kf_chain.x1, o.kf_chain.x2, o.kf_chain.rate_hat, o.kf_directed.x1, o.kf_directed.x2, o.kf_directed.rate_hat
     );
@@ -198,4 +199,21 @@ pub fn run(args: Args) -> Result<ExitCode> {
         );
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// `, loop A [...] B [...] (blanked switch transients: A [...] B [...])`: the nodes of the
+/// resonator-level gyros' loops that saturated or wrapped in the samples the chain takes, and
+/// apart those in the transients the sequencer blanks; empty for the other plants.
+fn loop_overflows(job: &Job, overflows: &gyrofx_codegen::vectors::Overflows) -> String {
+    if job.settings.resonator.is_none() || job.recording.is_some() {
+        return String::new();
+    }
+    let [a, b] = &overflows.gyro_loop;
+    format!(
+        ", loop A [{}] B [{}] (blanked switch transients: A [{}] B [{}])",
+        a.used.summary(),
+        b.used.summary(),
+        a.blanked.summary(),
+        b.blanked.summary()
+    )
 }

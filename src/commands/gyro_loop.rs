@@ -21,8 +21,9 @@ use super::usage;
 /// Run both gyros' closed loops (resonator physics, NCO, PLL, AGC, sense demodulation, CIC,
 /// 1/SF) in normal and reverse mode at a constant rate and print, per gyro and mode, the
 /// locked drive frequency, drive amplitude, scale factor, bias (the chain's sign convention),
-/// quadrature and settling after a switch beside SPEC 1.6's closed forms, and the residual
-/// bias after reversal. Noise and drift are off unless --noise is given.
+/// quadrature and settling after a switch beside SPEC 1.6's closed forms, the residual bias
+/// after reversal, and the fixed loop's nodes that saturated or wrapped (counts; a warning when
+/// that clipped the figures). Noise and drift are off unless --noise is given.
 #[derive(clap::Args)]
 pub struct Args {
     #[command(flatten)]
@@ -40,6 +41,10 @@ pub struct Args {
     /// Print JSON instead of the table.
     #[arg(long)]
     json: bool,
+    /// Refuse (exit 1, nothing printed or plotted) when a quantizer of a fixed loop saturated
+    /// or wrapped while the figures were measured; without it that is a warning.
+    #[arg(long)]
+    strict: bool,
     /// Also plot both gyros across a switch (normal to reverse at t = 0): drive amplitude, NCO
     /// frequency and rate output against time, the re-lock marked (.png or .svg).
     #[arg(long)]
@@ -120,6 +125,12 @@ pub fn run(args: Args) -> Result<ExitCode> {
             .collect::<std::result::Result<_, _>>()
     })?;
     bar.finish_and_clear();
+    if let Some(clipped) = clipped_figures(&figures) {
+        if args.strict {
+            anyhow::bail!("--strict: {clipped}; nothing printed (choose wider [loop] formats or settings for the nodes named, loop.output_format together with kf.input_format, or a resonator within range; or drop --strict to see the clipped figures)");
+        }
+        eprintln!("warning: {clipped}: those figures are clipped and not trustworthy (--strict makes this an error)");
+    }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&figures)?);
     } else {
@@ -161,6 +172,35 @@ pub fn run(args: Args) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// The fixed loops' saturations while figures were measured, gyro by gyro and mode by mode,
+/// as one sentence; `None` when there were none.
+fn clipped_figures(figures: &[GyroFigures]) -> Option<String> {
+    let clipped: Vec<String> = figures
+        .iter()
+        .flat_map(|gyro| {
+            [&gyro.figures.normal, &gyro.figures.reverse]
+                .into_iter()
+                .filter(|mode| mode.saturations.total() > 0)
+                .map(|mode| {
+                    format!(
+                        "gyro {} {}: {}",
+                        gyro.gyro,
+                        mode.mode,
+                        mode.saturations.summary()
+                    )
+                })
+        })
+        .collect();
+    if clipped.is_empty() {
+        None
+    } else {
+        Some(format!(
+            "the fixed loop saturated or wrapped while the figures were measured (counts per node): {}",
+            clipped.join("; ")
+        ))
+    }
+}
+
 fn print_table(figures: &[GyroFigures]) {
     println!(
         "{:<5} {:<8} {:<19} {:>16} {:>16} {:>12} {:>10}",
@@ -181,6 +221,7 @@ fn print_table(figures: &[GyroFigures]) {
             for (name, figure, unit) in rows {
                 print_row(gyro.gyro, mode.mode, name, figure, unit);
             }
+            print_saturations(gyro.gyro, mode);
         }
         print_row(
             gyro.gyro,
@@ -188,6 +229,26 @@ fn print_table(figures: &[GyroFigures]) {
             "residual_bias_dps",
             &gyro.figures.residual_bias_dps,
             1.0,
+        );
+    }
+}
+
+/// The nodes of `mode`'s fixed loop that saturated or wrapped, with their counts: while its
+/// figures were measured (always shown, `none` when clean), and during the start-up or the
+/// switch into it (shown only when there were any; the chain blanks that stretch).
+fn print_saturations(gyro: &str, mode: &ModeCharacterization) {
+    println!(
+        "{gyro:<5} {:<8} {:<19} {}",
+        mode.mode,
+        "saturations",
+        mode.saturations.summary()
+    );
+    if mode.transient_saturations.total() > 0 {
+        println!(
+            "{gyro:<5} {:<8} {:<19} {} (start-up or switch transient: blanked in the chain, only rate_settling_ms is measured there)",
+            mode.mode,
+            "transient_saturations",
+            mode.transient_saturations.summary()
         );
     }
 }

@@ -4,6 +4,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 mod readers;
+mod saturation;
 
 use common::*;
 

@@ -12,7 +12,7 @@
 //! only what the caller keeps is stored. A mode change calls [`Resonator::set_mode`] and is
 //! given to the loop's `mode` input at the same sample.
 
-use super::gyro::{FixedGyroLoop, FixedStep, FloatGyroLoop, Plan};
+use super::gyro::{FixedGyroLoop, FixedStep, FloatGyroLoop, LoopOverflows, Plan};
 use crate::resonator::{
     Mode, ModeFigures, ParamError, PhysicsSettings, Resonator, ResonatorParams,
 };
@@ -39,6 +39,9 @@ pub trait LoopUnderTest {
     fn frequency_hz(&self) -> f64;
     /// The lock flag.
     fn locked(&self) -> bool;
+    /// The saturations and wraps of the loop's quantizers since construction (none for the
+    /// float twin, which has no quantizers).
+    fn overflows(&self) -> LoopOverflows;
 }
 
 /// [`FixedGyroLoop`] with the ADC codes of the last sample.
@@ -78,6 +81,10 @@ impl LoopUnderTest for FixedHarness {
 
     fn locked(&self) -> bool {
         self.gyro.locked()
+    }
+
+    fn overflows(&self) -> LoopOverflows {
+        self.gyro.overflows()
     }
 }
 
@@ -120,6 +127,10 @@ impl LoopUnderTest for FloatHarness {
 
     fn locked(&self) -> bool {
         self.gyro.locked()
+    }
+
+    fn overflows(&self) -> LoopOverflows {
+        LoopOverflows::default()
     }
 }
 

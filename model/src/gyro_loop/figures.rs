@@ -32,7 +32,7 @@
 use serde::Serialize;
 
 use super::closed::{ClosedLoop, LoopUnderTest};
-use super::gyro::{mode_index, Plan};
+use super::gyro::{mode_index, LoopOverflows, Plan};
 use crate::resonator::{Mode, ModeFigures, ParamError, PhysicsSettings, ResonatorParams};
 
 /// A measured figure beside its closed-form prediction.
@@ -63,6 +63,12 @@ pub struct ModeCharacterization {
     pub settling_ms: Figure,
     /// From a switch into this mode until the rate is within 0.01 °/s of its final value, ms.
     pub rate_settling_ms: Figure,
+    /// The fixed loop's saturations and wraps while this mode's figures were measured: any
+    /// count clips them.
+    pub saturations: LoopOverflows,
+    /// Those during the start-up from rest or the switch into this mode (blanked in the
+    /// chain).
+    pub transient_saturations: LoopOverflows,
 }
 
 /// Both modes and what reversal leaves.
@@ -175,6 +181,36 @@ fn means<L: LoopUnderTest>(closed: &mut ClosedLoop<L>, rate: f64, mode: Mode, n:
     }
 }
 
+/// The loop's saturations booked by mode and by stretch: `[measured, transient]` per mode
+/// index, each the counts since the previous booking.
+struct SaturationLedger {
+    booked: [[LoopOverflows; 2]; 2],
+    last: LoopOverflows,
+}
+
+impl SaturationLedger {
+    fn new() -> Self {
+        SaturationLedger {
+            booked: Default::default(),
+            last: LoopOverflows::default(),
+        }
+    }
+
+    /// Books the counts since the last booking (`now` the loop's running counts) to `mode`'s
+    /// measured stretch, or to its transient one.
+    fn book(&mut self, now: LoopOverflows, mode: Mode, measured: bool) {
+        let stretch = if measured { 0 } else { 1 };
+        self.booked[mode_index(mode)][stretch].add(&now.since(&self.last));
+        self.last = now;
+    }
+
+    /// `(measured, transient)` of `mode`.
+    fn of(&self, mode: Mode) -> (LoopOverflows, LoopOverflows) {
+        let [measured, transient] = self.booked[mode_index(mode)];
+        (measured, transient)
+    }
+}
+
 /// A switch traced: `(t_ms, amplitude_m, locked, rate_dps if a chain sample came)` per window.
 type Trace = Vec<(f64, f64, bool, Option<f64>)>;
 
@@ -274,14 +310,21 @@ pub fn characterize_reporting<L: LoopUnderTest>(
         }
         (at_zero, at_rate)
     };
+    let mut ledger = SaturationLedger::new();
     for _ in 0..samples(procedure.startup_ms) {
         closed.step_chain(0.0, Mode::Normal);
     }
+    ledger.book(closed.gyro.overflows(), Mode::Normal, false);
     let normal = measure(&mut closed, Mode::Normal);
+    ledger.book(closed.gyro.overflows(), Mode::Normal, true);
     let to_reverse = trace_switch(&mut closed, Mode::Reverse, procedure, fs);
+    ledger.book(closed.gyro.overflows(), Mode::Reverse, false);
     let reverse = measure(&mut closed, Mode::Reverse);
+    ledger.book(closed.gyro.overflows(), Mode::Reverse, true);
     let to_normal = trace_switch(&mut closed, Mode::Normal, procedure, fs);
+    ledger.book(closed.gyro.overflows(), Mode::Normal, false);
     let normal_final = means(&mut closed, 0.0, Mode::Normal, n);
+    ledger.book(closed.gyro.overflows(), Mode::Normal, true);
 
     let hold_ms = f64::from(plan.lock.hold_samples) / fs * 1e3;
     // The CIC's N (R − 1)/2 ADC samples and the compensator's (T − 1)/2 chain samples.
@@ -296,6 +339,7 @@ pub fn characterize_reporting<L: LoopUnderTest>(
         let (settled, rate_settled) = settling(trace, final_amp, zero.rate);
         let sigma = f.sigma();
         let ring_start = f.drive_amplitude / f.scale_factor_m_per_dps();
+        let (saturations, transient_saturations) = ledger.of(mode);
         ModeCharacterization {
             mode: match mode {
                 Mode::Normal => "normal",
@@ -334,6 +378,8 @@ pub fn characterize_reporting<L: LoopUnderTest>(
                     * libm::log(ring_start / RATE_SETTLED_DPS)
                     + group_delay_ms,
             },
+            saturations,
+            transient_saturations,
         }
     };
     let normal_report = report(Mode::Normal, &normal, &to_normal, normal_final.amplitude);

@@ -7,7 +7,7 @@ use super::*;
 use crate::gyro_loop::figures::{
     characterize_reporting, coupled_resonance_hz, Characterization, Procedure, AVERAGES,
 };
-use crate::gyro_loop::gyro::Spec;
+use crate::gyro_loop::gyro::{LoopNode, Spec};
 
 fn paper_004() -> (Spec, Plan) {
     let spec = Spec::paper_004();
@@ -91,6 +91,19 @@ fn fixed_loop_reproduces_spec_1_6_with_paper_004() {
             "{what}: rate settled after {} ms, predicted {}",
             r.measured,
             r.predicted
+        );
+    }
+    // Nothing saturated while the figures were measured; after a switch the formerly driven
+    // axis's ring-down (about 2e4 °/s) pins the outputs for a few chain samples, nothing else.
+    for m in [&c.normal, &c.reverse] {
+        assert_eq!(m.saturations.summary(), "none", "{}", m.mode);
+        let t = m.transient_saturations;
+        let outputs = t.get(LoopNode::RateOutput) + t.get(LoopNode::QuadratureOutput);
+        assert!(
+            outputs > 0 && outputs < 20 && outputs == t.total(),
+            "{}: {}",
+            m.mode,
+            t.summary()
         );
     }
     // (B − B′)/2 = −0.0094 °/s: the bias errors above would allow 0.4 °/s; the measured
@@ -256,4 +269,61 @@ proptest! {
             prop_assert!(m.settling_ms.measured < 150.0, "{}: {:?}", m.mode, m.settling_ms);
         }
     }
+}
+
+/// The fixed loop of `spec` closed around its noiseless resonator, run `chain_samples` chain
+/// samples at zero rate in normal mode: the loop's counts and the last rate output (°/s).
+fn run_counted(spec: &Spec, chain_samples: usize) -> (crate::gyro_loop::gyro::LoopOverflows, f64) {
+    let plan = Plan::new(spec).unwrap();
+    let mut closed =
+        FixedClosedLoop::new(&plan, &spec.resonator, &spec.front_end.noiseless(), 0).unwrap();
+    let mut rate = 0.0;
+    for _ in 0..chain_samples {
+        rate = closed.step_chain(0.0, Mode::Normal).output.rate_dps;
+    }
+    (closed.gyro.overflows(), rate)
+}
+
+/// A mode-split bias (about 14 300 °/s) beyond the ±512 °/s output format pins the rate
+/// output, and every pinned sample is counted there.
+#[test]
+fn a_bias_beyond_the_output_range_is_counted_at_the_rate_output() {
+    let mut spec = Spec::paper_004();
+    spec.resonator.damping_angle_deg = 45.0;
+    spec.resonator.q_sense = 40.0;
+    let chain_samples = 100;
+    let (counts, rate) = run_counted(&spec, chain_samples);
+    assert!(rate < -511.9, "pinned at the format's minimum: {rate}");
+    // Pinned from the first output on (the CIC's first outputs still rise).
+    let pinned = counts.get(LoopNode::RateOutput);
+    assert!(pinned > 90 && pinned <= chain_samples as u64, "{counts:?}");
+    assert!(
+        counts.summary().contains("rate_output "),
+        "{}",
+        counts.summary()
+    );
+}
+
+/// A PLL pull range (0.2 mHz) narrower than the coupled resonance's offset from the nominal
+/// frequency (0.9 mHz) drives the PLL integrator into its limit again and again (about one
+/// sample in five from rest, one in ten once settled, as `gyrofx loop` counts them), though
+/// every output stays in range.
+#[test]
+fn a_pull_range_narrower_than_the_resonance_offset_is_counted_at_the_pll_integrator() {
+    let mut spec = Spec::paper_004();
+    spec.settings.pll_pull_range_hz = 0.0002;
+    let (counts, _) = run_counted(&spec, 100);
+    assert!(
+        counts.get(LoopNode::PllIntegrator) > 5_000,
+        "{}",
+        counts.summary()
+    );
+    assert_eq!(counts.get(LoopNode::RateOutput), 0);
+}
+
+/// The default loop saturates nothing from rest to lock and on.
+#[test]
+fn the_default_loop_saturates_nothing() {
+    let (counts, _) = run_counted(&Spec::paper_004(), 100);
+    assert_eq!(counts.summary(), "none");
 }

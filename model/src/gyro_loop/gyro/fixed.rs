@@ -2,6 +2,7 @@
 //! quadrature every `R`-th sample.
 
 use super::design::ModePlan;
+use super::overflows::{LoopNode, LoopOverflows};
 use super::plan::Plan;
 use super::{axes, mode_index};
 use crate::fx::Quantizer;
@@ -31,21 +32,6 @@ pub struct FixedStep {
     pub dac: [i64; 2],
     /// The chain-rate output, every `R`-th sample.
     pub chain: Option<ChainSample>,
-}
-
-/// Overflow and clamp counts of the loop's own points and its PIs.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct LoopOverflows {
-    /// `e_A` that did not fit.
-    pub agc_error: u64,
-    /// DAC codes that did not fit.
-    pub dac: u64,
-    /// Rate and quadrature outputs that did not fit.
-    pub output: u64,
-    /// PLL integrator clamps (anti-windup) and output overflows.
-    pub pll: [u64; 2],
-    /// AGC integrator clamps and output overflows.
-    pub agc: [u64; 2],
 }
 
 /// Per-mode constants in the form the step uses.
@@ -258,16 +244,32 @@ impl FixedGyroLoop {
         FixedStep { dac, chain }
     }
 
-    /// Counts since construction.
+    /// The saturations and wraps of every node since construction (a reset keeps them): a few
+    /// loads, cheap enough to take once per chain sample.
     pub fn overflows(&self) -> LoopOverflows {
+        let drive = self.demod_drive.overflow_counts();
+        let sense = self.demod_sense.overflow_counts();
         let pll = self.pll.overflow_counts();
         let agc = self.agc.overflow_counts();
-        LoopOverflows {
-            agc_error: self.agc_error.overflow_count,
-            dac: self.dac.overflow_count,
-            output: self.output[0].overflow_count + self.output[1].overflow_count,
-            pll: [pll.integrator_clamped, pll.output],
-            agc: [agc.integrator_clamped, agc.output],
-        }
+        let cic = [self.cic_i.overflow_counts(), self.cic_q.overflow_counts()];
+        let both = |pair: [u64; 2]| pair[0] + pair[1];
+        LoopOverflows::from_counts(&[
+            (LoopNode::DriveDemodProduct, both(drive.product)),
+            (LoopNode::DriveDemodState, both(drive.state)),
+            (LoopNode::DriveDemodOutput, both(drive.output)),
+            (LoopNode::SenseDemodProduct, both(sense.product)),
+            (LoopNode::SenseDemodState, both(sense.state)),
+            (LoopNode::SenseDemodOutput, both(sense.output)),
+            (LoopNode::PllIntegrator, pll.integrator_clamped),
+            (LoopNode::PllOutput, pll.output),
+            (LoopNode::AgcError, self.agc_error.overflow_count),
+            (LoopNode::AgcIntegrator, agc.integrator_clamped),
+            (LoopNode::AgcOutput, agc.output),
+            (LoopNode::Dac, self.dac.overflow_count),
+            (LoopNode::Cic, cic[0].cic + cic[1].cic),
+            (LoopNode::CicCompensator, cic[0].output + cic[1].output),
+            (LoopNode::RateOutput, self.output[0].overflow_count),
+            (LoopNode::QuadratureOutput, self.output[1].overflow_count),
+        ])
     }
 }

@@ -105,12 +105,14 @@
 mod design;
 mod fixed;
 mod float;
+mod overflows;
 mod plan;
 mod settings;
 
 pub use design::{Design, LockPlan, ModePlan};
-pub use fixed::{ChainSample, FixedGyroLoop, FixedStep, LoopOverflows};
+pub use fixed::{ChainSample, FixedGyroLoop, FixedStep};
 pub use float::{FloatChainSample, FloatGyroLoop, FloatStep};
+pub use overflows::{LoopNode, LoopOverflows};
 pub use plan::{Plan, Spec};
 pub use settings::LoopSettings;
 
