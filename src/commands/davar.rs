@@ -41,7 +41,7 @@ pub struct Args {
     /// --adaptive).
     #[arg(long, allow_negative_numbers = true, requires = "adaptive")]
     kd: Option<f64>,
-    /// Samples between window centres (default: window / 20).
+    /// Samples between window centres, 1 up to the record's length (default: window / 20).
     #[arg(long)]
     step: Option<usize>,
     /// Print JSON.
