@@ -424,7 +424,7 @@ fn every_preset_generates_and_passes_in_icarus_and_ghdl() {
     }
     let log = fails(&["init", "--preset", "adxrs300"]);
     assert!(
-        log.contains("preset = \"adxrs300\"") && log.contains("gu2019"),
+        log.contains("--preset \"adxrs300\"") && log.contains("gu2019"),
         "{log}"
     );
 }

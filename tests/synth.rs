@@ -298,7 +298,7 @@ fn check_place_and_route(synth: &Path, log: &str) {
             vec!["--target", "xilinx", "--blocks", "kf,system"],
             "\"system\"",
         ),
-        (vec!["--target", "xilinx", "--jobs", "0"], "--jobs 0"),
+        (vec!["--target", "xilinx", "--jobs", "0"], "'0' for '--jobs"),
     ] {
         let out = synth.with_file_name("refused");
         let mut command = vec!["synth", "--out", out.to_str().unwrap()];

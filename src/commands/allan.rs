@@ -59,6 +59,9 @@ pub fn run(args: Args) -> Result<ExitCode> {
         quiet,
     } = args;
     let rate = rate.hz()?;
+    if let Some(path) = &plot {
+        super::options::check_plot(path)?;
+    }
     let grid: allan::Grid = taus
         .parse()
         .map_err(|e: String| super::Usage(format!("--taus: {e}")))?;
@@ -87,14 +90,9 @@ pub fn run(args: Args) -> Result<ExitCode> {
                 values.len()
             );
         }
-        // The phase sums N·max|y| and their squares must stay finite.
-        let limit = 1e150 / values.len() as f64;
-        if let Some((row, v)) = values.iter().enumerate().find(|(_, v)| v.abs() > limit) {
-            bail!(
-                "{}: column {column}, value {row} = {v:e} is beyond ±{limit:.1e}: the Allan sums of {} such samples would overflow",
-                path.display(),
-                values.len()
-            );
+        // The phase sums N·max|y| and their squares must stay finite, and not underflow.
+        if let Err(e) = gyrofx_model::analysis::check_magnitudes(&values) {
+            bail!("{}: column {column}, {e}", path.display());
         }
         if grid == allan::Grid::All && values.len() > ALL_TAUS_MAX_SAMPLES {
             usage!(

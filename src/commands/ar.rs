@@ -18,13 +18,16 @@ use super::options::CsvColumn;
 pub struct Args {
     #[command(flatten)]
     csv: CsvColumn,
-    /// Largest order.
-    #[arg(long, default_value_t = 3)]
+    /// Largest order, 1..=1000 (the work grows as its square).
+    #[arg(long, default_value_t = 3, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=MAX_ORDER))]
     max_order: usize,
     /// Print JSON.
     #[arg(long)]
     json: bool,
 }
+
+/// Largest `--max-order`: Levinson–Durbin's work and the table grow as its square.
+const MAX_ORDER: u64 = 1000;
 
 /// Prints every order's coefficients, noise variance and AIC (a table, or JSON).
 pub fn run(args: Args) -> Result<ExitCode> {

@@ -41,7 +41,7 @@ pub struct Args {
     /// --adaptive).
     #[arg(long, allow_negative_numbers = true, requires = "adaptive")]
     kd: Option<f64>,
-    /// Samples between window centres (default: window / 20).
+    /// Samples between window centres, 1 up to the record's length (default: window / 20).
     #[arg(long)]
     step: Option<usize>,
     /// Print JSON.
@@ -73,6 +73,9 @@ pub fn run(args: Args) -> Result<ExitCode> {
         quiet,
     } = args;
     let rate = rate.hz()?;
+    if let Some(path) = &plot {
+        super::options::check_plot(path)?;
+    }
     for (name, gain) in [("--kp", kp), ("--ki", ki), ("--kd", kd)] {
         if let Some(g) = gain.filter(|g| !g.is_finite()) {
             usage!("{name} {g} is not allowed: a PID gain is a finite number");
@@ -82,6 +85,9 @@ pub fn run(args: Args) -> Result<ExitCode> {
     if let Some(note) = super::options::gaps_note(&csv.input, &csv.column, skipped) {
         eprintln!("{note}");
     }
+    // Beyond these the fixed-point sums overflow, or the squares underflow to zero deviations.
+    gyrofx_model::analysis::check_magnitudes(&values)
+        .map_err(|e| anyhow::anyhow!("{}, column {}: {e}", csv.input.display(), csv.column))?;
     if window < 4 || window > values.len() {
         usage!(
             "--window {window} is not allowed: it must be 4..={} samples (the record's length)",
@@ -93,8 +99,11 @@ pub fn run(args: Args) -> Result<ExitCode> {
         usage!("--min-window {min} is not allowed: it must be 4..={window}");
     }
     let step = step.unwrap_or((window / 20).max(1));
-    if step == 0 {
-        usage!("--step 0 is not allowed: windows move by at least 1 sample");
+    if step == 0 || step > values.len() {
+        usage!(
+            "--step {step} is not allowed: windows move by 1..={} samples (the record's length)",
+            values.len()
+        );
     }
     let mode = if adaptive {
         Window::Adaptive(Pid {

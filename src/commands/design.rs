@@ -5,6 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::Result;
 
+use super::options::number;
 use super::usage;
 
 use gyrofx_codegen::report;
@@ -16,7 +17,7 @@ use gyrofx_model::kf::{CoefficientFormat, Plan, Spec};
 #[derive(clap::Args)]
 pub struct Args {
     /// Random-walk intensity of the true rate, (°/s)²/s (sets the bandwidth).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, conflicts_with = "bandwidth")]
     qw: Option<f64>,
     /// Rate-random-walk intensity of the bias, (°/s)²/s (RRW²).
     #[arg(long, allow_negative_numbers = true)]
@@ -33,12 +34,51 @@ pub struct Args {
     /// Discretisation: direct or paper.
     #[arg(long, default_value = "direct")]
     method: String,
-    /// Coefficient width, bits (fraction bits chosen per coefficient).
+    /// Coefficient width, 2..=64 bits (fraction bits chosen per coefficient).
     #[arg(long, default_value_t = 18)]
     coefficient_width: u32,
     /// Print JSON.
     #[arg(long)]
     json: bool,
+}
+
+/// Largest `--coefficient-width`: a fixed-point format is at most 64 bits wide.
+const MAX_COEFFICIENT_WIDTH: u32 = 64;
+
+/// Refuses, before the design, every value it cannot take: the intensities and the rate must
+/// be finite and > 0, the bandwidth in (0, fs/2), the width 2..=64 bits.
+fn check_values(
+    qw: Option<f64>,
+    qb: f64,
+    qn: f64,
+    fs: f64,
+    bandwidth: Option<f64>,
+    coefficient_width: u32,
+) -> Result<()> {
+    let positive = [
+        ("--qw", qw),
+        ("--qb", Some(qb)),
+        ("--qn", Some(qn)),
+        ("--fs", Some(fs)),
+    ];
+    for (flag, value) in positive {
+        if let Some(v) = value.filter(|v| !(v.is_finite() && *v > 0.0)) {
+            usage!("{flag} {} is not allowed: a finite number > 0", number(v));
+        }
+    }
+    if let Some(bw) = bandwidth.filter(|bw| !(bw.is_finite() && *bw > 0.0 && *bw < fs / 2.0)) {
+        usage!(
+            "--bandwidth {} is not allowed: a number of Hz in (0, fs/2 = {})",
+            number(bw),
+            number(fs / 2.0)
+        );
+    }
+    if !(2..=MAX_COEFFICIENT_WIDTH).contains(&coefficient_width) {
+        usage!(
+            "--coefficient-width {coefficient_width} is not allowed: 2..={MAX_COEFFICIENT_WIDTH} bits (a sign bit and at least one more)"
+        );
+    }
+    Ok(())
 }
 
 /// Prints the gain, the bandwidth and every quantized coefficient with its error (text, or
@@ -54,8 +94,26 @@ pub fn run(args: Args) -> Result<ExitCode> {
         coefficient_width,
         json,
     } = args;
-    let method: Method = method.parse()?;
+    check_values(qw, qb, qn, fs, bandwidth, coefficient_width)?;
+    let method: Method = method
+        .parse()
+        .map_err(|e| super::Usage(format!("--method {method}: {e}")))?;
     let convergence = Convergence::default();
+    // Every value of the design comes from the command line: a design that fails is a usage
+    // error, named by the flags that made it.
+    let flags = match bandwidth {
+        Some(bw) => format!("--bandwidth {}", number(bw)),
+        None => format!("--qw {}", number(qw.unwrap_or(0.0))),
+    };
+    let flags = format!(
+        "{flags} --qb {} --qn {} --fs {}",
+        number(qb),
+        number(qn),
+        number(fs)
+    );
+    let refused = |e: gyrofx_model::kf::design::DesignError| {
+        super::Usage(format!("{flags} cannot be designed: {e}"))
+    };
     let designed = match (bandwidth, qw) {
         (Some(bw), _) => design_for_bandwidth(
             bw,
@@ -67,7 +125,8 @@ pub fn run(args: Args) -> Result<ExitCode> {
             fs,
             method,
             convergence,
-        )?,
+        )
+        .map_err(refused)?,
         (None, Some(q_w)) => design(
             Noise {
                 q_w,
@@ -77,7 +136,8 @@ pub fn run(args: Args) -> Result<ExitCode> {
             fs,
             method,
             convergence,
-        )?,
+        )
+        .map_err(refused)?,
         (None, None) => usage!("give --qw (°/s)²/s or --bandwidth HZ"),
     };
     let label = match bandwidth {
@@ -95,7 +155,8 @@ pub fn run(args: Args) -> Result<ExitCode> {
         overflow: Overflow::Saturate,
         gains: vec![designed.g],
         labels: vec![label],
-    })?;
+    })
+    .map_err(|e| super::Usage(format!("--coefficient-width {coefficient_width}: {e}")))?;
     let summary = &report::designs(std::slice::from_ref(&designed), &plan)[0];
     let coefficients = report::coefficients(&plan);
     if json {

@@ -63,8 +63,8 @@ pub struct Args {
     /// estimate and 2·fs + 1 samples after it (the ADEV at 1 s).
     #[arg(long, value_parser = count)]
     samples: Option<usize>,
-    /// Candidates simulated and synthesized at once (default: the available cores).
-    #[arg(long, value_parser = count)]
+    /// Candidates simulated and synthesized at once, 1..=256 (default: the available cores).
+    #[arg(long, value_parser = super::options::jobs)]
     jobs: Option<usize>,
     /// Cost cache folder, one JSON file per synthesized design (default:
     /// $XDG_CACHE_HOME/gyrofx/synth, else ~/.cache/gyrofx/synth).
@@ -117,9 +117,6 @@ pub fn run(args: Args) -> Result<ExitCode> {
         ),
     };
     let target: Target = args.target.parse().map_err(super::Usage)?;
-    if args.jobs == Some(0) {
-        usage!("--jobs 0 is not allowed: at least 1 candidate at a time");
-    }
     let cache = match args.cache.clone().or_else(default_folder) {
         Some(folder) => folder,
         None => usage!("no cache folder: neither XDG_CACHE_HOME nor HOME is set; give --cache DIR"),

@@ -17,7 +17,7 @@ use gyrofx_codegen::writers::Provenance;
 use gyrofx_model::fx::{from_f64, Overflow, Rounding};
 use gyrofx_model::kf::{FixedKf, FloatKf};
 
-use super::options::CsvColumn;
+use super::options::{number, CsvColumn};
 use super::usage;
 
 /// Run recorded rate data (°/s) through the bit-accurate KF and its float model.
@@ -47,7 +47,7 @@ pub struct Args {
     #[arg(long)]
     vectors: Option<PathBuf>,
     /// Replace the --vectors folder even when gyrofx did not write it.
-    #[arg(long)]
+    #[arg(long, requires = "vectors")]
     force: bool,
 }
 
@@ -103,6 +103,45 @@ fn filter_provenance(job: &Job, csv: &CsvColumn, fs: f64, bandwidth: Option<f64>
     }
 }
 
+/// Refuses, before any work, an `--fs` that is not a finite number of Hz > 0 and a
+/// `--bandwidth` outside (0, fs/2).
+fn check_rates(fs: f64, bandwidth: Option<f64>) -> Result<()> {
+    if !(fs.is_finite() && fs > 0.0) {
+        usage!(
+            "--fs {} is not allowed: the sample rate must be a finite number of Hz > 0",
+            number(fs)
+        );
+    }
+    if let Some(bw) = bandwidth.filter(|bw| !(bw.is_finite() && *bw > 0.0 && *bw < fs / 2.0)) {
+        usage!(
+            "--bandwidth {} is not allowed: a number of Hz in (0, fs/2 = {})",
+            number(bw),
+            number(fs / 2.0)
+        );
+    }
+    Ok(())
+}
+
+/// A config error on a key that `--fs` or `--bandwidth` set, reported as that flag's usage
+/// error (exit 2); any other stays the config file's error.
+fn flag_error(error: gyrofx_codegen::Error, fs: f64, bandwidth: Option<f64>) -> anyhow::Error {
+    let field = match &error {
+        gyrofx_codegen::Error::Config { field, .. } => field.as_str(),
+        _ => "",
+    };
+    match (field, bandwidth) {
+        ("stimulus.fs_hz", _) => {
+            super::Usage(format!("--fs {} is not allowed: {error}", number(fs))).into()
+        }
+        (f, Some(bw)) if f.starts_with("kf.bandwidths_hz") => super::Usage(format!(
+            "--bandwidth {} is not allowed: {error}",
+            number(bw)
+        ))
+        .into(),
+        _ => error.into(),
+    }
+}
+
 /// Writes the CSV atomically (one row per sample: the input, its code, the fixed-point and the
 /// float rate) and prints a summary with the saturation and overflow counts.
 pub fn run(args: Args) -> Result<ExitCode> {
@@ -116,6 +155,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
         vectors,
         force,
     } = args;
+    check_rates(fs, bandwidth)?;
     let output = output.as_path();
     if let (Ok(input), Ok(existing)) = (csv.input.canonicalize(), output.canonicalize()) {
         if input == existing {
@@ -153,13 +193,24 @@ pub fn run(args: Args) -> Result<ExitCode> {
     if let Some(bw) = bandwidth {
         config.kf.bandwidths_hz = vec![bw];
     }
-    let settings = config.validate()?.kf;
+    let settings = config
+        .validate()
+        .map_err(|e| flag_error(e, fs, bandwidth))?
+        .kf;
     let designs = design_bandwidths(
         &settings,
         fs,
         config.kf.arw_deg_per_sqrt_h,
         config.kf.rrw_deg_per_h_per_sqrt_h,
-    )?;
+    )
+    .map_err(|e| {
+        let bw = settings.bandwidths_hz[0];
+        super::Usage(format!(
+            "--fs {} with the bandwidth {} Hz (--bandwidth, else the config's kf.bandwidths_hz) cannot be designed: {e}",
+            number(fs),
+            number(bw)
+        ))
+    })?;
     let plan = plan_for(&settings, &designs)?;
     // The vectors' folder is checked, and their files opened, before the work.
     let mut kf_vectors = match &vectors {

@@ -22,8 +22,9 @@ use gyrofx_codegen::output_folder;
 pub struct Args {
     #[command(flatten)]
     config: ConfigSource,
-    /// Record length the bounds must hold for, samples (default: the config's `samples`).
-    #[arg(long, value_parser = count)]
+    /// Record length the bounds must hold for, samples, 1..=20000000 (default: the config's
+    /// `samples`).
+    #[arg(long, value_parser = super::options::samples)]
     samples: Option<usize>,
     /// Changes of `bw_sel` the bounds must allow for (each can move the KF's states).
     #[arg(long, value_parser = count, default_value = "100")]
@@ -41,7 +42,7 @@ pub struct Args {
     #[arg(long)]
     write: Option<PathBuf>,
     /// Replace an existing --write file.
-    #[arg(long)]
+    #[arg(long, requires = "write")]
     force: bool,
     /// Exit 1 when a configured format can overflow.
     #[arg(long)]

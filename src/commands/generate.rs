@@ -21,11 +21,11 @@ pub struct Args {
     out: OutputFolder,
     #[command(flatten)]
     source: ConfigSource,
-    /// Samples of the chain run (overrides the config).
-    #[arg(long, value_parser = super::options::count)]
+    /// Samples of the chain run, 1..=20000000 (overrides the config).
+    #[arg(long, value_parser = super::options::samples)]
     samples: Option<usize>,
-    /// Seed (overrides the config).
-    #[arg(long)]
+    /// Seed, 0..=2^63 - 1 (overrides the config).
+    #[arg(long, value_parser = super::options::seed)]
     seed: Option<u64>,
     /// Refuse to write the package when a quantizer overflows or saturates on the run's data
     /// (exit 1); without it, a warning names the signals.
@@ -51,18 +51,19 @@ pub struct Args {
         long,
         value_delimiter = ',',
         num_args = 1,
-        default_value = "y_a_dps,y_b_dps"
+        default_value = "y_a_dps,y_b_dps",
+        requires = "recording"
     )]
     recording_columns: Vec<String>,
     /// The recording's unit: dps (°/s) or rad/s.
-    #[arg(long, default_value = "dps")]
+    #[arg(long, default_value = "dps", requires = "recording")]
     recording_units: String,
     /// The recording's sample rate, Hz (must be the config's stimulus.fs_hz).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, requires = "recording")]
     recording_rate: Option<f64>,
     /// A column with gyro A's mode per row (1 normal, 0 or -1 reverse), checked against the
     /// configured sequencer; without it the rows are taken to follow the sequencer.
-    #[arg(long)]
+    #[arg(long, requires = "recording")]
     recording_mode: Option<String>,
 }
 

@@ -82,7 +82,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
         );
     }
     if let Some(path) = &args.plot {
-        plot::check_path(path).map_err(|e| super::Usage(format!("--plot: {e}")))?;
+        super::options::check_plot(path)?;
     }
     let config = args.source.load()?;
     let loops = config.gyro_loops()?;

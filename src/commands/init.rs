@@ -17,7 +17,10 @@ pub struct Args {
 /// Prints the config text as is, to be saved and edited.
 pub fn run(args: Args) -> Result<ExitCode> {
     match args.preset {
-        Some(name) => print!("{}", preset(&name)?),
+        Some(name) => {
+            super::options::check_preset(&name)?;
+            print!("{}", preset(&name)?)
+        }
         None => print!("{DEFAULT_TOML}"),
     }
     Ok(ExitCode::SUCCESS)

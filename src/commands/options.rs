@@ -4,18 +4,19 @@
 //! The groups carry `//` comments, not `///`: clap takes a struct's doc comment as the `about`
 //! text of whichever command flattens it.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 
 use super::usage;
 
-use gyrofx_codegen::config::Config;
+use gyrofx_codegen::config::{Config, MAX_SAMPLES, MAX_SEED, PRESETS};
 use gyrofx_codegen::generate::{provenance, Output};
 use gyrofx_codegen::input::{read_column, read_column_with_gaps};
 use gyrofx_codegen::job::Job;
 use gyrofx_codegen::output_folder::Replace;
 use gyrofx_codegen::writers::Provenance;
+use gyrofx_model::analysis::{MAX_RATE_HZ, MIN_RATE_HZ};
 
 // One column of a CSV record (ar, davar, filter). A command whose help words these flags
 // differently sets its own text with `#[command(mut_arg(..))]`.
@@ -58,21 +59,15 @@ pub fn gaps_note(path: &std::path::Path, column: &str, skipped: usize) -> Option
 // The sample rate of a recorded series (allan, davar).
 #[derive(clap::Args)]
 pub struct SampleRate {
-    /// Sample rate, Hz.
+    /// Sample rate, Hz (1e-9..=1e9: the range in which τ and the noise fit stay finite).
     #[arg(long, allow_negative_numbers = true)]
     pub rate: f64,
 }
 
 impl SampleRate {
-    /// The rate in Hz, refused unless it is finite and > 0.
+    /// The rate in Hz, refused unless it is within what the analyses compute ([`check_rate`]).
     pub fn hz(&self) -> Result<f64> {
-        let rate = self.rate;
-        if !(rate.is_finite() && rate > 0.0) {
-            usage!(
-                "--rate {rate} is not allowed: the sample rate must be a finite number of Hz > 0"
-            );
-        }
-        Ok(rate)
+        check_rate("--rate", self.rate)
     }
 }
 
@@ -119,6 +114,9 @@ pub struct ConfigSource {
 impl ConfigSource {
     /// The config: the embedded default, overlaid by the preset, overlaid by the file.
     pub fn load(&self) -> Result<Config> {
+        if let Some(name) = &self.preset {
+            check_preset(name)?;
+        }
         Ok(Config::from_preset_and_file(
             self.preset.as_deref(),
             self.config.as_deref(),
@@ -130,6 +128,18 @@ impl ConfigSource {
     pub fn provenance(&self, job: &Job, output: Output) -> Provenance {
         provenance(job, output, self.preset.as_deref(), self.config.as_deref())
     }
+}
+
+/// Refuses a `--preset` that is not one of [`PRESETS`] (a usage error, exit 2).
+pub fn check_preset(name: &str) -> Result<()> {
+    if !PRESETS.iter().any(|(known, _)| *known == name) {
+        let known: Vec<&str> = PRESETS.iter().map(|(n, _)| *n).collect();
+        usage!(
+            "--preset {name:?} is not allowed: one of {}",
+            known.join(", ")
+        );
+    }
+    Ok(())
 }
 
 /// A count of samples from the command line: a whole number, also written as `1e6` or
@@ -145,5 +155,108 @@ pub fn count(text: &str) -> std::result::Result<usize, String> {
         Ok(value as usize)
     } else {
         Err(refuse())
+    }
+}
+
+/// A seed from the command line: a whole number in `0..=MAX_SEED` (clap's value parser). The
+/// cap is the config's: a seed is written into TOML, whose integers are 64-bit signed.
+pub fn seed(text: &str) -> std::result::Result<u64, String> {
+    match text.trim().parse::<u64>() {
+        Ok(seed) if seed <= MAX_SEED => Ok(seed),
+        _ => Err(format!(
+            "'{text}' is not a seed: a whole number 0..={MAX_SEED} (2^63 - 1: TOML integers are 64-bit signed)"
+        )),
+    }
+}
+
+/// A count of chain samples from the command line ([`count`]), in `1..=MAX_SAMPLES`: every
+/// command that simulates builds its record in memory.
+pub fn samples(text: &str) -> std::result::Result<usize, String> {
+    let n = count(text)?;
+    if (1..=MAX_SAMPLES).contains(&n) {
+        Ok(n)
+    } else {
+        Err(format!(
+            "{n} samples are not allowed: 1..={MAX_SAMPLES} (the record is built in memory)"
+        ))
+    }
+}
+
+/// Largest `--jobs`: more tools or candidates at once than this only queue on any machine
+/// gyrofx runs on, and each costs a thread and its memory.
+pub const MAX_JOBS: usize = 256;
+
+/// A number of tools or candidates run at once, `1..=MAX_JOBS` (clap's value parser).
+pub fn jobs(text: &str) -> std::result::Result<usize, String> {
+    let n = count(text)?;
+    if (1..=MAX_JOBS).contains(&n) {
+        Ok(n)
+    } else {
+        Err(format!("{n} is not allowed: 1..={MAX_JOBS} at a time"))
+    }
+}
+
+/// Checks, before any work, that a file can be created at `path` given as `flag`: its folder
+/// exists and is writable (a file is created there and removed), and `path` is not a folder.
+pub fn check_writable_file(flag: &str, path: &Path) -> Result<()> {
+    if path.is_dir() {
+        usage!(
+            "{flag} {} is a folder: name the file to write",
+            path.display()
+        );
+    }
+    let folder = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    if !folder.is_dir() {
+        usage!(
+            "{flag} {}: the folder {} does not exist",
+            path.display(),
+            folder.display()
+        );
+    }
+    if let Err(e) = tempfile::Builder::new()
+        .prefix(".gyrofx-check-")
+        .tempfile_in(folder)
+    {
+        // The OS's reason, without the temporary file's name that tempfile adds.
+        let reason = e.to_string();
+        let reason = reason.split(" at path ").next().unwrap_or_default();
+        usage!(
+            "{flag} {}: cannot create a file in {}: {reason}",
+            path.display(),
+            folder.display()
+        );
+    }
+    Ok(())
+}
+
+/// Checks a `--plot` path before any work: `.png` or `.svg`, in a writable folder.
+pub fn check_plot(path: &Path) -> Result<()> {
+    gyrofx_codegen::plot::check_path(path).map_err(|e| super::Usage(format!("--plot: {e}")))?;
+    check_writable_file("--plot", path)
+}
+
+/// Checks a sample rate given as `flag`, in Hz: finite and within `MIN_RATE_HZ..=MAX_RATE_HZ`
+/// of the analyses.
+pub fn check_rate(flag: &str, rate: f64) -> Result<f64> {
+    if !(rate.is_finite() && (MIN_RATE_HZ..=MAX_RATE_HZ).contains(&rate)) {
+        usage!(
+            "{flag} {} is not allowed: the sample rate must be {MIN_RATE_HZ:e}..={MAX_RATE_HZ:e} Hz",
+            number(rate)
+        );
+    }
+    Ok(rate)
+}
+
+/// `value` as a message shows it: as written for ordinary magnitudes, in exponent form (`1e308`,
+/// not 309 digits) for very large or small ones.
+pub fn number(value: f64) -> String {
+    let magnitude = value.abs();
+    if value == 0.0 || !value.is_finite() || (1e-6..1e15).contains(&magnitude) {
+        format!("{value}")
+    } else {
+        format!("{value:e}")
     }
 }

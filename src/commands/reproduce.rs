@@ -17,11 +17,11 @@ pub struct Args {
     /// The paper: 000, 002, 003 or 004.
     #[arg(long)]
     paper: String,
-    /// Samples to simulate (default: the paper's record length).
-    #[arg(long, value_parser = super::options::count)]
+    /// Samples to simulate, at most 20000000 (default: the paper's record length).
+    #[arg(long, value_parser = super::options::samples)]
     samples: Option<usize>,
-    /// Seed of the simulation.
-    #[arg(long, default_value_t = 1)]
+    /// Seed of the simulation, 0..=2^63 - 1.
+    #[arg(long, default_value = "1", value_parser = super::options::seed)]
     seed: u64,
     /// Also write report.md, allan.png (and davar.png for 002) into this folder (replaced
     /// only if empty or a previous reproduction holding only its own files, unchanged).

@@ -10,8 +10,7 @@ use gyrofx_codegen::job::Job;
 use gyrofx_codegen::place_route::{self, Target};
 use gyrofx_codegen::synth::{synthesize, PlaceRequest, LOOP_TOP};
 
-use super::options::{count, ConfigSource, OutputFolder};
-use super::usage;
+use super::options::{ConfigSource, OutputFolder};
 
 /// Synthesize the chain with the config's widths in yosys (generic and Xilinx 7-series):
 /// fails on a latch, an undriven or multiply-driven net or a missing module; writes the
@@ -33,8 +32,8 @@ pub struct Args {
     /// architecture).
     #[arg(long, value_name = "LIST", requires = "target")]
     blocks: Option<String>,
-    /// yosys and nextpnr runs at a time for --target (default: the available cores).
-    #[arg(long, value_parser = count, requires = "target")]
+    /// yosys and nextpnr runs at a time for --target, 1..=256 (default: the available cores).
+    #[arg(long, value_parser = super::options::jobs, requires = "target")]
     jobs: Option<usize>,
     /// No progress spinner (it shows only on a terminal).
     #[arg(long)]
@@ -57,9 +56,6 @@ pub fn run(args: Args) -> Result<ExitCode> {
     };
     let blocks =
         place_route::parse_blocks(blocks.as_deref().unwrap_or("all")).map_err(super::Usage)?;
-    if jobs == Some(0) {
-        usage!("--jobs 0 is not allowed: at least 1 tool at a time");
-    }
     let place = PlaceRequest {
         targets,
         blocks,

@@ -76,8 +76,13 @@ pub fn run(args: Args) -> Result<ExitCode> {
     } else {
         sim.split(',')
             .map(|name| name.trim().parse())
-            .collect::<std::result::Result<_, _>>()?
+            .collect::<std::result::Result<_, _>>()
+            .map_err(|e| super::Usage(format!("--sim {sim}: {e}")))?
     };
+    if let Some(path) = &junit_path {
+        // Before the simulations, which can take minutes.
+        super::options::check_writable_file("--junit", path)?;
+    }
     let mut total = 0;
     for simulator in &simulators {
         total += simulate::block_names(&out, *simulator, &options)?.len() as u64;

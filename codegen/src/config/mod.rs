@@ -29,6 +29,9 @@ pub use gyro::PlantConfig;
 pub use resonator::GyroLoop;
 pub use stimulus::{Source, StimulusConfig};
 
+/// Largest `seed`: the config is written as TOML, whose integers are 64-bit signed.
+pub const MAX_SEED: u64 = i64::MAX as u64;
+
 /// Largest `samples`: the vector set and its files are built in memory.
 pub const MAX_SAMPLES: usize = 20_000_000;
 
@@ -387,6 +390,13 @@ impl Config {
     /// # Errors
     /// [`Error::Config`] naming the first bad field.
     pub fn validate(&self) -> Result<Settings> {
+        if self.seed > MAX_SEED {
+            return Err(Error::config(
+                "seed",
+                self.seed,
+                format!("0..={MAX_SEED} (TOML integers are 64-bit signed)"),
+            ));
+        }
         if self.samples == 0 || self.samples > MAX_SAMPLES {
             return Err(Error::config(
                 "samples",
@@ -484,6 +494,23 @@ mod tests {
             config
         );
         assert_eq!(config.kf.bandwidths_hz, vec![10.0, 20.0, 30.0]);
+    }
+
+    /// A seed beyond TOML's signed integers is refused by validation, not a panic when the
+    /// config is written; the largest one round-trips through TOML.
+    #[test]
+    fn a_seed_must_fit_a_toml_integer() {
+        let mut config = Config::embedded();
+        config.seed = MAX_SEED + 1;
+        let err = config.validate().unwrap_err().to_string();
+        assert!(
+            err.contains("seed = 9223372036854775808") && err.contains("0..=9223372036854775807"),
+            "{err}"
+        );
+        config.seed = MAX_SEED;
+        config.validate().unwrap();
+        let again = Config::from_toml(&config.to_toml(), "written").unwrap();
+        assert_eq!(again.seed, MAX_SEED);
     }
 
     #[test]

@@ -52,13 +52,16 @@ pub enum ArError {
         /// Its value.
         value: f64,
     },
+    /// A record outside the magnitudes whose autocovariances stay finite and normal.
+    #[error("{0}")]
+    Magnitude(#[from] super::MagnitudeError),
 }
 
 /// AR(1)..AR(`max_order`) of `record` by Yule–Walker (Levinson–Durbin), each with its AIC.
 ///
 /// # Errors
-/// [`ArError`] for `max_order` 0, too few samples, a non-finite sample or a record without
-/// variance.
+/// [`ArError`] for `max_order` 0, too few samples, a non-finite sample, a value outside
+/// [`super::check_magnitudes`] or a record without variance.
 pub fn fit_orders(record: &[f64], max_order: usize) -> Result<Vec<ArModel>, ArError> {
     if max_order == 0 {
         return Err(ArError::NoOrder);
@@ -77,6 +80,8 @@ pub fn fit_orders(record: &[f64], max_order: usize) -> Result<Vec<ArModel>, ArEr
             value: *value,
         });
     }
+    // Beyond these the autocovariances overflow (NaN variances, an AIC of NaN) or underflow.
+    super::check_magnitudes(record)?;
     let c = autocovariance(record, max_order);
     let n = record.len() as f64;
     let mut phi: Vec<f64> = Vec::with_capacity(max_order);
