@@ -59,6 +59,13 @@ pub fn run(args: Args) -> Result<ExitCode> {
         quiet,
     } = args;
     let rate = rate.hz()?;
+    if let Some(path) = &plot {
+        let inputs: Vec<(&str, Option<&std::path::Path>)> = inputs
+            .iter()
+            .map(|p| ("--input", Some(p.as_path())))
+            .collect();
+        super::options::check_output("--plot", path, false, &inputs)?;
+    }
     let grid: allan::Grid = taus
         .parse()
         .map_err(|e: String| super::Usage(format!("--taus: {e}")))?;

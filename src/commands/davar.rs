@@ -73,6 +73,9 @@ pub fn run(args: Args) -> Result<ExitCode> {
         quiet,
     } = args;
     let rate = rate.hz()?;
+    if let Some(path) = &plot {
+        super::options::check_output("--plot", path, false, &[("--input", Some(&csv.input))])?;
+    }
     for (name, gain) in [("--kp", kp), ("--ki", ki), ("--kd", kd)] {
         if let Some(g) = gain.filter(|g| !g.is_finite()) {
             usage!("{name} {g} is not allowed: a PID gain is a finite number");

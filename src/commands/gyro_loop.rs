@@ -78,6 +78,12 @@ pub fn run(args: Args) -> Result<ExitCode> {
     }
     if let Some(path) = &args.plot {
         plot::check_path(path).map_err(|e| super::Usage(format!("--plot: {e}")))?;
+        super::options::check_output(
+            "--plot",
+            path,
+            false,
+            &[("--config", args.source.config.as_deref())],
+        )?;
     }
     let config = args.source.load()?;
     let loops = config.gyro_loops()?;
