@@ -680,6 +680,16 @@ pub fn lock(out: &Path) -> Result<Lock> {
         .map_or_else(|| "out".into(), |n| n.to_string_lossy().into_owned());
     let path = parent.join(format!("{LOCK_PREFIX}{name}"));
     let own = std::process::id();
+    let holder = |path: &Path| {
+        std::fs::read_to_string(path)
+            .ok()
+            .and_then(|t| t.trim().parse::<u32>().ok())
+    };
+    if holder(&path) == Some(own) {
+        // Taken already by this process (the command, then its staging folder): that one
+        // stays registered and removes it.
+        return Ok(Lock { path: None });
+    }
     // The pid is written to a file of its own first and linked into place: a lock file is
     // never seen empty.
     let draft = parent.join(format!("{LOCK_PREFIX}{name}.{own}"));
@@ -706,10 +716,7 @@ pub fn lock(out: &Path) -> Result<Lock> {
                 }
             }
             unregister(&path);
-            let holder = std::fs::read_to_string(&path)
-                .ok()
-                .and_then(|t| t.trim().parse::<u32>().ok());
-            match holder {
+            match holder(&path) {
                 Some(pid) if pid == own => return Ok(Lock { path: None }),
                 Some(pid) if process_runs(pid) => {
                     return Err(Error::Output {
