@@ -42,9 +42,11 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    // Ctrl-C or SIGTERM while a package is being written: remove its staging folder, then end
-    // as a shell expects of an interrupted program (128 + SIGINT).
+    // Ctrl-C or SIGTERM: end the programs gyrofx started (they would go on writing into the
+    // folders removed next), remove the staging folders, temporary and lock files, then end as
+    // a shell expects of an interrupted program (128 + SIGINT).
     let _ = ctrlc::set_handler(|| {
+        gyrofx_codegen::processes::end_all();
         gyrofx_codegen::output_folder::remove_registered();
         std::process::exit(130);
     });
@@ -65,6 +67,13 @@ fn main() -> ExitCode {
         Command::Filter(args) => filter::run(args),
         Command::Reproduce(args) => reproduce::run(args),
     };
+    if gyrofx_codegen::processes::ending() || gyrofx_codegen::output_folder::interrupted() {
+        // A child the handler ended made the command fail: the handler is still removing
+        // files, and it ends the process with 130 when done.
+        loop {
+            std::thread::park();
+        }
+    }
     match outcome {
         Ok(code) => code,
         Err(e) => {

@@ -102,6 +102,7 @@ fn a_vector_file_with_other_formats_or_missing_is_refused() {
         let stimulus = dir.path().join("pkg/kf/kf_stimulus.hex");
         let original = std::fs::read_to_string(&stimulus).unwrap();
         std::fs::write(&stimulus, original.replacen("z:s24.14", "z:s24.13", 1)).unwrap();
+        reseal(&dir.path().join("pkg"));
         let log = fails(&["verify", "--out", &out, "--sim", sim, "--blocks", "kf"]);
         assert!(
             log.contains("kf_stimulus.hex declares rst:u1.0 bw_sel:u2.0 z:s24.13; the testbench expects rst:u1.0 bw_sel:u2.0 z:s24.14"),
@@ -111,6 +112,7 @@ fn a_vector_file_with_other_formats_or_missing_is_refused() {
         // A truncated stimulus file: the testbench names the sample whose line is missing.
         let lines: Vec<&str> = original.lines().take(102).collect();
         std::fs::write(&stimulus, lines.join("\n") + "\n").unwrap();
+        reseal(&dir.path().join("pkg"));
         let log = fails(&["verify", "--out", &out, "--sim", sim, "--blocks", "kf"]);
         assert!(
             log.contains("line for sample 100 is missing or malformed"),
@@ -119,14 +121,17 @@ fn a_vector_file_with_other_formats_or_missing_is_refused() {
 
         // A field that is not hex.
         std::fs::write(&stimulus, original.replacen("\n0 0 ", "\n0 0 g", 1)).unwrap();
+        reseal(&dir.path().join("pkg"));
         let log = fails(&["verify", "--out", &out, "--sim", sim, "--blocks", "kf"]);
         assert!(log.contains("FAIL"), "{sim}: {log}");
 
         std::fs::remove_file(&stimulus).unwrap();
+        reseal(&dir.path().join("pkg"));
         let log = fails(&["verify", "--out", &out, "--sim", sim, "--blocks", "kf"]);
         assert!(log.contains("cannot open kf_stimulus.hex"), "{sim}: {log}");
 
         std::fs::remove_file(dir.path().join("pkg/kf/kf_coefficients.mem")).unwrap();
+        reseal(&dir.path().join("pkg"));
         let log = fails(&["verify", "--out", &out, "--sim", sim, "--blocks", "kf"]);
         assert!(
             log.contains("cannot open kf_coefficients.mem"),

@@ -27,6 +27,7 @@ pub mod output_folder;
 pub mod package;
 pub mod place_route;
 pub mod plot;
+pub mod processes;
 pub mod progress;
 pub mod recording;
 pub mod report;

@@ -88,6 +88,11 @@ pub struct Marker {
     pub kind: String,
     /// Build outputs the package's own Makefile writes (simulator work folders, logs).
     pub build_outputs: Vec<String>,
+    /// SHA-256 (hex) of the package's `manifest.json`: the marker is written after it, so that
+    /// an edited manifest counts as a changed file too. Missing in the markers of gyrofx
+    /// before 0.1 of issue 27 (those packages are not replaced without `--force`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub manifest_sha256: Option<String>,
 }
 
 impl Marker {
@@ -97,6 +102,7 @@ impl Marker {
             tool: "gyrofx".into(),
             kind: kind.name().into(),
             build_outputs,
+            manifest_sha256: None,
         }
     }
 
@@ -107,7 +113,8 @@ impl Marker {
         text
     }
 
-    fn allows(&self, path: &str) -> bool {
+    /// Whether `path` (relative, `/`-separated) is one of the build outputs.
+    pub fn allows(&self, path: &str) -> bool {
         self.build_outputs.iter().any(|pattern| {
             if let Some(folder) = pattern.strip_suffix('/') {
                 path.starts_with(&format!("{folder}/"))
@@ -132,6 +139,9 @@ pub fn check(out: &Path, kind: Kind, replace: Replace) -> Result<()> {
         path: out.to_path_buf(),
         message,
     };
+    if let Some(reason) = unsafe_folder(out) {
+        return Err(refuse(reason));
+    }
     let Ok(meta) = std::fs::symlink_metadata(out) else {
         return Ok(());
     };
@@ -174,32 +184,30 @@ pub fn check(out: &Path, kind: Kind, replace: Replace) -> Result<()> {
             )))
         }
     }
-    let listed: BTreeMap<String, (String, u64)> = std::fs::read_to_string(out.join(MANIFEST))
-        .ok()
-        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
-        .and_then(|manifest| {
-            manifest["files"].as_array().map(|files| {
-                files
-                    .iter()
-                    .filter_map(|f| {
-                        Some((
-                            f["path"].as_str()?.to_string(),
-                            (f["sha256"].as_str()?.to_string(), f["bytes"].as_u64()?),
-                        ))
-                    })
-                    .collect()
-            })
-        })
-        .ok_or_else(|| {
-            refuse(format!(
-                "holds a gyrofx marker but no readable {MANIFEST} with its file list, so what \
-                 it holds cannot be checked; {force}"
-            ))
-        })?;
+    let listed = listed_files(out).ok_or_else(|| {
+        refuse(format!(
+            "holds a gyrofx marker but no readable {MANIFEST} with its file list, so what \
+             it holds cannot be checked; {force}"
+        ))
+    })?;
+    let Some(manifest_sha256) = &marker.manifest_sha256 else {
+        return Err(refuse(format!(
+            "holds a package of an older gyrofx whose marker does not record the SHA-256 of \
+             its {MANIFEST}, so an edit to that file cannot be told apart; it is not replaced: \
+             {force}"
+        )));
+    };
     let mut foreign = Vec::new();
     let mut changed = Vec::new();
+    if crate::package::file_sha256(&out.join(MANIFEST))
+        .ok()
+        .as_ref()
+        != Some(manifest_sha256)
+    {
+        changed.push(MANIFEST.to_string());
+    }
     for (path, size) in walk(out)? {
-        if path == MANIFEST || marker.allows(&path) {
+        if path == MANIFEST || path == MARKER || marker.allows(&path) {
             continue;
         }
         match (listed.get(&path), size) {
@@ -233,6 +241,110 @@ pub fn check(out: &Path, kind: Kind, replace: Replace) -> Result<()> {
     )))
 }
 
+/// The files a package's `manifest.json` lists: relative path to (SHA-256 hex, bytes); `None`
+/// when it cannot be read or lists none.
+fn listed_files(out: &Path) -> Option<BTreeMap<String, (String, u64)>> {
+    let text = std::fs::read_to_string(out.join(MANIFEST)).ok()?;
+    let manifest = serde_json::from_str::<serde_json::Value>(&text).ok()?;
+    let files = manifest["files"].as_array()?;
+    Some(
+        files
+            .iter()
+            .filter_map(|f| {
+                Some((
+                    f["path"].as_str()?.to_string(),
+                    (f["sha256"].as_str()?.to_string(), f["bytes"].as_u64()?),
+                ))
+            })
+            .collect(),
+    )
+}
+
+/// Why `out` may never be an output folder, whatever `--force` says: a filesystem root, the
+/// home folder, or the current folder or one of its ancestors (replacing it would take the
+/// folder gyrofx runs in, and walking it would cross into everything below). `None` when it
+/// may be one.
+pub fn unsafe_folder(out: &Path) -> Option<String> {
+    let resolved = resolve(out);
+    if resolved.parent().is_none() {
+        return Some("is a filesystem root: gyrofx writes its output into a folder of its own there; choose a new folder such as ./out".into());
+    }
+    let home = std::env::var_os("HOME").map(|h| resolve(Path::new(&h)));
+    if home.as_ref() == Some(&resolved) {
+        return Some(
+            "is the home folder: gyrofx replaces its output folder; choose a new folder in it"
+                .into(),
+        );
+    }
+    let current = std::env::current_dir().map(|c| resolve(&c));
+    if current.is_ok_and(|c| c.starts_with(&resolved)) {
+        return Some("is the current folder or one of its ancestors: gyrofx replaces its output folder, and cannot replace the folder it runs in; choose a new folder such as ./out".into());
+    }
+    None
+}
+
+/// `path` made absolute with links resolved as far as it exists (the rest appended), so that
+/// two names of one file compare equal even before the file exists.
+pub fn resolve(path: &Path) -> PathBuf {
+    let absolute = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
+    let mut existing = absolute.as_path();
+    let mut rest = Vec::new();
+    loop {
+        if let Ok(mut real) = existing.canonicalize() {
+            // The part that does not exist holds no links: its `..` go up by name.
+            for name in rest.iter().rev() {
+                if name == std::ffi::OsStr::new("..") {
+                    real.pop();
+                } else if name != std::ffi::OsStr::new(".") {
+                    real.push(name);
+                }
+            }
+            return real;
+        }
+        match (existing.parent(), existing.components().next_back()) {
+            (Some(parent), Some(last)) => {
+                rest.push(last.as_os_str().to_os_string());
+                existing = parent;
+            }
+            // A root that cannot be resolved: compared as written.
+            _ => return absolute,
+        }
+    }
+}
+
+/// Refuses an output that is, or as a folder would hold, one of the command's inputs: the
+/// message names both flags. `output` and each input are (flag, path); inputs that do not
+/// exist are skipped.
+///
+/// # Errors
+/// The message (for a usage error).
+pub fn refuse_overlap(
+    output: (&str, &Path),
+    inputs: &[(&str, &Path)],
+) -> std::result::Result<(), String> {
+    let (out_flag, out_path) = output;
+    let target = resolve(out_path);
+    for (flag, path) in inputs {
+        let Ok(input) = path.canonicalize() else {
+            continue;
+        };
+        if input == target {
+            return Err(format!(
+                "{out_flag} {} is the {flag} file: the output would replace it; choose another {out_flag}",
+                out_path.display()
+            ));
+        }
+        if input.starts_with(&target) {
+            return Err(format!(
+                "{out_flag} {} holds the {flag} file {}: writing the output there would replace it; choose another {out_flag}",
+                out_path.display(),
+                path.display()
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Up to eight paths, then how many more.
 fn listing(paths: &[String]) -> String {
     const SHOWN: usize = 8;
@@ -250,8 +362,15 @@ fn listing(paths: &[String]) -> String {
 
 /// Every entry under `root` by `/`-separated relative path: files with their size, and
 /// anything that is neither a file nor a folder (a link, a socket) with `None`. Empty folders
-/// are listed with `None` too, so that they count as foreign. Links are not followed.
+/// are listed with `None` too, so that they count as foreign. Links are not followed, nor is a
+/// folder on another file system (a mount point is listed with `None`).
 fn walk(root: &Path) -> Result<BTreeMap<String, Option<u64>>> {
+    #[cfg(unix)]
+    use std::os::unix::fs::MetadataExt;
+    #[cfg(unix)]
+    let device = std::fs::symlink_metadata(root)
+        .map_err(|e| Error::io(root, e))?
+        .dev();
     let mut out = BTreeMap::new();
     let mut pending = vec![PathBuf::new()];
     while let Some(relative) = pending.pop() {
@@ -263,7 +382,16 @@ fn walk(root: &Path) -> Result<BTreeMap<String, Option<u64>>> {
             let path = relative.join(entry.file_name());
             let kind = entry.file_type().map_err(|e| Error::io(entry.path(), e))?;
             let name = path.to_string_lossy().replace('\\', "/");
-            if kind.is_dir() {
+            #[cfg(unix)]
+            let other_device = kind.is_dir()
+                && entry
+                    .metadata()
+                    .map_err(|e| Error::io(entry.path(), e))?
+                    .dev()
+                    != device;
+            #[cfg(not(unix))]
+            let other_device = false;
+            if kind.is_dir() && !other_device {
                 pending.push(path);
             } else if kind.is_file() {
                 let size = entry
@@ -285,14 +413,20 @@ fn walk(root: &Path) -> Result<BTreeMap<String, Option<u64>>> {
     Ok(out)
 }
 
-/// Staging folders of this process that exist now.
+/// Staging folders, temporary files and lock files of this process that exist now.
 static STAGING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
-/// Records a staging folder, removed by [`remove_registered`] if a signal ends the process.
-pub fn register(path: &Path) {
+/// Records a staging folder or a temporary file, removed by [`remove_registered`] if a signal
+/// ends the process. Returns false, registering nothing, once that removal has started: then
+/// the caller must not create it (nothing would remove it).
+pub fn register(path: &Path) -> bool {
     if let Ok(mut staging) = STAGING.lock() {
+        if interrupted() {
+            return false;
+        }
         staging.push(path.to_path_buf());
     }
+    true
 }
 
 /// Forgets a staging folder (it was renamed into place or removed).
@@ -317,6 +451,10 @@ pub fn remove_registered() {
     INTERRUPTED.store(true, std::sync::atomic::Ordering::SeqCst);
     if let Ok(mut staging) = STAGING.lock() {
         for path in staging.drain(..) {
+            if std::fs::symlink_metadata(&path).is_ok_and(|m| !m.is_dir()) {
+                let _ = std::fs::remove_file(&path);
+                continue;
+            }
             for _ in 0..500 {
                 if std::fs::remove_dir_all(&path).is_ok() || !path.exists() {
                     break;
@@ -333,6 +471,11 @@ pub fn remove_registered() {
 /// # Errors
 /// The error of creating it.
 pub fn create_staging(parent: &Path) -> std::io::Result<PathBuf> {
+    create_registered_folder(parent, STAGING_PREFIX)
+}
+
+/// Creates a new folder `<prefix><pid>-<n>` in `parent`, registered before it exists.
+fn create_registered_folder(parent: &Path, prefix: &str) -> std::io::Result<PathBuf> {
     use std::sync::atomic::{AtomicU64, Ordering};
     static NEXT: AtomicU64 = AtomicU64::new(0);
     let nanos = std::time::SystemTime::now()
@@ -341,11 +484,10 @@ pub fn create_staging(parent: &Path) -> std::io::Result<PathBuf> {
         .unwrap_or(0);
     loop {
         let n = NEXT.fetch_add(1, Ordering::Relaxed);
-        let path = parent.join(format!(
-            "{STAGING_PREFIX}{}-{nanos:08x}{n}",
-            std::process::id()
-        ));
-        register(&path);
+        let path = parent.join(format!("{prefix}{}-{nanos:08x}{n}", std::process::id()));
+        if !register(&path) {
+            return Err(std::io::Error::from(std::io::ErrorKind::Interrupted));
+        }
         match std::fs::create_dir(&path) {
             Ok(()) => return Ok(path),
             Err(e) => {
@@ -358,42 +500,83 @@ pub fn create_staging(parent: &Path) -> std::io::Result<PathBuf> {
     }
 }
 
-/// Removes the staging and set-aside folders in `parent` that a run killed before it could
-/// clean up left behind: those whose process no longer runs (where the platform tells,
-/// `/proc/<pid>`), else those older than a day. Errors are ignored: this is housekeeping.
+/// Removes what runs killed before they could clean up left in `parent`: staging and
+/// set-aside folders and temporary files (`.gyrofx-<what>-<pid>-…`) whose process no longer
+/// runs (where the platform tells, `/proc/<pid>`), else those older than a day. Errors are
+/// ignored: this is housekeeping.
 pub fn clean_stale(parent: &Path) {
     let Ok(entries) = std::fs::read_dir(parent) else {
         return;
     };
-    let own = std::process::id();
     for entry in entries.flatten() {
         let name = entry.file_name().to_string_lossy().into_owned();
-        let Some(rest) = name
-            .strip_prefix(STAGING_PREFIX)
-            .or_else(|| name.strip_prefix(OLD_PREFIX))
-        else {
+        let Some(rest) = name.strip_prefix(".gyrofx-") else {
             continue;
         };
-        if !entry.file_type().is_ok_and(|t| t.is_dir()) {
+        let Some((what, tail)) = rest.split_once('-') else {
+            continue;
+        };
+        if what == "lock" {
             continue;
         }
-        let pid = rest
-            .split_once('-')
-            .and_then(|(pid, _)| pid.parse::<u32>().ok());
-        let proc_root = Path::new("/proc");
-        let stale = match pid {
-            Some(pid) if pid == own => false,
-            Some(pid) if proc_root.join("self").exists() => {
-                !proc_root.join(pid.to_string()).exists()
-            }
-            _ => entry
-                .metadata()
-                .and_then(|m| m.modified())
-                .ok()
-                .and_then(|t| t.elapsed().ok())
-                .is_some_and(|age| age.as_secs() > 24 * 3600),
+        let Ok(kind) = entry.file_type() else {
+            continue;
         };
-        if stale {
+        // The folders are staging and set-aside ones; every other prefix names a file.
+        let folder = format!(".gyrofx-{what}-") == STAGING_PREFIX
+            || format!(".gyrofx-{what}-") == OLD_PREFIX;
+        if kind.is_dir() != folder || kind.is_symlink() {
+            continue;
+        }
+        if is_stale(&entry, tail) {
+            let _ = if folder {
+                std::fs::remove_dir_all(entry.path())
+            } else {
+                std::fs::remove_file(entry.path())
+            };
+        }
+    }
+}
+
+/// Whether the entry named `…<pid>-<tail>` belongs to a process that ended: `/proc/<pid>` is
+/// gone, or (without /proc, or without a pid) it is older than a day.
+fn is_stale(entry: &std::fs::DirEntry, pid_and_rest: &str) -> bool {
+    let pid = pid_and_rest
+        .split_once('-')
+        .and_then(|(pid, _)| pid.parse::<u32>().ok());
+    let proc_root = Path::new("/proc");
+    match pid {
+        Some(pid) if pid == std::process::id() => false,
+        Some(pid) if proc_root.join("self").exists() => !proc_root.join(pid.to_string()).exists(),
+        _ => entry
+            .metadata()
+            .and_then(|m| m.modified())
+            .ok()
+            .and_then(|t| t.elapsed().ok())
+            .is_some_and(|age| age.as_secs() > 24 * 3600),
+    }
+}
+
+/// Prefix of the work folders in the system's temporary folder (then the pid and a random
+/// part).
+pub const WORK_PREFIX: &str = "gyrofx-work-";
+
+/// Removes the work folders in `temp` whose process no longer runs (a SIGKILLed `synth` or
+/// `explore` cannot remove its own).
+pub fn clean_stale_work(temp: &Path) {
+    let Ok(entries) = std::fs::read_dir(temp) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let Some(tail) = name.strip_prefix(WORK_PREFIX) else {
+            continue;
+        };
+        // A folder of an older gyrofx without a pid in its name is left alone.
+        let has_pid = tail
+            .split_once('-')
+            .is_some_and(|(pid, _)| pid.parse::<u32>().is_ok());
+        if has_pid && entry.file_type().is_ok_and(|t| t.is_dir()) && is_stale(&entry, tail) {
             let _ = std::fs::remove_dir_all(entry.path());
         }
     }
@@ -403,7 +586,7 @@ pub fn clean_stale(parent: &Path) {
 /// registered so that a signal ending the process removes it ([`remove_registered`]), and
 /// removed when dropped.
 #[derive(Debug)]
-pub struct WorkFolder(tempfile::TempDir);
+pub struct WorkFolder(PathBuf);
 
 impl WorkFolder {
     /// Creates one.
@@ -411,25 +594,36 @@ impl WorkFolder {
     /// # Errors
     /// The error of creating it.
     pub fn new() -> std::io::Result<WorkFolder> {
-        let folder = tempfile::Builder::new().prefix("gyrofx-work-").tempdir()?;
-        register(folder.path());
-        Ok(WorkFolder(folder))
+        let temp = std::env::temp_dir();
+        clean_stale_work(&temp);
+        // Registered before it exists, as a staging folder: a signal cannot leave it behind.
+        let folder = WorkFolder(create_registered_folder(&temp, WORK_PREFIX)?);
+        // Private, as a temporary folder should be.
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            std::fs::set_permissions(&folder.0, std::fs::Permissions::from_mode(0o700))?;
+        }
+        Ok(folder)
     }
 
     /// Its path.
     pub fn path(&self) -> &Path {
-        self.0.path()
+        &self.0
     }
 }
 
 impl Drop for WorkFolder {
     fn drop(&mut self) {
-        unregister(self.0.path());
+        let _ = std::fs::remove_dir_all(&self.0);
+        unregister(&self.0);
     }
 }
 
-/// A temporary file in `folder` (`<prefix>…<suffix>`) for a single output file that is
-/// renamed into place when complete. Created with mode 0666 less the umask, as any file a
+/// A temporary file in `folder` (`<prefix><pid>-…<suffix>`) for a single output file that is
+/// renamed into place when complete, registered for removal on a signal (once renamed, its
+/// temporary name no longer exists); the next run's [`clean_stale`] removes one a killed
+/// process left. Created with mode 0666 less the umask, as any file a
 /// program writes, not the 0600 of a private temporary file: the renamed output keeps it.
 ///
 /// # Errors
@@ -439,14 +633,217 @@ pub fn staged_file(
     prefix: &str,
     suffix: &str,
 ) -> std::io::Result<tempfile::NamedTempFile> {
+    let prefix = format!("{prefix}{}-", std::process::id());
     let mut builder = tempfile::Builder::new();
-    builder.prefix(prefix).suffix(suffix);
+    builder.prefix(&prefix).suffix(suffix);
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
         builder.permissions(std::fs::Permissions::from_mode(0o666));
     }
-    builder.tempfile_in(folder)
+    let file = builder.tempfile_in(folder)?;
+    if !register(file.path()) {
+        return Err(std::io::Error::from(std::io::ErrorKind::Interrupted));
+    }
+    Ok(file)
+}
+
+/// Prefix of the lock file beside an output folder (then the folder's name); it holds the pid
+/// of the process writing the folder.
+pub const LOCK_PREFIX: &str = ".gyrofx-lock-";
+
+/// The exclusive right to write one output folder: a lock file beside it, removed when
+/// dropped (or by [`remove_registered`] on a signal). A lock this process holds already is
+/// not taken twice (the second is empty and removes nothing).
+#[derive(Debug)]
+pub struct Lock {
+    path: Option<PathBuf>,
+}
+
+/// Takes the lock of the output folder `out`: creates `.gyrofx-lock-<name>` beside it with this
+/// pid, or takes over one whose process no longer runs. Without a parent folder yet, nothing
+/// else can be writing there: the lock is empty (the staging folder takes it when it creates
+/// the parent).
+///
+/// # Errors
+/// [`Error::Output`] when another process holds it: "another gyrofx (pid N) is writing DIR".
+pub fn lock(out: &Path) -> Result<Lock> {
+    let parent = match out.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    if !parent.is_dir() {
+        return Ok(Lock { path: None });
+    }
+    let name = out
+        .file_name()
+        .map_or_else(|| "out".into(), |n| n.to_string_lossy().into_owned());
+    let path = parent.join(format!("{LOCK_PREFIX}{name}"));
+    let own = std::process::id();
+    let holder = |path: &Path| {
+        std::fs::read_to_string(path)
+            .ok()
+            .and_then(|t| t.trim().parse::<u32>().ok())
+    };
+    if holder(&path) == Some(own) {
+        // Taken already by this process (the command, then its staging folder): that one
+        // stays registered and removes it.
+        return Ok(Lock { path: None });
+    }
+    // The pid is written to a file of its own first and linked into place: a lock file is
+    // never seen empty.
+    let draft = parent.join(format!("{LOCK_PREFIX}{name}.{own}"));
+    let interrupted = || Error::io(out, std::io::Error::from(std::io::ErrorKind::Interrupted));
+    if !register(&draft) {
+        return Err(interrupted());
+    }
+    std::fs::write(&draft, own.to_string()).map_err(|e| Error::io(&draft, e))?;
+    let taken = (|| {
+        for _ in 0..3 {
+            if !register(&path) {
+                return Err(interrupted());
+            }
+            match std::fs::hard_link(&draft, &path) {
+                Ok(()) => {
+                    return Ok(Lock {
+                        path: Some(path.clone()),
+                    })
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {}
+                Err(e) => {
+                    unregister(&path);
+                    return Err(Error::io(&path, e));
+                }
+            }
+            unregister(&path);
+            match holder(&path) {
+                Some(pid) if pid == own => return Ok(Lock { path: None }),
+                Some(pid) if process_runs(pid) => {
+                    return Err(Error::Output {
+                        path: out.to_path_buf(),
+                        message: format!(
+                            "another gyrofx (pid {pid}) is writing {}: wait for it to end, or choose another --out (its lock is {})",
+                            out.display(),
+                            path.display()
+                        ),
+                    })
+                }
+                // Its process is gone (or it is unreadable): a stale lock, taken over.
+                _ => {
+                    let _ = std::fs::remove_file(&path);
+                }
+            }
+        }
+        Err(Error::Output {
+            path: out.to_path_buf(),
+            message: format!("cannot take its lock {}", path.display()),
+        })
+    })();
+    let _ = std::fs::remove_file(&draft);
+    unregister(&draft);
+    taken
+}
+
+/// Whether process `pid` runs (where the platform cannot tell: assumed so).
+fn process_runs(pid: u32) -> bool {
+    let proc_root = Path::new("/proc");
+    !proc_root.join("self").exists() || proc_root.join(pid.to_string()).exists()
+}
+
+impl Drop for Lock {
+    fn drop(&mut self) {
+        if let Some(path) = self.path.take() {
+            let _ = std::fs::remove_file(&path);
+            unregister(&path);
+        }
+    }
+}
+
+/// Checks a package against its `manifest.json` before it is simulated: the marker's record
+/// of the manifest's SHA-256, every listed file present with its size and SHA-256, and each
+/// block's testbench `VECTOR_COUNT` as the manifest gives it. Files the manifest does not list (build outputs, waves) are not checked.
+///
+/// # Errors
+/// [`Error::Simulation`] listing every difference.
+pub fn verify_contents(out: &Path) -> Result<()> {
+    let mut differences = Vec::new();
+    let marker: Option<Marker> = std::fs::read_to_string(out.join(MARKER))
+        .ok()
+        .and_then(|text| serde_json::from_str(&text).ok());
+    match marker.and_then(|m| m.manifest_sha256) {
+        Some(recorded) => {
+            if crate::package::file_sha256(&out.join(MANIFEST)).ok() != Some(recorded) {
+                differences.push(format!("{MANIFEST} changed since gyrofx wrote it"));
+            }
+        }
+        None => differences.push(format!(
+            "{MARKER} records no SHA-256 of {MANIFEST} (a package of an older gyrofx, or not one): regenerate it"
+        )),
+    }
+    let listed = listed_files(out).unwrap_or_default();
+    if listed.is_empty() {
+        differences.push(format!("{MANIFEST} lists no files"));
+    }
+    for (path, (sha256, bytes)) in &listed {
+        if path == MARKER {
+            continue;
+        }
+        let file = out.join(path);
+        match std::fs::metadata(&file) {
+            Err(_) => differences.push(format!("{path} is missing")),
+            Ok(meta) if meta.len() != *bytes => differences.push(format!(
+                "{path} has {} bytes, the manifest {bytes}",
+                meta.len()
+            )),
+            Ok(_) => {
+                if crate::package::file_sha256(&file).ok().as_ref() != Some(sha256) {
+                    differences.push(format!(
+                        "{path} changed (its SHA-256 is not the manifest's)"
+                    ));
+                }
+            }
+        }
+    }
+    differences.extend(vector_count_differences(out));
+    if differences.is_empty() {
+        return Ok(());
+    }
+    Err(Error::Simulation(format!(
+        "{} does not match its {MANIFEST}, so its testbenches would not check what gyrofx generated: {}; regenerate the package (gyrofx generate) or restore its files",
+        out.display(),
+        differences.join("; ")
+    )))
+}
+
+/// Each block whose `<block>/<block>_params.vh` `VECTOR_COUNT` differs from the manifest's
+/// vector count (the testbench checks that many vectors and says `PASS n=<that many>`).
+fn vector_count_differences(out: &Path) -> Vec<String> {
+    let Some(manifest) = std::fs::read_to_string(out.join(MANIFEST))
+        .ok()
+        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
+    else {
+        return vec![format!("{MANIFEST} is not readable JSON")];
+    };
+    let mut differences = Vec::new();
+    for (block, section) in manifest["blocks"].as_object().into_iter().flatten() {
+        let Some(vectors) = section["vectors"].as_u64() else {
+            continue;
+        };
+        let params = format!("{block}/{block}_params.vh");
+        if let Ok(text) = std::fs::read_to_string(out.join(&params)) {
+            let count = text
+                .lines()
+                .filter_map(|l| l.split_once("VECTOR_COUNT ="))
+                .find_map(|(_, v)| v.trim().trim_end_matches(';').trim().parse::<u64>().ok());
+            if count != Some(vectors) {
+                differences.push(format!(
+                    "{params}: VECTOR_COUNT {} but the manifest gives {vectors} vectors",
+                    count.map_or("missing".into(), |c| c.to_string())
+                ));
+            }
+        }
+    }
+    differences
 }
 
 #[cfg(test)]
@@ -481,5 +878,50 @@ mod tests {
         ] {
             assert!(!marker.allows(refused), "{refused}");
         }
+    }
+
+    #[test]
+    fn stale_work_folders_of_ended_processes_are_removed() {
+        let temp = tempfile::tempdir().unwrap();
+        let mut child = std::process::Command::new("true").spawn().unwrap();
+        let gone = child.id();
+        child.wait().unwrap();
+        let own = std::process::id();
+        for name in [
+            format!("{WORK_PREFIX}{gone}-abc"),
+            format!("{WORK_PREFIX}{own}-abc"),
+            format!("{WORK_PREFIX}xyz"),
+        ] {
+            std::fs::create_dir(temp.path().join(name)).unwrap();
+        }
+        clean_stale_work(temp.path());
+        let mut left: Vec<String> = std::fs::read_dir(temp.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        left.sort();
+        assert_eq!(
+            left,
+            [
+                format!("{WORK_PREFIX}{own}-abc"),
+                format!("{WORK_PREFIX}xyz")
+            ]
+        );
+    }
+
+    #[test]
+    fn an_output_holding_an_input_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let config = dir.path().join("c.toml");
+        std::fs::write(&config, "").unwrap();
+        let inputs = [("--config", config.as_path())];
+        let same = refuse_overlap(("--output", &config), &inputs).unwrap_err();
+        assert!(same.contains("is the --config file"), "{same}");
+        let holds = refuse_overlap(("--out", dir.path()), &inputs).unwrap_err();
+        assert!(holds.contains("holds the --config file"), "{holds}");
+        // Through a name that does not exist yet.
+        let other = dir.path().join("new/../c.toml");
+        assert!(refuse_overlap(("--out", &other), &inputs).is_err());
+        assert!(refuse_overlap(("--out", &dir.path().join("out")), &inputs).is_ok());
     }
 }

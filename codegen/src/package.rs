@@ -70,7 +70,8 @@ pub fn file_sha256(path: &Path) -> Result<String> {
 
 impl Package {
     /// A package of `kind` holding only its marker, which lists `build_outputs`: the paths
-    /// the package's own Makefile writes (see [`Marker`]).
+    /// the package's own Makefile writes (see [`Marker`]). Adding the manifest records its
+    /// SHA-256 in the marker.
     pub fn new(kind: Kind, build_outputs: Vec<String>) -> Self {
         Package {
             kind,
@@ -81,10 +82,28 @@ impl Package {
         }
     }
 
-    /// Adds a file at the relative `path`.
+    /// Adds a file at the relative `path`. The manifest ([`MANIFEST`]) also goes into the
+    /// marker, as its SHA-256: then an edit to the manifest is a changed file too.
     pub fn add(&mut self, path: impl Into<PathBuf>, content: impl Into<Vec<u8>>) {
-        self.files
-            .push((path.into(), Content::Data(content.into())));
+        let (path, content) = (path.into(), content.into());
+        if path == Path::new(MANIFEST) {
+            self.record_manifest(&content);
+        }
+        self.files.push((path, Content::Data(content)));
+    }
+
+    /// Rewrites the marker with the manifest's SHA-256.
+    fn record_manifest(&mut self, manifest: &[u8]) {
+        for (path, content) in &mut self.files {
+            if path == Path::new(MARKER) {
+                if let Content::Data(data) = content {
+                    if let Ok(mut marker) = serde_json::from_slice::<Marker>(data) {
+                        marker.manifest_sha256 = Some(sha256_hex(manifest));
+                        *data = marker.text().into_bytes();
+                    }
+                }
+            }
+        }
     }
 
     /// Lists a file already written into the staging folder the package will be written to
@@ -102,7 +121,9 @@ impl Package {
             .collect()
     }
 
-    /// Entries of every file so far, in the order added (hashed on parallel threads).
+    /// Entries of every file so far but the marker, in the order added (hashed on parallel
+    /// threads): the manifest lists these, and the marker, written after it, records the
+    /// manifest's SHA-256 instead.
     pub fn entries(&self) -> Vec<FileEntry> {
         std::thread::scope(|scope| {
             let hashes: Vec<_> = self
@@ -118,6 +139,7 @@ impl Package {
             self.paths()
                 .into_iter()
                 .zip(hashes)
+                .filter(|(path, _)| path != MARKER)
                 .map(|(path, hash)| {
                     let (sha256, bytes) = hash.join().expect("hashing does not panic");
                     FileEntry {
@@ -201,6 +223,11 @@ pub struct Staging {
     kind: Kind,
     replace: Replace,
     committed: bool,
+    /// The output folder's lock, held until the staging folder is committed or removed.
+    lock: Option<output_folder::Lock>,
+    /// The outermost parent folder this staging created (removed again, if empty, when the
+    /// package is not committed).
+    created_parent: Option<PathBuf>,
 }
 
 impl Staging {
@@ -218,15 +245,32 @@ impl Staging {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
         };
+        let created_parent = parent
+            .ancestors()
+            .take_while(|a| !a.as_os_str().is_empty() && !a.exists())
+            .last()
+            .map(Path::to_path_buf);
         std::fs::create_dir_all(&parent)
             .map_err(|e| refuse(format!("cannot create its parent folder: {e}")))?;
+        let lock = match output_folder::lock(out) {
+            Ok(lock) => lock,
+            Err(e) => {
+                remove_created(&parent, created_parent.as_deref());
+                return Err(e);
+            }
+        };
         output_folder::clean_stale(&parent);
-        let path = output_folder::create_staging(&parent).map_err(|e| {
-            refuse(format!(
-                "cannot create a temporary folder in {}: {e}",
-                parent.display()
-            ))
-        })?;
+        let path = match output_folder::create_staging(&parent) {
+            Ok(path) => path,
+            Err(e) => {
+                drop(lock);
+                remove_created(&parent, created_parent.as_deref());
+                return Err(refuse(format!(
+                    "cannot create a temporary folder in {}: {e}",
+                    parent.display()
+                )));
+            }
+        };
         Ok(Staging {
             path,
             out: out.to_path_buf(),
@@ -234,6 +278,8 @@ impl Staging {
             kind,
             replace,
             committed: false,
+            lock: Some(lock),
+            created_parent,
         })
     }
 
@@ -276,6 +322,7 @@ impl Staging {
             message,
         };
         let replaced = if out.exists() {
+            keep_mode_and_owner(out, staged);
             let old = parent.join(format!(
                 "{OLD_PREFIX}{}-{}",
                 std::process::id(),
@@ -313,5 +360,37 @@ impl Drop for Staging {
             let _ = std::fs::remove_dir_all(&self.path);
         }
         output_folder::unregister(&self.path);
+        // The lock file is in the parent: gone before the parent may be removed.
+        drop(self.lock.take());
+        if !self.committed {
+            remove_created(&self.parent, self.created_parent.as_deref());
+        }
+    }
+}
+
+/// Removes `parent` and its ancestors up to `created` (the outermost folder a staging created
+/// for it), those that are empty: a refused package leaves no folders behind.
+fn remove_created(parent: &Path, created: Option<&Path>) {
+    let Some(created) = created else {
+        return;
+    };
+    for folder in parent.ancestors() {
+        if !folder.starts_with(created) || std::fs::remove_dir(folder).is_err() {
+            break;
+        }
+    }
+}
+
+/// Gives the staged folder the permissions (and, where this process may, the owner and group)
+/// of the folder it replaces: an existing `--out` (a private 0700 folder) keeps them.
+fn keep_mode_and_owner(out: &Path, staged: &Path) {
+    let Ok(meta) = std::fs::metadata(out) else {
+        return;
+    };
+    let _ = std::fs::set_permissions(staged, meta.permissions());
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        let _ = std::os::unix::fs::chown(staged, Some(meta.uid()), Some(meta.gid()));
     }
 }

@@ -172,7 +172,7 @@ pub fn check_tools(targets: &[Target]) -> Result<()> {
     let Some(ice40) = targets.iter().find(|t| **t != Target::Xilinx) else {
         return Ok(());
     };
-    match Command::new("nextpnr-ice40").arg("--version").output() {
+    match crate::processes::output(Command::new("nextpnr-ice40").arg("--version")) {
         Ok(output) if output.status.success() => Ok(()),
         _ => Err(Error::Synthesis(format!(
             "--target {} needs nextpnr-ice40, which does not run here (install the Debian package nextpnr-ice40)",
@@ -498,10 +498,7 @@ fn sum(cells: &[(String, u64)], keep: impl Fn(&str) -> bool) -> u64 {
 
 /// Runs `program` with `args` in `dir`; `Ok(None)` when it succeeded, else what it printed.
 fn run_tool(dir: &Path, program: &str, args: &[String]) -> Result<Option<String>> {
-    let output = Command::new(program)
-        .args(args)
-        .current_dir(dir)
-        .output()
+    let output = crate::processes::output(Command::new(program).args(args).current_dir(dir))
         .map_err(|e| Error::Synthesis(format!("cannot run {program} (is it installed?): {e}")))?;
     Ok((!output.status.success()).then(|| {
         format!(
@@ -527,19 +524,20 @@ enum Routed {
 
 /// Runs nextpnr in `dir` for at most [`NEXTPNR_LIMIT`].
 fn run_nextpnr(dir: &Path, args: &[String]) -> Result<Routed> {
-    let mut child = Command::new("nextpnr-ice40")
-        .args(args)
-        .current_dir(dir)
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .map_err(|e| {
-            Error::Synthesis(format!("cannot run nextpnr-ice40 (is it installed?): {e}"))
-        })?;
+    let mut child = crate::processes::spawn(
+        Command::new("nextpnr-ice40")
+            .args(args)
+            .current_dir(dir)
+            .stdin(std::process::Stdio::null())
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped()),
+    )
+    .map_err(|e| Error::Synthesis(format!("cannot run nextpnr-ice40 (is it installed?): {e}")))?;
     let start = std::time::Instant::now();
     loop {
         match child.try_wait() {
             Ok(Some(status)) => {
+                crate::processes::forget(&child);
                 let mut printed = String::new();
                 if let Some(mut stderr) = child.stderr.take() {
                     let _ = std::io::Read::read_to_string(&mut stderr, &mut printed);
@@ -549,10 +547,14 @@ fn run_nextpnr(dir: &Path, args: &[String]) -> Result<Routed> {
             Ok(None) if start.elapsed() >= NEXTPNR_LIMIT => {
                 let _ = child.kill();
                 let _ = child.wait();
+                crate::processes::forget(&child);
                 return Ok(Routed::OutOfTime);
             }
             Ok(None) => std::thread::sleep(std::time::Duration::from_millis(200)),
-            Err(e) => return Err(Error::Synthesis(format!("waiting for nextpnr-ice40: {e}"))),
+            Err(e) => {
+                crate::processes::forget(&child);
+                return Err(Error::Synthesis(format!("waiting for nextpnr-ice40: {e}")));
+            }
         }
     }
 }

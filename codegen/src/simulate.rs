@@ -252,23 +252,27 @@ pub fn run_reporting(
         Some(folder) => Some(Netlists::read(folder, out, simulator)?),
         None => None,
     };
+    // The simulators' temporary files (iverilog's) go into a work folder of gyrofx's own: a
+    // signal that ends them mid-run leaves none in the system's temporary folder.
+    let temp = crate::output_folder::WorkFolder::new()
+        .map_err(|e| Error::Simulation(format!("cannot create a temporary folder: {e}")))?;
     let mut blocks = Vec::with_capacity(names.len());
     for block in names {
         let start = Instant::now();
         let mut make = Command::new("make");
+        make.env("TMPDIR", temp.path());
         if let Some(netlists) = &netlists {
             make.args(netlists.make_variables(&block, simulator));
         }
-        let output = make
-            .arg("--no-print-directory")
+        make.arg("--no-print-directory")
             .arg("-C")
             .arg(out)
             .arg(format!("{}-{block}", simulator.name()))
             .arg(format!("MASK={}", options.mask))
             .arg(format!("MAX_REPORTED={}", options.max_reported))
             .arg(format!("MAX_MISMATCHES={}", options.max_mismatches))
-            .arg(format!("WAVES={}", u8::from(options.waves)))
-            .output()
+            .arg(format!("WAVES={}", u8::from(options.waves)));
+        let output = crate::processes::output(&mut make)
             .map_err(|e| Error::Simulation(format!("cannot run make: {e}")))?;
         let seconds = start.elapsed().as_secs_f64();
         let mut log = String::from_utf8_lossy(&output.stdout).into_owned();

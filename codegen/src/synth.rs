@@ -316,11 +316,12 @@ fn count(by_type: &[(String, u64)], keep: impl Fn(&str) -> bool) -> u64 {
 }
 
 fn yosys(dir: &Path, script: &str, log: &str) -> Result<()> {
-    let output = Command::new("yosys")
-        .args(["-q", "-l", log, "-s", script])
-        .current_dir(dir)
-        .output()
-        .map_err(|e| Error::Synthesis(format!("cannot run yosys (is it installed?): {e}")))?;
+    let output = crate::processes::output(
+        Command::new("yosys")
+            .args(["-q", "-l", log, "-s", script])
+            .current_dir(dir),
+    )
+    .map_err(|e| Error::Synthesis(format!("cannot run yosys (is it installed?): {e}")))?;
     if !output.status.success() {
         let text = std::fs::read_to_string(dir.join(log)).unwrap_or_default();
         let tail: Vec<&str> = text.lines().rev().take(20).collect();
@@ -697,9 +698,7 @@ fn yosys_version() -> String {
     static VERSION: std::sync::OnceLock<String> = std::sync::OnceLock::new();
     VERSION
         .get_or_init(|| {
-            Command::new("yosys")
-                .arg("-V")
-                .output()
+            crate::processes::output(Command::new("yosys").arg("-V"))
                 .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
                 .unwrap_or_default()
         })

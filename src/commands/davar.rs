@@ -75,6 +75,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
     let rate = rate.hz()?;
     if let Some(path) = &plot {
         super::options::check_plot(path)?;
+        super::options::check_output("--plot", path, false, &[("--input", Some(&csv.input))])?;
     }
     for (name, gain) in [("--kp", kp), ("--ki", ki), ("--kd", kd)] {
         if let Some(g) = gain.filter(|g| !g.is_finite()) {

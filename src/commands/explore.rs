@@ -128,16 +128,23 @@ pub fn run(args: Args) -> Result<ExitCode> {
         Err(PlanError::Config(e)) => return Err(e.into()),
     };
     let out = args.out.out.as_path();
+    super::options::check_output(
+        "--out",
+        out,
+        true,
+        &[
+            ("--config", args.source.config.as_deref()),
+            ("--cache", Some(cache.as_path())),
+        ],
+    )?;
+    // Held to the end: a second run into the same folder fails now, not after its sweep.
+    let _lock = gyrofx_codegen::output_folder::lock(out)?;
     gyrofx_codegen::output_folder::check(
         out,
         gyrofx_codegen::output_folder::Kind::Explore,
         args.out.replace(),
     )?;
-    if std::process::Command::new("yosys")
-        .arg("-V")
-        .output()
-        .is_err()
-    {
+    if gyrofx_codegen::processes::output(std::process::Command::new("yosys").arg("-V")).is_err() {
         anyhow::bail!("gyrofx explore synthesizes every candidate with yosys, which is not installed (or not on PATH)");
     }
     let costs = Costs::open(&cache).with_context(|| format!("--cache {}", cache.display()))?;

@@ -17,7 +17,7 @@ use gyrofx_codegen::writers::Provenance;
 use gyrofx_model::fx::{from_f64, Overflow, Rounding};
 use gyrofx_model::kf::{FixedKf, FloatKf};
 
-use super::options::{number, CsvColumn};
+use super::options::{check_output, number, CsvColumn};
 use super::usage;
 
 /// Run recorded rate data (°/s) through the bit-accurate KF and its float model.
@@ -157,19 +157,22 @@ pub fn run(args: Args) -> Result<ExitCode> {
     } = args;
     check_rates(fs, bandwidth)?;
     let output = output.as_path();
-    if let (Ok(input), Ok(existing)) = (csv.input.canonicalize(), output.canonicalize()) {
-        if input == existing {
-            usage!(
-                "--output {} is the --input file: the filtered CSV would replace the record; choose another file",
-                output.display()
-            );
-        }
+    let inputs = [
+        ("--input", Some(csv.input.as_path())),
+        ("--config", config.as_deref()),
+    ];
+    check_output("--output", output, false, &inputs)?;
+    if let Some(folder) = &vectors {
+        let mut inputs = inputs.to_vec();
+        inputs.push(("--output", Some(output)));
+        check_output("--vectors", folder, true, &inputs)?;
     }
     // The output's folder is checked before the work: the file is staged there first.
     let folder = match output.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
+    output_folder::clean_stale(folder);
     let mut staged =
         output_folder::staged_file(folder, ".gyrofx-filter-", ".csv").map_err(|e| {
             // The OS's reason, without the temporary file's name that tempfile adds.
@@ -301,9 +304,8 @@ pub fn run(args: Args) -> Result<ExitCode> {
         }
         eprintln!("warning: {counts} (--strict makes this an error)");
     }
-    staged
-        .persist(output)
-        .with_context(|| format!("output {}: cannot move into place", output.display()))?;
+    // The vectors first: when they fail, the staged CSV is removed as it drops, and neither
+    // output is left.
     if let (Some((job, provenance, package)), Some(folder)) = (kf_vectors, &vectors) {
         let recording = serde_json::json!({
             "input": csv.input.display().to_string(),
@@ -322,6 +324,9 @@ pub fn run(args: Args) -> Result<ExitCode> {
             folder.display()
         );
     }
+    staged
+        .persist(output)
+        .with_context(|| format!("output {}: cannot move into place", output.display()))?;
     println!(
         "filtered {} samples at {} Hz, bandwidth {} Hz -> {}; ADC saturations {}, overflows x1 {} x2 {} rate_hat {}",
         values.len(),

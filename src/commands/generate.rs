@@ -91,6 +91,17 @@ pub fn run(args: Args) -> Result<ExitCode> {
     };
     contents.check().map_err(super::Usage)?;
     let out = folder.out.as_path();
+    super::options::check_output(
+        "--out",
+        out,
+        true,
+        &[
+            ("--config", source.config.as_deref()),
+            ("--recording", recording.as_deref()),
+        ],
+    )?;
+    // Held to the end: a second run into the same folder fails now, not after its run.
+    let _lock = gyrofx_codegen::output_folder::lock(out)?;
     let mut config = source.load()?;
     let recording = match recording {
         Some(path) => {

@@ -90,6 +90,28 @@ impl OutputFolder {
     }
 }
 
+/// Refuses (a usage error) an output that would destroy one of the command's inputs (it is
+/// one, or as a folder holds one) and, for a `folder`, one that may never be an output folder
+/// (a filesystem root, the home folder, the current folder or an ancestor): before any work.
+pub fn check_output(
+    flag: &str,
+    out: &std::path::Path,
+    folder: bool,
+    inputs: &[(&str, Option<&std::path::Path>)],
+) -> Result<()> {
+    if folder {
+        if let Some(reason) = gyrofx_codegen::output_folder::unsafe_folder(out) {
+            usage!("{flag} {} {reason}", out.display());
+        }
+    }
+    let inputs: Vec<(&str, &std::path::Path)> = inputs
+        .iter()
+        .filter_map(|(f, p)| p.map(|p| (*f, p)))
+        .collect();
+    gyrofx_codegen::output_folder::refuse_overlap((flag, out), &inputs)
+        .map_err(|message| super::Usage(message).into())
+}
+
 /// [`Replace::Force`] when `--force` was given.
 pub fn replace(force: bool) -> Replace {
     if force {

@@ -48,7 +48,7 @@ pub struct Args {
     netlist: Option<PathBuf>,
 }
 
-/// Runs every block's testbench in each simulator, prints the mismatches and a verdict per
+/// Checks the package against its manifest, then runs every block's testbench in each simulator, prints the mismatches and a verdict per
 /// simulator, and writes the JUnit summary if asked.
 pub fn run(args: Args) -> Result<ExitCode> {
     let Args {
@@ -87,6 +87,9 @@ pub fn run(args: Args) -> Result<ExitCode> {
     for simulator in &simulators {
         total += simulate::block_names(&out, *simulator, &options)?.len() as u64;
     }
+    // What the testbenches check is what the manifest lists: an edited testbench, vector
+    // count or manifest is refused before anything runs.
+    gyrofx_codegen::output_folder::verify_contents(&out)?;
     let bar = super::progress::bar(total, "verify", quiet);
     let mut outcomes = Vec::with_capacity(simulators.len());
     for simulator in simulators {

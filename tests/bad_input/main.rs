@@ -4,6 +4,7 @@
 #[path = "../common/mod.rs"]
 mod cli;
 mod common;
+mod files;
 mod readers;
 mod saturation;
 

@@ -115,7 +115,36 @@ pub fn flip_expected_bit(package: &Path, block: &str, sample: usize) -> String {
     let flipped = u64::from_str_radix(&last, 16).unwrap() ^ 1;
     *line = format!("{head}{flipped:0width$x}", width = last.len());
     std::fs::write(&path, lines.join("\n") + "\n").unwrap();
+    reseal(package);
     signal
+}
+
+/// Makes a package's manifest (and the marker's record of the manifest's SHA-256) describe its
+/// files as they are now: after a test changed or removed a file on purpose, `gyrofx verify`
+/// (which refuses a package that differs from its manifest) runs the testbenches on it, to see
+/// what they make of the change.
+pub fn reseal(package: &Path) {
+    let manifest_path = package.join("manifest.json");
+    let mut manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&manifest_path).unwrap()).unwrap();
+    let files = manifest["files"].as_array_mut().unwrap();
+    files.retain(|f| package.join(f["path"].as_str().unwrap()).is_file());
+    for entry in files.iter_mut() {
+        let data = std::fs::read(package.join(entry["path"].as_str().unwrap())).unwrap();
+        entry["sha256"] = hex_sha256(&data).into();
+        entry["bytes"] = data.len().into();
+    }
+    let text = serde_json::to_string_pretty(&manifest).unwrap() + "\n";
+    std::fs::write(&manifest_path, &text).unwrap();
+    let marker_path = package.join(".gyrofx-package");
+    let mut marker: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&marker_path).unwrap()).unwrap();
+    marker["manifest_sha256"] = hex_sha256(text.as_bytes()).into();
+    std::fs::write(
+        &marker_path,
+        serde_json::to_string_pretty(&marker).unwrap() + "\n",
+    )
+    .unwrap();
 }
 
 /// Like [`flip_expected_bit`], at the first sample from `from` where the last output is
