@@ -1,8 +1,8 @@
 //! Bad input: a clear error naming the field, the value and what is allowed, a non-zero exit,
 //! and no output left behind.
 
-#[path = "../common/mod.rs"]
 mod cli;
+#[path = "../common/mod.rs"]
 mod common;
 mod files;
 mod readers;
