@@ -250,9 +250,16 @@ fn the_manifest_lists_every_file_with_its_sha256() {
     let listed = manifest["files"].as_array().unwrap();
     let on_disk = files_below(root);
     assert_eq!(
-        listed.len() + 1,
+        listed.len() + 2,
         on_disk.len(),
-        "every file but the manifest itself"
+        "every file but the manifest itself and the marker, which holds the manifest's hash"
+    );
+    let marker: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(root.join(".gyrofx-package")).unwrap())
+            .unwrap();
+    assert_eq!(
+        marker["manifest_sha256"].as_str().unwrap(),
+        hex_sha256(&std::fs::read(root.join("manifest.json")).unwrap())
     );
     for entry in listed {
         let path = entry["path"].as_str().unwrap();
@@ -502,6 +509,7 @@ fn truncating_instead_of_rounding_in_the_rtl_fails_the_chain_testbench() {
         let truncating = source.replace(rounding, truncation);
         assert_ne!(source, truncating, "the mutation must apply to {file}");
         std::fs::write(&quantizer, truncating).unwrap();
+        reseal(std::path::Path::new(&out));
         let log = fails(&["verify", "--out", &out, "--sim", sim, "--blocks", "top"]);
         let top = log
             .split("== top")
