@@ -468,7 +468,10 @@ fn ar_fits_the_orders_and_names_the_aic_choice() {
         "--max-order",
         "0",
     ]);
-    assert!(log.contains("'0' for '--max-order") && log.contains("1..=1000"), "{log}");
+    assert!(
+        log.contains("'0' for '--max-order") && log.contains("1..=1000"),
+        "{log}"
+    );
     let short = ar1_csv(dir.path(), 4);
     let log = fails(&["ar", "--input", &short, "--column", "drift"]);
     assert!(log.contains("4 samples are too few for AR(3)"), "{log}");
