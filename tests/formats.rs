@@ -431,7 +431,7 @@ fn bad_input_is_refused_naming_what_is_allowed_and_writes_nothing() {
             1,
             "missing.toml",
         ),
-        (vec!["--preset", "nope"], 1, "one of gu2019"),
+        (vec!["--preset", "nope"], 2, "one of gu2019"),
     ] {
         let mut full = vec!["formats"];
         if args[0] != "--write" {

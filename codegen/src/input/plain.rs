@@ -191,14 +191,16 @@ fn parse_part(
 /// The wanted cell's value when `line` has the header's cell count and the cell is a plain
 /// decimal the fast path reads exactly; `None` for anything else.
 fn plain_value(line: &[u8], layout: Layout) -> Option<f64> {
-    if memchr::memchr_iter(b',', line).count() != layout.commas {
-        return None;
-    }
+    // One pass over the commas: up to the wanted cell, then counting the rest.
+    let mut commas = memchr::memchr_iter(b',', line);
     let cell = if layout.index == 0 {
         0
     } else {
-        memchr::memchr_iter(b',', line).nth(layout.index - 1)? + 1
+        commas.nth(layout.index - 1)? + 1
     };
+    if layout.index + commas.count() != layout.commas {
+        return None;
+    }
     let (value, used) = decimal::parse_prefix(&line[cell..])?;
     matches!(line.get(cell + used), None | Some(b',')).then_some(value)
 }
