@@ -501,60 +501,68 @@ fn create_registered_folder(parent: &Path, prefix: &str) -> std::io::Result<Path
 }
 
 /// Removes what runs killed before they could clean up left in `parent`: staging and
-/// set-aside folders and temporary files (`.gyrofx-<what>-<pid>-…`) whose process no longer
-/// runs (where the platform tells, `/proc/<pid>`), else those older than a day. Errors are
-/// ignored: this is housekeeping.
+/// set-aside folders (`.gyrofx-staging-<pid>-…`, `.gyrofx-old-<pid>-…`) and staged files
+/// (`.gyrofx-<what>-<pid>-…`, [`staged_file`]) whose process no longer runs (where the platform
+/// tells, `/proc/<pid>`). A folder without /proc to ask is removed once older than a day; a
+/// file only by its pid, so that no file gyrofx did not name is ever taken for one of its own.
+/// Errors are ignored: this is housekeeping.
 pub fn clean_stale(parent: &Path) {
     let Ok(entries) = std::fs::read_dir(parent) else {
         return;
     };
     for entry in entries.flatten() {
         let name = entry.file_name().to_string_lossy().into_owned();
-        let Some(rest) = name.strip_prefix(".gyrofx-") else {
-            continue;
-        };
-        let Some((what, tail)) = rest.split_once('-') else {
-            continue;
-        };
-        if what == "lock" {
-            continue;
-        }
         let Ok(kind) = entry.file_type() else {
             continue;
         };
-        // The folders are staging and set-aside ones; every other prefix names a file.
-        let folder = format!(".gyrofx-{what}-") == STAGING_PREFIX
-            || format!(".gyrofx-{what}-") == OLD_PREFIX;
-        if kind.is_dir() != folder || kind.is_symlink() {
+        if kind.is_symlink() {
             continue;
         }
-        if is_stale(&entry, tail) {
-            let _ = if folder {
-                std::fs::remove_dir_all(entry.path())
-            } else {
-                std::fs::remove_file(entry.path())
-            };
+        let folder = [STAGING_PREFIX, OLD_PREFIX]
+            .iter()
+            .find_map(|prefix| name.strip_prefix(prefix));
+        if let Some(tail) = folder {
+            if kind.is_dir() && is_stale(&entry, tail, true) {
+                let _ = std::fs::remove_dir_all(entry.path());
+            }
+            continue;
+        }
+        // A staged file: `.gyrofx-<what>-<pid>-…` (lock files are the locks' own business).
+        let Some((what, tail)) = name
+            .strip_prefix(".gyrofx-")
+            .and_then(|rest| rest.split_once('-'))
+        else {
+            continue;
+        };
+        if what != "lock" && kind.is_file() && is_stale(&entry, tail, false) {
+            let _ = std::fs::remove_file(entry.path());
         }
     }
 }
 
-/// Whether the entry named `…<pid>-<tail>` belongs to a process that ended: `/proc/<pid>` is
-/// gone, or (without /proc, or without a pid) it is older than a day.
-fn is_stale(entry: &std::fs::DirEntry, pid_and_rest: &str) -> bool {
+/// Whether the entry named `…<pid>-<tail>` belongs to a process that ended. Without a pid in
+/// the name, or without /proc to ask, only an `aged` entry older than a day is.
+fn is_stale(entry: &std::fs::DirEntry, pid_and_rest: &str, aged: bool) -> bool {
     let pid = pid_and_rest
         .split_once('-')
         .and_then(|(pid, _)| pid.parse::<u32>().ok());
-    let proc_root = Path::new("/proc");
     match pid {
         Some(pid) if pid == std::process::id() => false,
-        Some(pid) if proc_root.join("self").exists() => !proc_root.join(pid.to_string()).exists(),
-        _ => entry
-            .metadata()
-            .and_then(|m| m.modified())
-            .ok()
-            .and_then(|t| t.elapsed().ok())
-            .is_some_and(|age| age.as_secs() > 24 * 3600),
+        Some(pid) if proc_tells() => !process_runs(pid),
+        _ => {
+            aged && entry
+                .metadata()
+                .and_then(|m| m.modified())
+                .ok()
+                .and_then(|t| t.elapsed().ok())
+                .is_some_and(|age| age.as_secs() > 24 * 3600)
+        }
     }
+}
+
+/// Whether this platform tells which processes run (`/proc/self`).
+fn proc_tells() -> bool {
+    Path::new("/proc/self").exists()
 }
 
 /// Prefix of the work folders in the system's temporary folder (then the pid and a random
@@ -576,7 +584,7 @@ pub fn clean_stale_work(temp: &Path) {
         let has_pid = tail
             .split_once('-')
             .is_some_and(|(pid, _)| pid.parse::<u32>().is_ok());
-        if has_pid && entry.file_type().is_ok_and(|t| t.is_dir()) && is_stale(&entry, tail) {
+        if has_pid && entry.file_type().is_ok_and(|t| t.is_dir()) && is_stale(&entry, tail, false) {
             let _ = std::fs::remove_dir_all(entry.path());
         }
     }
@@ -620,11 +628,12 @@ impl Drop for WorkFolder {
     }
 }
 
-/// A temporary file in `folder` (`<prefix><pid>-…<suffix>`) for a single output file that is
-/// renamed into place when complete, registered for removal on a signal (once renamed, its
-/// temporary name no longer exists); the next run's [`clean_stale`] removes one a killed
-/// process left. Created with mode 0666 less the umask, as any file a
-/// program writes, not the 0600 of a private temporary file: the renamed output keeps it.
+/// A temporary file in `folder` (`<prefix><pid>-…<suffix>`, `prefix` being `.gyrofx-<what>-`)
+/// for a single output file that is renamed into place when complete, registered for removal
+/// on a signal (once renamed, its temporary name no longer exists). Those a killed process left
+/// in `folder` are removed first ([`clean_stale`]). Created with mode 0666 less the umask, as
+/// any file a program writes, not the 0600 of a private temporary file: the renamed output
+/// keeps it.
 ///
 /// # Errors
 /// The error of creating it.
@@ -633,6 +642,9 @@ pub fn staged_file(
     prefix: &str,
     suffix: &str,
 ) -> std::io::Result<tempfile::NamedTempFile> {
+    // What killed runs left here goes first: every staged file's folder is cleaned, not only
+    // the folders of the commands that remember to.
+    clean_stale(folder);
     let prefix = format!("{prefix}{}-", std::process::id());
     let mut builder = tempfile::Builder::new();
     builder.prefix(&prefix).suffix(suffix);
@@ -746,8 +758,7 @@ pub fn lock(out: &Path) -> Result<Lock> {
 
 /// Whether process `pid` runs (where the platform cannot tell: assumed so).
 fn process_runs(pid: u32) -> bool {
-    let proc_root = Path::new("/proc");
-    !proc_root.join("self").exists() || proc_root.join(pid.to_string()).exists()
+    !proc_tells() || Path::new("/proc").join(pid.to_string()).exists()
 }
 
 impl Drop for Lock {
@@ -907,6 +918,49 @@ mod tests {
                 format!("{WORK_PREFIX}xyz")
             ]
         );
+    }
+
+    /// Staged files of ended processes go, whichever command staged them; a file gyrofx did
+    /// not name (no pid where its own names have one) stays, however old.
+    #[test]
+    fn stale_staged_files_are_removed_and_nothing_else() {
+        let folder = tempfile::tempdir().unwrap();
+        let mut child = std::process::Command::new("true").spawn().unwrap();
+        let gone = child.id();
+        child.wait().unwrap();
+        let own = std::process::id();
+        let week_ago = std::time::SystemTime::now() - std::time::Duration::from_secs(7 * 86400);
+        for name in [
+            format!(".gyrofx-plot-{gone}-x1.png"),
+            format!(".gyrofx-plot-{own}-x2.png"),
+            ".gyrofx-my-notes.txt".to_string(),
+            ".gyrofx-notes".to_string(),
+            format!("{LOCK_PREFIX}out"),
+        ] {
+            let file = std::fs::File::create(folder.path().join(name)).unwrap();
+            file.set_modified(week_ago).unwrap();
+        }
+        let staged = staged_file(folder.path(), ".gyrofx-formats-", ".toml").unwrap();
+        let mut left: Vec<String> = std::fs::read_dir(folder.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        left.sort();
+        let staged_name = staged
+            .path()
+            .file_name()
+            .unwrap()
+            .to_string_lossy()
+            .into_owned();
+        let mut want = vec![
+            format!(".gyrofx-plot-{own}-x2.png"),
+            ".gyrofx-my-notes.txt".to_string(),
+            ".gyrofx-notes".to_string(),
+            format!("{LOCK_PREFIX}out"),
+            staged_name,
+        ];
+        want.sort();
+        assert_eq!(left, want);
     }
 
     #[test]

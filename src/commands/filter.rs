@@ -172,7 +172,6 @@ pub fn run(args: Args) -> Result<ExitCode> {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
-    output_folder::clean_stale(folder);
     let mut staged =
         output_folder::staged_file(folder, ".gyrofx-filter-", ".csv").map_err(|e| {
             // The OS's reason, without the temporary file's name that tempfile adds.
