@@ -184,12 +184,15 @@ pub fn check(out: &Path, kind: Kind, replace: Replace) -> Result<()> {
             )))
         }
     }
-    let listed = listed_files(out).ok_or_else(|| {
-        refuse(format!(
-            "holds a gyrofx marker but no readable {MANIFEST} with its file list, so what \
+    let listed = read_manifest(out)
+        .as_ref()
+        .and_then(listed_files)
+        .ok_or_else(|| {
+            refuse(format!(
+                "holds a gyrofx marker but no readable {MANIFEST} with its file list, so what \
              it holds cannot be checked; {force}"
-        ))
-    })?;
+            ))
+        })?;
     let Some(manifest_sha256) = &marker.manifest_sha256 else {
         return Err(refuse(format!(
             "holds a package of an older gyrofx whose marker does not record the SHA-256 of \
@@ -241,11 +244,15 @@ pub fn check(out: &Path, kind: Kind, replace: Replace) -> Result<()> {
     )))
 }
 
-/// The files a package's `manifest.json` lists: relative path to (SHA-256 hex, bytes); `None`
-/// when it cannot be read or lists none.
-fn listed_files(out: &Path) -> Option<BTreeMap<String, (String, u64)>> {
+/// The package's `manifest.json`, parsed; `None` when it cannot be read or is not JSON.
+fn read_manifest(out: &Path) -> Option<serde_json::Value> {
     let text = std::fs::read_to_string(out.join(MANIFEST)).ok()?;
-    let manifest = serde_json::from_str::<serde_json::Value>(&text).ok()?;
+    serde_json::from_str(&text).ok()
+}
+
+/// The files `manifest` lists: relative path to (SHA-256 hex, bytes); `None` when it lists
+/// none.
+fn listed_files(manifest: &serde_json::Value) -> Option<BTreeMap<String, (String, u64)>> {
     let files = manifest["files"].as_array()?;
     Some(
         files
@@ -772,7 +779,8 @@ impl Drop for Lock {
 
 /// Checks a package against its `manifest.json` before it is simulated: the marker's record
 /// of the manifest's SHA-256, every listed file present with its size and SHA-256, and each
-/// block's testbench `VECTOR_COUNT` as the manifest gives it. Files the manifest does not list (build outputs, waves) are not checked.
+/// block's testbench `VECTOR_COUNT` as the manifest gives it. Files the manifest does not
+/// list (build outputs, waves) are not checked.
 ///
 /// # Errors
 /// [`Error::Simulation`] listing every difference.
@@ -791,7 +799,14 @@ pub fn verify_contents(out: &Path) -> Result<()> {
             "{MARKER} records no SHA-256 of {MANIFEST} (a package of an older gyrofx, or not one): regenerate it"
         )),
     }
-    let listed = listed_files(out).unwrap_or_default();
+    let Some(manifest) = read_manifest(out) else {
+        return Err(Error::Simulation(format!(
+            "{}: no readable {MANIFEST}, so what its testbenches check cannot be told; \
+             regenerate the package (gyrofx generate)",
+            out.display()
+        )));
+    };
+    let listed = listed_files(&manifest).unwrap_or_default();
     if listed.is_empty() {
         differences.push(format!("{MANIFEST} lists no files"));
     }
@@ -815,7 +830,7 @@ pub fn verify_contents(out: &Path) -> Result<()> {
             }
         }
     }
-    differences.extend(vector_count_differences(out));
+    differences.extend(vector_count_differences(out, &manifest));
     if differences.is_empty() {
         return Ok(());
     }
@@ -828,13 +843,7 @@ pub fn verify_contents(out: &Path) -> Result<()> {
 
 /// Each block whose `<block>/<block>_params.vh` `VECTOR_COUNT` differs from the manifest's
 /// vector count (the testbench checks that many vectors and says `PASS n=<that many>`).
-fn vector_count_differences(out: &Path) -> Vec<String> {
-    let Some(manifest) = std::fs::read_to_string(out.join(MANIFEST))
-        .ok()
-        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
-    else {
-        return vec![format!("{MANIFEST} is not readable JSON")];
-    };
+fn vector_count_differences(out: &Path, manifest: &serde_json::Value) -> Vec<String> {
     let mut differences = Vec::new();
     for (block, section) in manifest["blocks"].as_object().into_iter().flatten() {
         let Some(vectors) = section["vectors"].as_u64() else {

@@ -48,8 +48,9 @@ pub struct Args {
     netlist: Option<PathBuf>,
 }
 
-/// Checks the package against its manifest, then runs every block's testbench in each simulator, prints the mismatches and a verdict per
-/// simulator, and writes the JUnit summary if asked.
+/// Checks the package against its manifest, then runs every block's testbench in each
+/// simulator, prints the mismatches and a verdict per simulator, and writes the JUnit summary
+/// if asked.
 pub fn run(args: Args) -> Result<ExitCode> {
     let Args {
         out,
