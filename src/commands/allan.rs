@@ -60,12 +60,11 @@ pub fn run(args: Args) -> Result<ExitCode> {
     } = args;
     let rate = rate.hz()?;
     if let Some(path) = &plot {
-        super::options::check_plot(path)?;
         let inputs: Vec<(&str, Option<&std::path::Path>)> = inputs
             .iter()
             .map(|p| ("--input", Some(p.as_path())))
             .collect();
-        super::options::check_output("--plot", path, false, &inputs)?;
+        super::options::check_plot(path, &inputs)?;
     }
     let grid: allan::Grid = taus
         .parse()

@@ -74,8 +74,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
     } = args;
     let rate = rate.hz()?;
     if let Some(path) = &plot {
-        super::options::check_plot(path)?;
-        super::options::check_output("--plot", path, false, &[("--input", Some(&csv.input))])?;
+        super::options::check_plot(path, &[("--input", Some(&csv.input))])?;
     }
     for (name, gain) in [("--kp", kp), ("--ki", ki), ("--kd", kd)] {
         if let Some(g) = gain.filter(|g| !g.is_finite()) {

@@ -82,13 +82,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
         );
     }
     if let Some(path) = &args.plot {
-        super::options::check_plot(path)?;
-        super::options::check_output(
-            "--plot",
-            path,
-            false,
-            &[("--config", args.source.config.as_deref())],
-        )?;
+        super::options::check_plot(path, &[("--config", args.source.config.as_deref())])?;
     }
     let config = args.source.load()?;
     let loops = config.gyro_loops()?;
