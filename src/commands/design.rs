@@ -66,13 +66,7 @@ fn check_values(
             usage!("{flag} {} is not allowed: a finite number > 0", number(v));
         }
     }
-    if let Some(bw) = bandwidth.filter(|bw| !(bw.is_finite() && *bw > 0.0 && *bw < fs / 2.0)) {
-        usage!(
-            "--bandwidth {} is not allowed: a number of Hz in (0, fs/2 = {})",
-            number(bw),
-            number(fs / 2.0)
-        );
-    }
+    super::options::check_bandwidth(bandwidth, fs)?;
     if !(2..=MAX_COEFFICIENT_WIDTH).contains(&coefficient_width) {
         usage!(
             "--coefficient-width {coefficient_width} is not allowed: 2..={MAX_COEFFICIENT_WIDTH} bits (a sign bit and at least one more)"

@@ -112,13 +112,7 @@ fn check_rates(fs: f64, bandwidth: Option<f64>) -> Result<()> {
             number(fs)
         );
     }
-    if let Some(bw) = bandwidth.filter(|bw| !(bw.is_finite() && *bw > 0.0 && *bw < fs / 2.0)) {
-        usage!(
-            "--bandwidth {} is not allowed: a number of Hz in (0, fs/2 = {})",
-            number(bw),
-            number(fs / 2.0)
-        );
-    }
+    super::options::check_bandwidth(bandwidth, fs)?;
     Ok(())
 }
 

@@ -274,6 +274,18 @@ pub fn check_rate(flag: &str, rate: f64) -> Result<f64> {
     Ok(rate)
 }
 
+/// Refuses (a usage error) a `--bandwidth` that is not a number of Hz in (0, fs/2).
+pub fn check_bandwidth(bandwidth: Option<f64>, fs: f64) -> Result<()> {
+    if let Some(bw) = bandwidth.filter(|bw| !(bw.is_finite() && *bw > 0.0 && *bw < fs / 2.0)) {
+        usage!(
+            "--bandwidth {} is not allowed: a number of Hz in (0, fs/2 = {})",
+            number(bw),
+            number(fs / 2.0)
+        );
+    }
+    Ok(())
+}
+
 /// `value` as a message shows it: as written for ordinary magnitudes, in exponent form (`1e308`,
 /// not 309 digits) for very large or small ones.
 pub fn number(value: f64) -> String {
