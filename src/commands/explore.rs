@@ -128,17 +128,13 @@ pub fn run(args: Args) -> Result<ExitCode> {
         Err(PlanError::Config(e)) => return Err(e.into()),
     };
     let out = args.out.out.as_path();
-    super::options::check_output(
-        "--out",
+    let _lock = super::options::claim_output_folder(
         out,
-        true,
         &[
             ("--config", args.source.config.as_deref()),
             ("--cache", Some(cache.as_path())),
         ],
     )?;
-    // Held to the end: a second run into the same folder fails now, not after its sweep.
-    let _lock = gyrofx_codegen::output_folder::lock(out)?;
     gyrofx_codegen::output_folder::check(
         out,
         gyrofx_codegen::output_folder::Kind::Explore,

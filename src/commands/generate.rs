@@ -91,17 +91,13 @@ pub fn run(args: Args) -> Result<ExitCode> {
     };
     contents.check().map_err(super::Usage)?;
     let out = folder.out.as_path();
-    super::options::check_output(
-        "--out",
+    let _lock = super::options::claim_output_folder(
         out,
-        true,
         &[
             ("--config", source.config.as_deref()),
             ("--recording", recording.as_deref()),
         ],
     )?;
-    // Held to the end: a second run into the same folder fails now, not after its run.
-    let _lock = gyrofx_codegen::output_folder::lock(out)?;
     let mut config = source.load()?;
     let recording = match recording {
         Some(path) => {

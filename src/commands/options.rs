@@ -112,6 +112,17 @@ pub fn check_output(
         .map_err(|message| super::Usage(message).into())
 }
 
+/// Claims `--out` before any work: refuses it as [`check_output`] does for a folder, then takes
+/// its lock, held until the returned value drops, so that a second run into the same folder
+/// fails at once rather than after its run.
+pub fn claim_output_folder(
+    out: &Path,
+    inputs: &[(&str, Option<&Path>)],
+) -> Result<gyrofx_codegen::output_folder::Lock> {
+    check_output("--out", out, true, inputs)?;
+    Ok(gyrofx_codegen::output_folder::lock(out)?)
+}
+
 /// [`Replace::Force`] when `--force` was given.
 pub fn replace(force: bool) -> Replace {
     if force {

@@ -49,9 +49,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
     let replace = super::options::replace(force);
     let mut _lock = None;
     if let Some(folder) = &out {
-        super::options::check_output("--out", folder, true, &[])?;
-        // Held to the end: a second run into the same folder fails now.
-        _lock = Some(output_folder::lock(folder)?);
+        _lock = Some(super::options::claim_output_folder(folder, &[])?);
         // Before the simulation: a folder that cannot be written fails now, not minutes later.
         output_folder::check(folder, output_folder::Kind::Reproduce, replace)?;
     }

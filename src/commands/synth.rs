@@ -64,14 +64,8 @@ pub fn run(args: Args) -> Result<ExitCode> {
         }),
     };
     let out = folder.out.as_path();
-    super::options::check_output(
-        "--out",
-        out,
-        true,
-        &[("--config", source.config.as_deref())],
-    )?;
-    // Held to the end: a second run into the same folder fails now, not after its synthesis.
-    let _lock = gyrofx_codegen::output_folder::lock(out)?;
+    let _lock =
+        super::options::claim_output_folder(out, &[("--config", source.config.as_deref())])?;
     let config = source.load()?;
     let job = Job::new(config)?;
     let mut provenance = source.provenance(&job, Output::Synthesis);
