@@ -1,9 +1,7 @@
 //! `gyrofx allan` and `gyrofx ar`: JSON fields, agreement with the library on a known record,
 //! and bad input.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 
 /// White rate noise from a fixed LCG (the NIST test generator), written as a CSV.
 fn white_csv(dir: &std::path::Path, samples: usize) -> String {

@@ -5,9 +5,9 @@
 use std::path::Path;
 
 use gyrofx_codegen::blocks::{RomImages, REGISTRY};
-use gyrofx_codegen::config::Config;
-use gyrofx_codegen::job::Job;
 use gyrofx_codegen::writers::Provenance;
+use gyrofx_job::config::Config;
+use gyrofx_job::job::Job;
 
 /// A port: name, direction (`in`/`out`) and format (`s24.14`, `u1.0`).
 type Port = (String, String, String);

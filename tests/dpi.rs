@@ -2,15 +2,13 @@
 //! testbenches in Verilator (through `gyrofx verify --sim dpi`), their failure on one flipped
 //! expected bit and on a mutated RTL line, and the C++ Verilator harness example.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use common::{capi_library as library, generate_default, run_tool, text};
-use gyrofx_codegen::config::Config;
-use gyrofx_codegen::golden;
-use gyrofx_codegen::job::Job;
+use crate::common::{capi_library as library, generate_default, run_tool, text};
+use gyrofx_job::config::Config;
+use gyrofx_job::golden;
+use gyrofx_job::job::Job;
 
 /// The repository.
 fn repository() -> PathBuf {
@@ -129,7 +127,7 @@ fn the_dpi_testbenches_pass_fail_on_a_flipped_bit_and_on_a_mutated_line() {
     let log = text(&output);
     assert!(output.status.success(), "{log}");
     assert!(log.contains("dpi: passed"), "{log}");
-    for block in gyrofx_codegen::golden::BLOCKS {
+    for block in gyrofx_job::golden::BLOCKS {
         assert!(log.contains(&format!("== {block}")), "{block}: {log}");
     }
     // One flipped expected bit fails it with exactly one mismatch.

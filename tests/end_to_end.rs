@@ -1,8 +1,6 @@
 //! generate → verify in Icarus, Verilator and GHDL → pass; and every way it must fail.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 
 /// The package path as the CLI arguments take it.
 fn generate_default_str(dir: &std::path::Path, samples: &str) -> String {

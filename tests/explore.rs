@@ -5,12 +5,10 @@
 //! takes every cost from the cache and writes the same CSV; a target nobody meets writes the CSV
 //! and plots but no best.toml and exits 1; bad arguments name the flag and leave no folder.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-use common::{gyrofx, ok, text};
+use crate::common::{gyrofx, ok, text};
 
 const SWEEP: &str = "kf.state_format=s26.16..s28.18";
 const SAMPLES: &str = "2000";

@@ -2,11 +2,9 @@
 //! GHDL, consistent with the filtered CSV, with the recording's SHA-256 in the manifest; a
 //! foreign folder and `--strict` leave nothing behind.
 
-mod common;
-
 use std::path::Path;
 
-use common::{fails, files_below, flip_expected_bit, hex_sha256, ok, run_tool};
+use crate::common::{fails, files_below, flip_expected_bit, hex_sha256, ok, run_tool};
 
 /// A record of `n` rates (°/s): a slow sine plus a deterministic ripple, with a header.
 fn record(dir: &Path, n: usize, scale: f64) -> String {

@@ -3,9 +3,7 @@
 //! `--strict` fails on it), `--write` gives a config whose configured nodes are proven and which
 //! `generate --strict` accepts, and an existing file is not replaced without `--force`.
 
-mod common;
-
-use common::{fails, gyrofx, ok, run_tool, text};
+use crate::common::{fails, gyrofx, ok, run_tool, text};
 
 fn nodes(json: &serde_json::Value) -> Vec<serde_json::Value> {
     json["nodes"].as_array().unwrap().clone()
@@ -308,7 +306,7 @@ fn write_gives_a_proven_config_that_generate_accepts_and_keeps_existing_files() 
 #[test]
 fn the_manifest_records_which_formats_are_proven() {
     let dir = tempfile::tempdir().unwrap();
-    let package = common::generate_default(dir.path(), "1000");
+    let package = crate::common::generate_default(dir.path(), "1000");
     let manifest: serde_json::Value =
         serde_json::from_slice(&std::fs::read(package.join("manifest.json")).unwrap()).unwrap();
     let formats = &manifest["formats"];

@@ -2,11 +2,9 @@
 //! (the VHDL testbench package aside), FuseSoC's lint target (Verilator -Wall) passes on it and
 //! fails without a module, and its VHDL target (GHDL) analyses and elaborates the VHDL twin.
 
-mod common;
-
 use std::path::Path;
 
-use common::run_tool;
+use crate::common::run_tool;
 
 const CORE: &str = "gyrofx:gyrofx:chain";
 

@@ -6,18 +6,18 @@
 use std::io::Write as _;
 use std::str::FromStr;
 
-use gyrofx_codegen::config::Config;
-use gyrofx_codegen::input::{read_column, read_column_with_gaps};
-use gyrofx_codegen::job::Job;
 use gyrofx_codegen::rom::{self, RomFormat};
 use gyrofx_codegen::simulate::Simulator;
+use gyrofx_job::config::Config;
+use gyrofx_job::input::{read_column, read_column_with_gaps};
+use gyrofx_job::job::Job;
 use gyrofx_model::analysis::allan::Grid;
 use gyrofx_model::fx::{Format, Overflow, Rounding};
 use gyrofx_model::kf::design::Method;
 use proptest::prelude::*;
 
 /// The embedded default as `gyrofx init` prints it: the seed of the plausible configs.
-const DEFAULT: &str = include_str!("../codegen/src/default.toml");
+const DEFAULT: &str = include_str!("../job/src/default.toml");
 
 /// Tokens that plausible mutations put in place of a value.
 const TOKENS: &[&str] = &[

@@ -1,12 +1,10 @@
 //! The golden vector set of the default config (`vectors/`): any change to the model, the
 //! writers or the default shows up here. Regenerate on purpose with
-//! `GYROFX_UPDATE_GOLDEN=1 cargo test --test golden` (or scripts/update-golden.sh).
-
-mod common;
+//! `GYROFX_UPDATE_GOLDEN=1 cargo test --test main golden::` (or scripts/update-golden.sh).
 
 use std::path::Path;
 
-use common::*;
+use crate::common::*;
 
 const GOLDEN: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/vectors");
 
@@ -56,7 +54,7 @@ fn default_package_matches_the_golden_vectors() {
         assert_eq!(
             entry["sha256"].as_str().unwrap(),
             hex_sha256(&data),
-            "{file} differs from the golden manifest's SHA-256; regenerate with GYROFX_UPDATE_GOLDEN=1 cargo test --test golden if the change is intended"
+            "{file} differs from the golden manifest's SHA-256; regenerate with GYROFX_UPDATE_GOLDEN=1 cargo test --test main golden:: if the change is intended"
         );
     }
     assert_eq!(
@@ -74,7 +72,7 @@ fn default_package_matches_the_golden_vectors() {
                 .position(|(a, b)| a != b)
                 .map(|i| i + 1);
             panic!(
-                "{} differs from the golden copy (first differing line {:?}); regenerate with GYROFX_UPDATE_GOLDEN=1 cargo test --test golden if the change is intended",
+                "{} differs from the golden copy (first differing line {:?}); regenerate with GYROFX_UPDATE_GOLDEN=1 cargo test --test main golden:: if the change is intended",
                 file.display(),
                 first
             );

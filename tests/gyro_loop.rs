@@ -1,9 +1,7 @@
 //! `gyrofx loop`: both resonator-level gyros' closed loops against SPEC §1.6's closed forms,
 //! through the command line.
 
-mod common;
-
-use common::{fails, ok, write_config};
+use crate::common::{fails, ok, write_config};
 
 /// Every figure of one mode from the JSON: (measured, predicted).
 fn figure(mode: &serde_json::Value, name: &str) -> (f64, f64) {
@@ -138,8 +136,8 @@ fn loop_plots_the_switch_as_png_or_svg() {
         "an SVG with the re-lock"
     );
     let bad = dir.path().join("switch.jpg");
-    let output = common::gyrofx(&["loop", "--plot", bad.to_str().unwrap()]);
-    let log = common::text(&output);
+    let output = crate::common::gyrofx(&["loop", "--plot", bad.to_str().unwrap()]);
+    let log = crate::common::text(&output);
     assert_eq!(output.status.code(), Some(2), "{log}");
     assert!(
         log.contains("--plot") && log.contains(".png or .svg"),

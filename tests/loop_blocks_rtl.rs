@@ -7,12 +7,10 @@
 //! expected bit must fail in Icarus and GHDL. The Verilog lints clean under
 //! `verilator -Wall` and synthesizes in yosys without latches.
 
-mod common;
-
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use common::run_tool;
+use crate::common::run_tool;
 use gyrofx_model::fx::{CoefficientFormat, Format, Overflow, Rounding};
 use gyrofx_model::gyro_loop::{cic, demodulator, nco, pi, RtlParameter};
 

@@ -1,18 +1,23 @@
 //! Bounded memory (issue 13, item 2): `generate` streams the chain through its writers, so its
-//! peak RSS does not grow with `--samples`. Alone in its test binary: the peak is read with
-//! `getrusage(RUSAGE_CHILDREN)`, which covers every child this process has waited for.
+//! peak RSS does not grow with `--samples`. Each run's own peak is read from `wait4`'s rusage
+//! for that child alone, so the other tests' children (yosys, simulators) running beside it in
+//! the one test binary do not count.
 
-mod common;
+use crate::common::write_config;
 
-use common::write_config;
-
-/// Largest peak RSS of the waited-for children so far, KiB (Linux reports `ru_maxrss` in KiB).
-fn children_peak_kib() -> i64 {
+/// Runs `command` and returns its exit status and its own peak RSS, KiB (Linux reports
+/// `ru_maxrss` in KiB).
+fn run_with_peak_kib(command: &mut std::process::Command) -> (i32, i64) {
+    let child = command.spawn().unwrap();
+    let pid = child.id() as libc::pid_t;
+    let mut status = 0;
     let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    // SAFETY: `usage` is a valid, writable rusage.
-    let status = unsafe { libc::getrusage(libc::RUSAGE_CHILDREN, &mut usage) };
-    assert_eq!(status, 0, "getrusage");
-    usage.ru_maxrss
+    // SAFETY: `status` and `usage` are valid and writable; `pid` is our child, reaped here and
+    // never by `Child` (which is dropped without a wait).
+    let waited = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
+    assert_eq!(waited, pid, "wait4");
+    std::mem::forget(child);
+    (status, usage.ru_maxrss)
 }
 
 #[test]
@@ -22,23 +27,25 @@ fn generate_peak_memory_does_not_grow_with_the_samples() {
     let mut peaks = Vec::new();
     for samples in ["20000", "1000000"] {
         let out = dir.path().join(format!("out-{samples}"));
-        let status = std::process::Command::new(env!("CARGO_BIN_EXE_gyrofx"))
-            .args([
-                "generate",
-                "--config",
-                &config,
-                "--samples",
-                samples,
-                "--quiet",
-            ])
-            .arg("--out")
-            .arg(&out)
-            .stdout(std::process::Stdio::null())
-            .status()
-            .unwrap();
-        assert!(status.success(), "generate --samples {samples}");
-        // The high-water mark only rises: the larger run's peak is read after it.
-        peaks.push(children_peak_kib());
+        let (status, peak) = run_with_peak_kib(
+            std::process::Command::new(env!("CARGO_BIN_EXE_gyrofx"))
+                .args([
+                    "generate",
+                    "--config",
+                    &config,
+                    "--samples",
+                    samples,
+                    "--quiet",
+                    "--out",
+                    out.to_str().unwrap(),
+                ])
+                .stdout(std::process::Stdio::null()),
+        );
+        assert_eq!(
+            status, 0,
+            "generate --samples {samples}: wait status {status}"
+        );
+        peaks.push(peak);
         std::fs::remove_dir_all(&out).unwrap();
     }
     let [small, large] = [peaks[0], peaks[1]];

@@ -4,14 +4,12 @@
 //! checked by hashing the user's folder before and after. Staging folders are removed on
 //! SIGINT and SIGTERM and, when a killed run left them, by the next run.
 
-mod common;
-
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-use common::{fails, gyrofx, ok, text, write_config};
+use crate::common::{fails, gyrofx, ok, text, write_config};
 use sha2::{Digest, Sha256};
 
 /// A small, fast package: the rate-level plant, 400 samples.

@@ -3,11 +3,9 @@
 //! bit for bit; the manifest names the recording by its SHA-256; a recording out of step with
 //! the sequencer, at another rate or with a missing column is refused with nothing written.
 
-mod common;
-
 use std::path::Path;
 
-use common::{fails, generate_default, hex_sha256, ok, run_tool};
+use crate::common::{fails, generate_default, hex_sha256, ok, run_tool};
 
 /// The rows of a vector CSV (`#` lines skipped) as (header, rows of cells).
 fn rows(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {

@@ -2,11 +2,9 @@
 //! `$readmemh` files hold, and the HDL formats compile in Icarus, Verilator and GHDL and
 //! read back those words there.
 
-mod common;
-
 use std::path::Path;
 
-use common::*;
+use crate::common::*;
 use gyrofx_codegen::rom::{parse, RomFormat, ROM_FOLDER};
 
 const ROMS: [(&str, &str); 2] = [("kf_coefficients", "kf"), ("estimator_gains", "estimator")];

@@ -3,11 +3,9 @@
 //! elaborated for several parameter sets, and the requantizer of each language checked
 //! exhaustively against the model on small widths for every rounding and overflow mode.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 
-use common::run_tool;
+use crate::common::run_tool;
 use gyrofx_model::fx::{requantize, Format, Overflow, Rounding};
 
 fn hdl(name: &str) -> PathBuf {

@@ -3,9 +3,7 @@
 //! flipped bit fails every testbench, and bad values are refused. (Its cocotb test:
 //! `python/tests/test_cocotb.py`.)
 
-mod common;
-
-use common::*;
+use crate::common::*;
 
 /// Short intervals so that 1 300 samples hold five windows (estimates, smoothing, resets of
 /// the accumulators), B staggered.

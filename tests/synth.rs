@@ -1,12 +1,10 @@
 //! `gyrofx synth`: the chain synthesizes in yosys with the config's widths, wider formats cost
 //! more, and the check fails on a latch or a missing module without writing anything.
 
-mod common;
-
 use std::path::Path;
 
-use common::*;
-use gyrofx_codegen::synth::measure;
+use crate::common::*;
+use gyrofx_codegen::synth::{design_inputs, measure, Design};
 
 fn manifest(dir: &Path) -> serde_json::Value {
     let text = std::fs::read_to_string(dir.join("manifest.json")).unwrap();

@@ -1,11 +1,9 @@
 //! The testbench options, the same in every simulator through the package's Makefile (MASK,
 //! MAX_REPORTED, MAX_MISMATCHES, WAVES) and through `gyrofx verify` (and its JUnit summary).
 
-mod common;
-
 use std::path::Path;
 
-use common::*;
+use crate::common::*;
 
 /// Runs `make <sim>-kf` in the package with `variables`; (exit ok, output).
 fn make_kf(package: &Path, sim: &str, variables: &[&str]) -> (bool, String) {

@@ -2,7 +2,7 @@
 //! and SystemVerilog through DPI-C. The header is `capi/include/gyrofx.h` (cbindgen; a test
 //! keeps it equal to the code).
 //!
-//! Every block wraps [`gyrofx_codegen::golden`]: the same model as the vectors, codes in and out
+//! Every block wraps [`gyrofx_job::golden`]: the same model as the vectors, codes in and out
 //! exactly as the RTL ports carry them (`int64_t` two's-complement values, flags 0/1, a mode 1
 //! normal / 0 reverse). The signatures keep to DPI-C's types (`chandle` = pointer, `longint` =
 //! `int64_t`, `int` = `int32_t`, `string` = `const char *`) so a SystemVerilog testbench imports
@@ -20,9 +20,9 @@ use std::cell::RefCell;
 use std::ffi::{c_char, CStr, CString};
 use std::path::Path;
 
-use gyrofx_codegen::config::Config;
-use gyrofx_codegen::golden;
-use gyrofx_codegen::job::Job;
+use gyrofx_job::config::Config;
+use gyrofx_job::golden;
+use gyrofx_job::job::Job;
 
 thread_local! {
     static LAST_ERROR: RefCell<CString> = RefCell::new(CString::default());
@@ -70,7 +70,7 @@ unsafe fn text<'a>(text: *const c_char, what: &str) -> Option<&'a str> {
     }
 }
 
-fn plan(config: gyrofx_codegen::error::Result<Config>) -> *mut GyrofxPlan {
+fn plan(config: gyrofx_job::error::Result<Config>) -> *mut GyrofxPlan {
     match config.and_then(Job::new) {
         Ok(job) => Box::into_raw(Box::new(GyrofxPlan { job })),
         Err(e) => {
@@ -120,9 +120,7 @@ pub unsafe extern "C" fn gyrofx_plan_from_file(path: *const c_char) -> *mut Gyro
 pub unsafe extern "C" fn gyrofx_plan_from_package(folder: *const c_char) -> *mut GyrofxPlan {
     // SAFETY: forwarded contract.
     match unsafe { text(folder, "folder") } {
-        Some(folder) => plan(gyrofx_codegen::config::Config::from_package(Path::new(
-            folder,
-        ))),
+        Some(folder) => plan(gyrofx_job::config::Config::from_package(Path::new(folder))),
         None => std::ptr::null_mut(),
     }
 }

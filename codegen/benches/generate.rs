@@ -3,11 +3,11 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 
-use gyrofx_codegen::config::Config;
 use gyrofx_codegen::generate::{generate, provenance, Contents, Options, Output};
-use gyrofx_codegen::job::Job;
 use gyrofx_codegen::output_folder::Replace;
 use gyrofx_codegen::progress::Progress;
+use gyrofx_job::config::Config;
+use gyrofx_job::job::Job;
 
 fn generate_million(c: &mut Criterion) {
     let mut config =

@@ -206,7 +206,7 @@ pub trait RowSink: Send + Sync + std::fmt::Debug {
     ///
     /// # Errors
     /// Write errors.
-    fn finish(self: Box<Self>) -> crate::error::Result<Vec<crate::package::FileEntry>>;
+    fn finish(self: Box<Self>) -> gyrofx_job::error::Result<Vec<crate::package::FileEntry>>;
 }
 
 /// A block's rows: kept, or streamed to a sink.
@@ -336,7 +336,7 @@ impl Block {
     ///
     /// # Errors
     /// The sink's write errors.
-    pub fn finish_rows(&mut self) -> crate::error::Result<()> {
+    pub fn finish_rows(&mut self) -> gyrofx_job::error::Result<()> {
         let entries = self.end_rows()?;
         self.written.extend(entries);
         Ok(())
@@ -348,7 +348,7 @@ impl Block {
         &self.written
     }
 
-    fn end_rows(&mut self) -> crate::error::Result<Vec<crate::package::FileEntry>> {
+    fn end_rows(&mut self) -> gyrofx_job::error::Result<Vec<crate::package::FileEntry>> {
         match std::mem::replace(
             &mut self.rows,
             Rows::Memory {

@@ -18,7 +18,7 @@ use crate::writers::Provenance;
 /// The shared driver, protocol and scoreboard.
 const SHARED: &str = include_str!("cocotb/gyrofx_cocotb.py");
 
-/// Blocks with a cocotb test (those with a golden model, [`crate::golden::BLOCKS`]), with the
+/// Blocks with a cocotb test (those with a golden model, [`gyrofx_job::golden::BLOCKS`]), with the
 /// test module.
 pub const TESTS: [(&str, &str); 7] = [
     ("sequencer", include_str!("cocotb/test_sequencer.py")),
@@ -185,6 +185,6 @@ mod tests {
     #[test]
     fn every_block_with_a_golden_model_has_a_cocotb_test() {
         let names: Vec<&str> = super::TESTS.iter().map(|(name, _)| *name).collect();
-        assert_eq!(names, crate::golden::BLOCKS);
+        assert_eq!(names, gyrofx_job::golden::BLOCKS);
     }
 }

@@ -24,7 +24,7 @@ pub const FOLDER: &str = "dpi";
 pub fn tested(blocks: &[Block]) -> Vec<&Block> {
     blocks
         .iter()
-        .filter(|b| crate::golden::BLOCKS.contains(&b.name))
+        .filter(|b| gyrofx_job::golden::BLOCKS.contains(&b.name))
         .collect()
 }
 

@@ -2,14 +2,14 @@
 //!
 //! A sweep ([`Sweep`]: `--vary KEY=FORMAT..FORMAT`, several flags giving their Cartesian
 //! product, or `--guard-bits A..B` over [`GUARD_BIT_KEYS`]) gives the candidates; each is the
-//! config with those formats, resolved by [`Job::new`] (a candidate the config's validation
+//! config with those formats, resolved by [`crate::blocks::checked_job`] (a candidate the config's validation
 //! refuses gets a CSV row with the reason, not a crash). Per candidate:
 //!
 //! - the noise ([`measure`]): the chain's fixed output against its float twin over the
 //!   configured stimulus (`--samples` overrides the record length): rms and max error in
 //!   output LSB and °/s, the quantization noise's share of the output's Allan deviation at
 //!   τ = 1 s and of the sensor's ARW, and the chain's overflows on the run's data;
-//! - whether `gyrofx formats`' analysis ([`crate::formats::analyse`], for this record and its
+//! - whether `gyrofx formats`' analysis ([`gyrofx_job::formats::analyse`], for this record and its
 //!   `bw_sel` switches) proves the swept nodes' formats: the `proven` column, `yes` or `no:`
 //!   and the nodes that can overflow;
 //! - the cost: [`crate::synth::cost`] of `gyrofx_top` (and of `gyrofx_gyro_loop` when a
@@ -29,13 +29,13 @@
 
 use std::path::Path;
 
-use crate::config::Config;
-use crate::error::{Error, Result};
-use crate::job::Job;
 use crate::output_folder::{Kind, Replace};
 use crate::package::Package;
 use crate::progress::Progress;
 use crate::synth::{Design, Resources};
+use gyrofx_job::config::Config;
+use gyrofx_job::error::{Error, Result};
+use gyrofx_job::job::Job;
 
 mod cache;
 pub mod measure;
@@ -143,16 +143,16 @@ impl Plan {
         let record = samples.unwrap_or(config.samples);
         let mut run = config.clone();
         run.samples = record;
-        let job = Job::new(run).map_err(|e| match (samples, &e) {
+        let job = crate::blocks::checked_job(run).map_err(|e| match (samples, &e) {
             (Some(n), Error::Config { field, .. }) if field == "samples" => {
                 PlanError::Usage(format!(
                     "--samples {n} is not allowed: 1 to {}",
-                    crate::config::MAX_SAMPLES
+                    gyrofx_job::config::MAX_SAMPLES
                 ))
             }
             _ => PlanError::Config(e),
         })?;
-        let analysis = crate::formats::analyse(&job, record as u64, measure::switches(&job));
+        let analysis = gyrofx_job::formats::analyse(&job, record as u64, measure::switches(&job));
         let (keys, candidates) = candidates(&analysis, sweep).map_err(PlanError::Usage)?;
         let loops = keys.iter().any(|k| k.starts_with("loop."));
         if loops && job.settings.resonator.is_none() {
@@ -217,7 +217,7 @@ impl Plan {
         let mut config = self.base.clone();
         config.samples = self.samples;
         for (key, format) in &candidate.formats {
-            crate::formats::set_format(&mut config, key, *format);
+            gyrofx_job::formats::set_format(&mut config, key, *format);
         }
         config
     }
@@ -274,7 +274,7 @@ fn run_candidate(
         candidate: candidate.clone(),
         outcome,
     };
-    let job = match Job::new(plan.config_of(candidate)) {
+    let job = match crate::blocks::checked_job(plan.config_of(candidate)) {
         Ok(job) => job,
         Err(e) => return Ok(row(Err(one_line(&format!("refused: {e}"))))),
     };
@@ -293,7 +293,7 @@ fn run_candidate(
         Ok(m) => m,
         Err(message) => return Ok(row(Err(one_line(&message)))),
     };
-    let analysis = crate::formats::analyse(&job, plan.samples as u64, measure::switches(&job));
+    let analysis = gyrofx_job::formats::analyse(&job, plan.samples as u64, measure::switches(&job));
     let unproven: Vec<&'static str> = candidate
         .formats
         .iter()
@@ -551,9 +551,9 @@ impl Exploration {
         };
         let mut config = self.base.clone();
         for (key, format) in &row.candidate.formats {
-            crate::formats::set_format(&mut config, key, *format);
+            gyrofx_job::formats::set_format(&mut config, key, *format);
         }
-        Job::new(config.clone())?;
+        crate::blocks::checked_job(config.clone())?;
         let c = m.cost();
         let formats = row.candidate.assignments(" = ");
         Ok(Some(format!(

@@ -14,14 +14,14 @@ use serde_json::json;
 
 use crate::block::Block;
 use crate::blocks::{kf, RomImages, RtlBlock};
-use crate::error::Result;
 use crate::generate::{block_files, block_manifest, BlockFile};
 use crate::hdl;
-use crate::job::Job;
 use crate::output_folder::{Kind, Replace};
 use crate::package::{Package, Staging};
 use crate::vector_rows::StagedRows;
 use crate::writers::{self, Provenance};
+use gyrofx_job::error::Result;
+use gyrofx_job::job::Job;
 
 /// A KF package being written.
 pub struct FilterPackage {

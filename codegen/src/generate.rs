@@ -7,9 +7,7 @@ use serde_json::json;
 
 use crate::block::{Block, Timing};
 use crate::blocks::{RomImages, REGISTRY};
-use crate::error::Result;
 use crate::hdl;
-use crate::job::Job;
 use crate::output_folder::{Kind, Replace};
 use crate::package::{sha256_hex, FileEntry, Package, Staging, MANIFEST};
 use crate::progress::Progress;
@@ -17,6 +15,8 @@ use crate::rom::{self, RomFormat, ROM_FOLDER};
 use crate::testbench::{verilog, vhdl};
 use crate::vectors::{self, Run};
 use crate::writers::{self, Provenance};
+use gyrofx_job::error::Result;
+use gyrofx_job::job::Job;
 
 /// What `generate` reports back.
 #[derive(Debug)]
@@ -226,7 +226,7 @@ pub fn build_package(
     let switches = crate::vectors::bw_sel_switches(run.samples, job.kf().rom.len());
     sections.insert(
         "formats".into(),
-        crate::formats::analyse(job, run.samples as u64, switches).json(),
+        gyrofx_job::formats::analyse(job, run.samples as u64, switches).json(),
     );
     sections.insert("files".to_string(), json!(package.entries()));
     let mut text = serde_json::to_string_pretty(&manifest).expect("manifest serializes");
@@ -341,7 +341,9 @@ pub fn generate(
     let overflowed = summary.run.overflows.in_chain_run();
     if options.strict && !overflowed.is_empty() {
         // The staging folder goes with `staging`: nothing is written.
-        return Err(crate::error::Error::Overflow(overflow_list(&overflowed)));
+        return Err(gyrofx_job::error::Error::Overflow(overflow_list(
+            &overflowed,
+        )));
     }
     progress.set_phase("writing");
     package.write_staged(staging)?;

@@ -1,7 +1,9 @@
-//! gyrofx-codegen: config, the vector / ROM / testbench writers, the output package and the
-//! simulator runner.
+//! gyrofx-codegen: a job (`gyrofx-job`) → a verification package: the vector / ROM / testbench
+//! writers, the output package, and (until they move to a crate of their own) the simulator,
+//! synthesis and place-and-route runners.
 //!
-//! Data flows one way: [`config::Config`] → [`job::Job`] (designs and every block's plan) →
+//! Data flows one way: [`gyrofx_job::config::Config`] → [`gyrofx_job::job::Job`] (designs and
+//! every block's plan; [`blocks::checked_job`] adds each block's own check) →
 //! [`vectors`] (one run of the chain, cut into every registered block's [`block::Block`] by
 //! its module in [`blocks`]) → [`writers`] and
 //! [`testbench`] → [`package::Package`], written atomically by [`generate::generate`].
@@ -11,17 +13,11 @@
 pub mod block;
 pub mod blocks;
 pub mod cocotb;
-pub mod config;
 pub mod dpi;
-pub mod error;
 pub mod explore;
 pub mod filter_package;
-pub mod formats;
 pub mod generate;
-pub mod golden;
 pub mod hdl;
-pub mod input;
-pub mod job;
 pub mod junit;
 pub mod output_folder;
 pub mod package;
@@ -29,7 +25,6 @@ pub mod place_route;
 pub mod plot;
 pub mod processes;
 pub mod progress;
-pub mod recording;
 pub mod report;
 pub mod reproduce;
 pub mod rom;
@@ -41,4 +36,4 @@ pub mod vector_rows;
 pub mod vectors;
 pub mod writers;
 
-pub use error::{Error, Result};
+pub use gyrofx_job::error::{Error, Result};

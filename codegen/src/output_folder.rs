@@ -17,8 +17,8 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-use crate::error::{Error, Result};
 use crate::package::{sha256_hex, MANIFEST};
+use gyrofx_job::error::{Error, Result};
 
 /// The marker file at the root of every package.
 pub const MARKER: &str = ".gyrofx-package";

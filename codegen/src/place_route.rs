@@ -18,10 +18,10 @@ use serde::Serialize;
 
 use crate::block::Block;
 use crate::blocks::{self, RomImages};
-use crate::error::{Error, Result};
-use crate::job::Job;
 use crate::package::Package;
 use crate::synth;
+use gyrofx_job::error::{Error, Result};
+use gyrofx_job::job::Job;
 
 /// The blocks placed, in the package's order: the chain's blocks, the chain, the chain in the
 /// serial architecture ([`SERIAL_TOP`]), the mean filter beside it in both architectures

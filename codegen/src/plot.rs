@@ -20,7 +20,7 @@ use gyrofx_model::analysis::davar::{Coefficients, Davar};
 use gyrofx_model::analysis::noise::{self, Terms};
 use gyrofx_model::gyro_loop::trace::TracePoint;
 
-use crate::error::{Error, Result};
+use gyrofx_job::error::{Error, Result};
 
 const FONT_PATHS: [&str; 6] = [
     "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",

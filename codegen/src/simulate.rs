@@ -6,7 +6,7 @@ use std::path::Path;
 use std::process::Command;
 use std::time::Instant;
 
-use crate::error::{Error, Result};
+use gyrofx_job::error::{Error, Result};
 
 /// A supported simulator.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

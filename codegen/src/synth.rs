@@ -14,13 +14,13 @@ use serde::{Deserialize, Serialize};
 
 use crate::block::Block;
 use crate::blocks::{self, RomImages};
-use crate::error::{Error, Result};
 use crate::hdl;
-use crate::job::Job;
 use crate::output_folder::{self, Kind, Replace};
 use crate::package::Package;
 use crate::place_route;
 use crate::writers::Provenance;
+use gyrofx_job::error::{Error, Result};
+use gyrofx_job::job::Job;
 
 /// Module synthesized: the whole chain.
 pub const TOP: &str = "gyrofx_top";

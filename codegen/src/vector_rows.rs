@@ -14,10 +14,10 @@ use gyrofx_model::fx::Format;
 use sha2::{Digest, Sha256};
 
 use crate::block::{Block, RowSink, Signal};
-use crate::error::{Error, Result};
 use crate::package::FileEntry;
 use crate::testbench::header;
 use crate::writers::{push_hex, Provenance};
+use gyrofx_job::error::{Error, Result};
 
 /// The signals, gates and extra columns of a block's vector files.
 #[derive(Clone, Debug)]

@@ -25,13 +25,13 @@ use serde::Serialize;
 use crate::block::Block;
 use crate::blocks::kf::TieCases;
 use crate::blocks::{ChainSample, RomImages};
-use crate::config::GyroLoop;
-use crate::error::{Error, Result};
-use crate::job::Job;
 use crate::progress::Progress;
 pub use crate::stats::ErrorStats;
 use crate::vector_rows::StagedRows;
 use crate::writers::Provenance;
+use gyrofx_job::config::GyroLoop;
+use gyrofx_job::error::{Error, Result};
+use gyrofx_job::job::Job;
 
 /// Overflow counts of every quantization point.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -490,7 +490,7 @@ enum Gyros {
     /// Recorded outputs (`generate --recording`): already in the sequencer's modes; the
     /// report's "without reversal" rows show the same record.
     Recorded {
-        rows: Box<crate::recording::Rows>,
+        rows: Box<gyrofx_job::recording::Rows>,
         /// This batch's rates of gyro A and B, °/s.
         rates: [Vec<f64>; 2],
         input: Format,
@@ -815,8 +815,8 @@ mod tests {
             );
         }
     }
-    use crate::config::Config;
     use crate::writers::Provenance;
+    use gyrofx_job::config::Config;
     use gyrofx_model::kf::FixedKf;
 
     /// The embedded config with 4000 samples, changed by `edit`, run.

@@ -9,7 +9,7 @@ use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use gyrofx_codegen::golden::{
+use gyrofx_job::golden::{
     self, check_bw_sel, check_codes, slot_from_ports, CHAIN_OUTPUTS, ESTIMATOR_OUTPUTS,
     ESTIMATOR_SLOT_PORTS, SLOT_PORTS,
 };

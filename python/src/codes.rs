@@ -3,7 +3,7 @@
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 
-use gyrofx_codegen::golden::check_code;
+use gyrofx_job::golden::check_code;
 use gyrofx_model::fx::{from_f64, Format, Overflow, Rounding};
 
 use crate::refused;

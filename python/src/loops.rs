@@ -9,8 +9,8 @@ use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use gyrofx_codegen::config::GyroLoop as LoopConfig;
-use gyrofx_codegen::golden::{self, check_code, GYRO_LOOP_OUTPUTS, SYSTEM_OUTPUTS};
+use gyrofx_job::config::GyroLoop as LoopConfig;
+use gyrofx_job::golden::{self, check_code, GYRO_LOOP_OUTPUTS, SYSTEM_OUTPUTS};
 use gyrofx_model::chain;
 use gyrofx_model::gyro_loop::gyro::{FloatGyroLoop, Plan as LoopPlan};
 use gyrofx_model::resonator::{Mode, Resonator as PhysicalResonator};

@@ -7,8 +7,8 @@ use std::sync::Arc;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use gyrofx_codegen::config::Config;
-use gyrofx_codegen::job::Job;
+use gyrofx_job::config::Config;
+use gyrofx_job::job::Job;
 
 use crate::blocks::{
     Chain, ChainFloat, Estimator, EstimatorFloat, Kf, KfFloat, MeanFilter, MeanFilterFloat,
@@ -25,7 +25,7 @@ pub(crate) struct Plan {
 }
 
 impl Plan {
-    fn resolve(config: gyrofx_codegen::error::Result<Config>) -> PyResult<Plan> {
+    fn resolve(config: gyrofx_job::error::Result<Config>) -> PyResult<Plan> {
         let job = config.and_then(Job::new).map_err(refused)?;
         Ok(Plan { job: Arc::new(job) })
     }
@@ -205,12 +205,12 @@ impl Plan {
             .job
             .system_chain
             .as_ref()
-            .ok_or_else(|| refused(gyrofx_codegen::golden::NO_SYSTEM))?;
+            .ok_or_else(|| refused(gyrofx_job::golden::NO_SYSTEM))?;
         let [a, b] = &self.job.gyro_loops;
         Ok(([&a.plan, &b.plan], chain))
     }
 
-    fn gyro(&self, gyro: &str) -> PyResult<&gyrofx_codegen::config::GyroLoop> {
+    fn gyro(&self, gyro: &str) -> PyResult<&gyrofx_job::config::GyroLoop> {
         Ok(&self.job.gyro_loops[gyro_index(gyro)?])
     }
 }

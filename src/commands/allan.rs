@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Result};
 
-use gyrofx_codegen::input::read_column_with_gaps;
+use gyrofx_job::input::read_column_with_gaps;
 use gyrofx_model::analysis::{allan, noise};
 
 use super::options::SampleRate;

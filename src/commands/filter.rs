@@ -8,12 +8,12 @@ use std::io::Write;
 
 use anyhow::{Context, Result};
 
-use gyrofx_codegen::config::Config;
 use gyrofx_codegen::filter_package::FilterPackage;
-use gyrofx_codegen::job::{design_bandwidths, plan_for, Job};
 use gyrofx_codegen::output_folder;
 use gyrofx_codegen::package::sha256_hex;
 use gyrofx_codegen::writers::Provenance;
+use gyrofx_job::config::Config;
+use gyrofx_job::job::{design_bandwidths, plan_for, Job};
 use gyrofx_model::fx::{from_f64, Overflow, Rounding};
 use gyrofx_model::kf::{FixedKf, FloatKf};
 
@@ -211,7 +211,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
     // The vectors' folder is checked, and their files opened, before the work.
     let mut kf_vectors = match &vectors {
         Some(folder) => {
-            let job = Job::new(config.clone())?;
+            let job = gyrofx_codegen::blocks::checked_job(config.clone())?;
             let provenance = filter_provenance(&job, &csv, fs, bandwidth);
             let package =
                 FilterPackage::create(folder, &job, &provenance, super::options::replace(force))?;

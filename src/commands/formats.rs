@@ -10,9 +10,8 @@ use anyhow::{Context, Result};
 use super::options::{count, ConfigSource};
 use super::usage;
 
-use gyrofx_codegen::formats::{analyse, fractions_for};
-use gyrofx_codegen::job::Job;
 use gyrofx_codegen::output_folder;
+use gyrofx_job::formats::{analyse, fractions_for};
 
 /// Prove the formats: for any input inside the ADC's range, the range of every analysed
 /// quantization point (worst-case peak gain of the linear blocks, interval arithmetic, the
@@ -67,7 +66,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
     }
     let config = args.config.load()?;
     let samples = args.samples.unwrap_or(config.samples) as u64;
-    let job = Job::new(config.clone())?;
+    let job = gyrofx_codegen::blocks::checked_job(config.clone())?;
     let analysis = analyse(&job, samples, args.switches as u64);
     let budget = match &args.output_error {
         None => None,

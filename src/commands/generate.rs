@@ -7,9 +7,9 @@ use std::process::ExitCode;
 use anyhow::Result;
 
 use gyrofx_codegen::generate::{generate, overflow_list, Contents, Options, Output};
-use gyrofx_codegen::job::Job;
 use gyrofx_codegen::progress::Progress;
-use gyrofx_codegen::recording::{Recording, Units};
+use gyrofx_job::job::Job;
+use gyrofx_job::recording::{Recording, Units};
 
 use super::options::{ConfigSource, OutputFolder};
 use super::usage;
@@ -129,7 +129,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
     if let Some(s) = seed {
         config.seed = s;
     }
-    let mut job = Job::new(config)?;
+    let mut job = gyrofx_codegen::blocks::checked_job(config)?;
     if let Some(recording) = recording {
         job = job.with_recording(recording)?;
     }

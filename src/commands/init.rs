@@ -4,7 +4,7 @@ use std::process::ExitCode;
 
 use anyhow::Result;
 
-use gyrofx_codegen::config::{preset, DEFAULT_TOML};
+use gyrofx_job::config::{preset, DEFAULT_TOML};
 
 /// Print the annotated default config, or a preset (an overlay of it).
 #[derive(clap::Args)]

@@ -10,12 +10,12 @@ use anyhow::Result;
 
 use super::usage;
 
-use gyrofx_codegen::config::{Config, MAX_SAMPLES, MAX_SEED, PRESETS};
 use gyrofx_codegen::generate::{provenance, Output};
-use gyrofx_codegen::input::{read_column, read_column_with_gaps};
-use gyrofx_codegen::job::Job;
 use gyrofx_codegen::output_folder::Replace;
 use gyrofx_codegen::writers::Provenance;
+use gyrofx_job::config::{Config, MAX_SAMPLES, MAX_SEED, PRESETS};
+use gyrofx_job::input::{read_column, read_column_with_gaps};
+use gyrofx_job::job::Job;
 use gyrofx_model::analysis::{MAX_RATE_HZ, MIN_RATE_HZ};
 
 // One column of a CSV record (ar, davar, filter). A command whose help words these flags

@@ -6,7 +6,6 @@ use std::process::ExitCode;
 use anyhow::Result;
 
 use gyrofx_codegen::generate::Output;
-use gyrofx_codegen::job::Job;
 use gyrofx_codegen::place_route::{self, Target};
 use gyrofx_codegen::synth::{synthesize, PlaceRequest, LOOP_TOP};
 
@@ -67,7 +66,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
     let _lock =
         super::options::claim_output_folder(out, &[("--config", source.config.as_deref())])?;
     let config = source.load()?;
-    let job = Job::new(config)?;
+    let job = gyrofx_codegen::blocks::checked_job(config)?;
     let mut provenance = source.provenance(&job, Output::Synthesis);
     if !place.targets.is_empty() {
         let names = |list: Vec<&str>| list.join(",");

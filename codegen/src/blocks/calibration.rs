@@ -4,7 +4,7 @@
 
 use super::{mode_params, RomImages, RtlBlock, VectorBuilder};
 use crate::block::{Block, Output, Param, Signal};
-use crate::job::Job;
+use gyrofx_job::job::Job;
 
 /// The calibration block.
 pub struct Calibration;

@@ -18,10 +18,10 @@ use serde_json::json;
 
 use super::{flag, mode_params, ChainSample, RomImages, RtlBlock, VectorBuilder};
 use crate::block::{Block, Output, Param, Signal};
-use crate::config::GyroLoop as LoopConfig;
-use crate::job::Job;
 use crate::rom::Rom;
 use crate::vectors::{Results, Run};
+use gyrofx_job::config::GyroLoop as LoopConfig;
+use gyrofx_job::job::Job;
 
 /// The gyro-loop block.
 pub struct GyroLoop;

@@ -24,10 +24,10 @@ use gyrofx_model::chain::{FloatSample, Sample};
 use gyrofx_model::fx::{Overflow, Rounding};
 
 use crate::block::{Block, Param};
-use crate::job::Job;
 use crate::rom::{self, Rom, RomFormat};
 use crate::vectors::{Results, Run};
 use crate::writers::Provenance;
+use gyrofx_job::job::Job;
 
 /// One RTL block.
 pub trait RtlBlock: Sync {
@@ -44,6 +44,15 @@ pub trait RtlBlock: Sync {
     /// the resonator plant).
     fn in_package(&self, _job: &Job) -> bool {
         true
+    }
+
+    /// What the block's RTL needs of `job` beyond what [`Job::new`] validates (the system's:
+    /// both loops share every parameter `gyrofx_system` gives them once).
+    ///
+    /// # Errors
+    /// [`gyrofx_job::error::Error::Config`] naming the field.
+    fn check(&self, _job: &Job) -> gyrofx_job::error::Result<()> {
+        Ok(())
     }
 
     /// The ROMs the block owns (the package writes each in every format under `roms/`).
@@ -92,6 +101,19 @@ pub static REGISTRY: &[&dyn RtlBlock] = &[
 /// The blocks of `job`'s package, in registry order.
 pub fn of(job: &Job) -> impl Iterator<Item = &'static dyn RtlBlock> + '_ {
     REGISTRY.iter().copied().filter(|b| b.in_package(job))
+}
+
+/// [`Job::new`], then the check of every block in its package ([`RtlBlock::check`]): the job
+/// every command that builds RTL, vectors or netlists starts from.
+///
+/// # Errors
+/// The first config, design or plan error, then the first block's refusal.
+pub fn checked_job(config: gyrofx_job::config::Config) -> gyrofx_job::error::Result<Job> {
+    let job = Job::new(config)?;
+    for block in of(&job) {
+        block.check(&job)?;
+    }
+    Ok(job)
 }
 
 /// The registered block called `name`.

@@ -16,21 +16,20 @@
 //! the report cover that).
 
 use gyrofx_model::chain;
-use gyrofx_model::estimator;
-use gyrofx_model::fx::CoefficientFormat;
 use gyrofx_model::gyro_loop::gyro::Plan as LoopPlan;
 use gyrofx_model::resonator::Mode;
-use gyrofx_model::sequencer::Schedule;
 use gyrofx_model::system::{record, GyroPhysics, RecordedSample};
 use serde_json::json;
 
 use super::{flag, gyro_loop, kf, top, ChainSample, RomImages, RtlBlock, VectorBuilder};
 use crate::block::{Block, Output, Param, Signal};
-use crate::config::GyroLoop as LoopConfig;
-use crate::error::{Error, Result};
-use crate::job::Job;
 use crate::rom::Rom;
 use crate::vectors::{Results, Run};
+use gyrofx_job::config::GyroLoop as LoopConfig;
+use gyrofx_job::error::{Error, Result};
+use gyrofx_job::job::Job;
+
+pub use gyrofx_job::system::{chain_plan, schedule, BLANK, INTERVAL_LENGTH};
 
 /// The system block.
 pub struct System;
@@ -38,10 +37,6 @@ pub struct System;
 /// Name of the system chain's estimator gain ROM (its schedule's, not the configured one's).
 pub const GAINS_ROM: &str = "system_estimator_gains";
 
-/// Chain samples per interval of the system vectors' schedule.
-pub const INTERVAL_LENGTH: usize = 3;
-/// Blanked chain samples at the start of each interval there.
-pub const BLANK: usize = 1;
 /// Estimator windows after the start-up.
 pub const WINDOWS: usize = 2;
 /// Seconds of start-up with `enable` low, rounded up to whole chain periods (the loops lock in
@@ -54,41 +49,6 @@ pub const RATE_DPS: f64 = 10.0;
 /// testbench always allows: the loop's four stages, then the chain's six
 /// ([`super::top::SETTLE_CLOCKS`] + 1).
 pub const SETTLE_CLOCKS: u32 = 4 + super::top::SETTLE_CLOCKS;
-
-/// The system vectors' schedule: the configured one with L = [`INTERVAL_LENGTH`] and
-/// M = [`BLANK`]; B runs [`BLANK`] samples behind A when the configured schedule staggers.
-pub fn schedule(configured: &Schedule) -> Schedule {
-    Schedule {
-        interval_length: INTERVAL_LENGTH,
-        blank: BLANK,
-        stagger: if configured.stagger > 0 { BLANK } else { 0 },
-        ..configured.clone()
-    }
-}
-
-/// The system's chain: the configured estimator settings on [`schedule`] (the reciprocal's
-/// fraction bits re-derived for `1/(L − M)`, its width kept) and the configured KF.
-///
-/// # Errors
-/// [`Error::Estimator`] when the estimator cannot be planned on the short schedule.
-pub fn chain_plan(
-    configured: &estimator::Spec,
-    kf: &gyrofx_model::kf::Plan,
-) -> Result<chain::Plan> {
-    let mut spec = configured.clone();
-    spec.schedule = schedule(&configured.schedule);
-    let width = match spec.reciprocal {
-        CoefficientFormat::Auto { width } => width,
-        CoefficientFormat::Fixed(format) => format.width,
-    };
-    spec.reciprocal = CoefficientFormat::Auto { width };
-    let plan = estimator::Plan::new(&spec).map_err(Error::Estimator)?;
-    chain::Plan::new(plan, kf.clone()).map_err(|e| Error::Config {
-        field: "estimator / kf formats (system vectors)".into(),
-        value: String::new(),
-        allowed: e.to_string(),
-    })
-}
 
 /// Whether loop parameter `name` differs between the gyros (each loop gets its own, `A_` or
 /// `B_` prefixed): the per-mode values and everything designed from the gyro's physics.
@@ -169,6 +129,12 @@ pub fn loop_params(loops: [&LoopPlan; 2], sine_file: &str, taps_file: &str) -> R
 }
 
 impl RtlBlock for System {
+    fn check(&self, job: &Job) -> Result<()> {
+        // gyrofx_system gives both loops one value of every shared parameter: refuse
+        // resonators whose loop designs differ in one (ROM file names do not matter).
+        loop_params([&job.gyro_loops[0].plan, &job.gyro_loops[1].plan], "", "").map(|_| ())
+    }
+
     fn name(&self) -> &'static str {
         "system"
     }
@@ -250,7 +216,7 @@ impl RtlBlock for System {
                 &sine.0,
                 &taps.0,
             )
-            .expect("Job::new checked that the loops share what the RTL shares"),
+            .expect("checked_job checked that the loops share what the RTL shares"),
         );
         block.roms.push(gains);
         block.roms.push(coefficients);
@@ -434,7 +400,7 @@ impl VectorBuilder for Vectors<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::{preset, Config, PRESETS};
+    use gyrofx_job::config::{preset, Config, PRESETS};
 
     fn resonator_jobs() -> Vec<(String, Job)> {
         let mut jobs = vec![("default".to_string(), Job::new(Config::embedded()).unwrap())];

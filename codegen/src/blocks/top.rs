@@ -9,10 +9,10 @@ use serde_json::json;
 use super::{estimator, flag, kf, mode_bit, mode_params, sequencer};
 use super::{ChainSample, RomImages, RtlBlock, VectorBuilder};
 use crate::block::{Block, Output, Param, Signal};
-use crate::job::Job;
 use crate::rom::Rom;
 use crate::stats::Accumulator;
 use crate::vectors::{Results, Run};
+use gyrofx_job::job::Job;
 
 /// The top block.
 pub struct Top;

@@ -11,9 +11,9 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 
-use crate::error::{Error, Result};
-use crate::job::Job;
 use crate::synth::{self, Design, Resources};
+use gyrofx_job::error::{Error, Result};
+use gyrofx_job::job::Job;
 
 /// The cache folder when `--cache` is not given: `$XDG_CACHE_HOME/gyrofx/synth`, else
 /// `$HOME/.cache/gyrofx/synth`; `None` when neither variable is set.

@@ -40,11 +40,11 @@ use gyrofx_model::stimulus::adc;
 use gyrofx_model::system::loop_mode;
 use serde::Serialize;
 
-use crate::config::GyroLoop;
-use crate::error::Result;
-use crate::job::Job;
 use crate::stats::Accumulator;
 use crate::vectors::{bw_sel_at, bw_sel_switches, started_loop, EstimatorCounts, KfCounts};
+use gyrofx_job::config::GyroLoop;
+use gyrofx_job::error::Result;
+use gyrofx_job::job::Job;
 
 /// The averaging time of the ADEV and ARW readings, s.
 pub const TAU_S: f64 = 1.0;

@@ -8,7 +8,7 @@ use std::path::Path;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::error::{Error, Result};
+use gyrofx_job::error::{Error, Result};
 
 use super::target::Target;
 

@@ -8,7 +8,7 @@
 
 use gyrofx_model::fx::Format;
 
-use crate::formats::Analysis;
+use gyrofx_job::formats::Analysis;
 
 /// The most candidates one run explores.
 pub const MAX_CANDIDATES: usize = 200;
@@ -400,8 +400,8 @@ mod tests {
     }
 
     fn default_analysis() -> Analysis {
-        let job = crate::job::Job::new(crate::config::Config::embedded()).unwrap();
-        crate::formats::analyse(&job, 10_000, 10)
+        let job = gyrofx_job::job::Job::new(gyrofx_job::config::Config::embedded()).unwrap();
+        gyrofx_job::formats::analyse(&job, 10_000, 10)
     }
 
     #[test]

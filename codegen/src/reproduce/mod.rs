@@ -6,7 +6,7 @@ use gyrofx_model::analysis::allan::{self, Grid, Kind, Point};
 use gyrofx_model::analysis::noise;
 use gyrofx_model::plant::GyroErrors;
 
-use crate::error::{Error, Result};
+use gyrofx_job::error::{Error, Result};
 
 mod paper_000;
 mod paper_002;

@@ -12,7 +12,7 @@ use gyrofx_model::kf::FloatKf;
 use gyrofx_model::plant::GyroErrors;
 
 use super::{gyro_record, paper_gyro, Curves};
-use crate::error::{Error, Result};
+use gyrofx_job::error::{Error, Result};
 
 /// Paper 000's sample rate, Hz.
 pub const FS_000_HZ: f64 = 200.0;

@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 use gyrofx_model::plant::GyroErrors;
 
 use super::{gyro_record, paper_gyro, terms};
-use crate::error::{Error, Result};
+use gyrofx_job::error::{Error, Result};
 
 /// Paper 002's record: 60000 samples at 100 Hz, a disturbance from 237.3 s to 286.3 s.
 pub const SAMPLES_002: usize = 60_000;

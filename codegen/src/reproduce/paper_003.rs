@@ -15,7 +15,7 @@ use gyrofx_model::fx::{Format, Overflow, Rounding};
 use gyrofx_model::mean_filter::{self, FloatMeanFilter};
 
 use super::{detrend, gyro_record, paper_gyro, terms, variance, Curves};
-use crate::error::{Error, Result};
+use gyrofx_job::error::{Error, Result};
 
 /// Paper 003's sample rate, Hz.
 pub const FS_HZ: f64 = 50.0;

@@ -13,7 +13,7 @@ use gyrofx_model::gyro_loop::figures::{characterize, Characterization, Procedure
 use gyrofx_model::resonator::{Mode, ModeFigures};
 
 use super::{terms, Curves};
-use crate::error::{Error, Result};
+use gyrofx_job::error::{Error, Result};
 
 /// Paper 004's Table 2 (°/s units): Q (µrad), N (°/√s), B (°/s), K (°/s^1.5), R (°/s²) for
 /// gyro A, gyro B, mode reversal, and mode reversal with threshold denoising.
@@ -59,7 +59,7 @@ pub struct ResonatorBias {
 }
 
 /// Both gyros of `config` at resonator level: each closed loop characterized (noise off).
-fn resonator_biases(config: &crate::config::Config) -> Result<Vec<ResonatorBias>> {
+fn resonator_biases(config: &gyrofx_job::config::Config) -> Result<Vec<ResonatorBias>> {
     let loops = config.gyro_loops()?;
     std::thread::scope(|scope| {
         let handles: Vec<_> = loops
@@ -115,14 +115,14 @@ pub fn paper_004(samples: usize, seed: u64) -> Result<Paper004> {
             "--samples {samples} is too few for paper 004's comparison: at least 20000 (400 s)"
         )));
     }
-    let mut config = crate::config::Config::from_preset_and_file(Some("gu2019"), None)?;
+    let mut config = gyrofx_job::config::Config::from_preset_and_file(Some("gu2019"), None)?;
     let resonators = resonator_biases(&config)?;
     // Table 2's terms are the paper's measured gyro noise, which the preset's rate-level gyros
     // carry; the resonator's noise is physical ([front_end]) and not fitted to them.
     config.plant.model = "rate".into();
     config.samples = samples;
     config.seed = seed;
-    let job = crate::job::Job::new(config)?;
+    let job = crate::blocks::checked_job(config)?;
     let est = &job.chain.estimator;
     let fs = job.config.stimulus.fs_hz;
     let mut sequencer = Sequencer::new(&est.schedule);

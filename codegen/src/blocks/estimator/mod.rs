@@ -1,17 +1,15 @@
 //! `estimator` — `gyrofx_bias_estimator`, the least-squares bias estimator of mode reversal:
 //! interval means and `b = G m` at every window end (SPEC §1.3, `docs/blocks/estimator.md`).
 
-pub mod config;
-
 use gyrofx_model::estimator::Plan;
 use serde_json::json;
 
 use super::{flag, mode_params, ChainSample, RomImages, RtlBlock, VectorBuilder};
 use crate::block::{Block, Output, Param, Signal};
-use crate::job::Job;
 use crate::rom::{Rom, RomFormat, ROM_FOLDER};
 use crate::stats::Accumulator;
 use crate::vectors::{Results, Run};
+use gyrofx_job::job::Job;
 
 /// The estimator block.
 pub struct Estimator;

@@ -2,8 +2,6 @@
 //! bandwidth (SPEC §1.4, `docs/blocks/kf.md`). Its vectors: the chain's KF inputs, then a
 //! directed segment (rounding ties and full scale, each from reset).
 
-pub mod config;
-
 use gyrofx_model::kf::bound::rate_error_bound_lsb;
 use gyrofx_model::kf::{FixedKf, FloatKf, OverflowCounts, Plan};
 use serde::Serialize;
@@ -11,11 +9,11 @@ use serde_json::json;
 
 use super::{mode_params, ChainSample, RomImages, RtlBlock, VectorBuilder};
 use crate::block::{Block, Output, Param, Signal};
-use crate::job::Job;
 use crate::report;
 use crate::rom::{Rom, RomFormat, ROM_FOLDER};
 use crate::stats::Accumulator;
 use crate::vectors::{Results, Run};
+use gyrofx_job::job::Job;
 
 /// The KF block.
 pub struct Kf;

@@ -2,18 +2,16 @@
 //! 003, a block beside the chain (SPEC §1.5, `docs/blocks/mean_filter.md`). Its vectors: gyro
 //! A's ADC samples with gross errors added, the chain's reset, then directed blocks.
 
-pub mod config;
-
 use gyrofx_model::mean_filter::{serial, FixedMeanFilter, FloatMeanFilter, Plan};
 use serde_json::json;
 
 use super::{mode_params, ChainSample, RomImages, RtlBlock, VectorBuilder};
 use crate::block::{Block, Output, Param, Signal};
-use crate::config::Architecture;
-use crate::job::Job;
 use crate::rom::{Rom, RomFormat, ROM_FOLDER};
 use crate::stats::Accumulator;
 use crate::vectors::{Results, Run};
+use gyrofx_job::config::Architecture;
+use gyrofx_job::job::Job;
 
 /// The mean-filter block.
 pub struct MeanFilter;

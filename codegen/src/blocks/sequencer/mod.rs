@@ -2,14 +2,12 @@
 //! mode, blanking, interval index and interval/window strobes (SPEC §1.2,
 //! `docs/blocks/sequencer.md`).
 
-pub mod config;
-
 use gyrofx_model::sequencer::Schedule;
 
 use super::{flag, mode_bit, ChainSample, RomImages, RtlBlock, VectorBuilder};
 use crate::block::{Block, Output, Param, Signal};
-use crate::job::Job;
 use crate::vectors::Results;
+use gyrofx_job::job::Job;
 
 /// The sequencer block.
 pub struct Sequencer;

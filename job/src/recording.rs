@@ -22,8 +22,8 @@ use gyrofx_model::sequencer::{Schedule, Sequencer};
 use sha2::{Digest, Sha256};
 
 use crate::error::{Error, Result};
+use crate::hash::digest_hex;
 use crate::input::{read_header, Columns};
-use crate::package::digest_hex;
 
 /// The unit of the recorded rates.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

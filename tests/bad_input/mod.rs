@@ -2,13 +2,11 @@
 //! and no output left behind.
 
 mod cli;
-#[path = "../common/mod.rs"]
-mod common;
 mod files;
 mod readers;
 mod saturation;
 
-use common::*;
+use crate::common::*;
 
 /// Generates with `toml` as config into a fresh folder; asserts failure, that every `needle`
 /// is in the message, and that no output (nor staging folder) was left.

@@ -30,7 +30,7 @@ pub struct Job {
     /// every package).
     pub gyro_loops: [GyroLoop; 2],
     /// The chain of the system vectors (both loops feeding the chain), on its short schedule
-    /// ([`crate::blocks::system::chain_plan`]); `None` on the rate plant, whose loops' output
+    /// ([`crate::system::chain_plan`]); `None` on the rate plant, whose loops' output
     /// need not be the chain's input.
     pub system_chain: Option<chain::Plan>,
     /// Recorded gyro outputs that drive the chain instead of the plant (`generate
@@ -129,19 +129,7 @@ impl Job {
         let mean_filter =
             mean_filter::Plan::new(&settings.mean_filter).map_err(Error::MeanFilter)?;
         let system_chain = match settings.resonator {
-            Some(_) => {
-                // gyrofx_system gives both loops one value of every shared parameter: refuse
-                // resonators whose loop designs differ in one (ROM file names do not matter).
-                crate::blocks::system::loop_params(
-                    [&gyro_loops[0].plan, &gyro_loops[1].plan],
-                    "",
-                    "",
-                )?;
-                Some(crate::blocks::system::chain_plan(
-                    &settings.estimator,
-                    &chain.kf,
-                )?)
-            }
+            Some(_) => Some(crate::system::chain_plan(&settings.estimator, &chain.kf)?),
             None => None,
         };
         let serial = match settings.architecture {

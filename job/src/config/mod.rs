@@ -17,16 +17,20 @@ use gyrofx_model::resonator::ResonatorParams;
 use crate::error::{Error, Result};
 
 pub(crate) mod check;
+mod estimator;
 mod gyro;
+mod kf;
+mod mean_filter;
 mod resonator;
+mod sequencer;
 mod stimulus;
 
-pub use crate::blocks::estimator::config::EstimatorConfig;
-pub use crate::blocks::kf::config::{KfConfig, KfSettings};
-pub use crate::blocks::mean_filter::config::MeanFilterConfig;
-pub use crate::blocks::sequencer::config::SequencerConfig;
+pub use estimator::EstimatorConfig;
 pub use gyro::PlantConfig;
+pub use kf::{KfConfig, KfSettings};
+pub use mean_filter::MeanFilterConfig;
 pub use resonator::GyroLoop;
+pub use sequencer::SequencerConfig;
 pub use stimulus::{Source, StimulusConfig};
 
 /// Largest `seed`: the config is written as TOML, whose integers are 64-bit signed.
