@@ -79,6 +79,36 @@ pub fn verilog_sources_of(module: &str) -> Vec<&'static (&'static str, &'static 
         .collect()
 }
 
+/// The VHDL sources a testbench of `module` analyses: the module's file, the testbench package,
+/// and every unit they name as `work.<unit>` (entities they instantiate, packages they use),
+/// transitively, in [`VHDL_SOURCES`] (compile) order. Read from the VHDL text itself, like
+/// [`verilog_sources_of`], so it cannot drift from the RTL. Analysing these alone, not the
+/// whole `hdl/`, is what makes a short GHDL run short: analysis took most of it.
+pub fn vhdl_sources_of(module: &str) -> Vec<&'static (&'static str, &'static str)> {
+    let mut needed = vec![module.to_string(), "gyrofx_testbench_pkg".to_string()];
+    let mut next = 0;
+    while next < needed.len() {
+        let name = format!("{}.vhd", needed[next]);
+        next += 1;
+        let Some((_, source)) = VHDL_SOURCES.iter().find(|(n, _)| *n == name) else {
+            continue;
+        };
+        for (start, _) in source.match_indices("work.") {
+            let unit: String = source[start + "work.".len()..]
+                .chars()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                .collect();
+            if unit.starts_with("gyrofx_") && !needed.contains(&unit) {
+                needed.push(unit);
+            }
+        }
+    }
+    VHDL_SOURCES
+        .iter()
+        .filter(|(n, _)| needed.iter().any(|m| format!("{m}.vhd") == *n))
+        .collect()
+}
+
 /// The reference RTL in VHDL-2008, in compile order (packages first), and the package the VHDL
 /// testbenches share (last: simulation only).
 pub const VHDL_SOURCES: [(&str, &str); 18] = [
@@ -143,7 +173,7 @@ pub const VHDL_SOURCES: [(&str, &str); 18] = [
 
 #[cfg(test)]
 mod tests {
-    use super::verilog_sources_of;
+    use super::{verilog_sources_of, vhdl_sources_of};
 
     fn names(module: &str) -> Vec<&'static str> {
         verilog_sources_of(module).iter().map(|(n, _)| *n).collect()
@@ -185,5 +215,45 @@ mod tests {
                 "gyrofx_gyro_loop.v",
             ]
         );
+    }
+
+    /// A VHDL testbench analyses its DUT's units, the packages they use and the testbench
+    /// package, in compile order: the KF's bench not the loop's files, the system's every
+    /// file but the serial chain's and the mean filter (beside the chain, not in it).
+    #[test]
+    fn a_vhdl_benchs_sources_follow_its_instances_and_packages() {
+        let names = |module: &str| -> Vec<&'static str> {
+            vhdl_sources_of(module).iter().map(|(n, _)| *n).collect()
+        };
+        assert_eq!(
+            names("gyrofx_kf"),
+            [
+                "gyrofx_mem_pkg.vhd",
+                "gyrofx_quantize.vhd",
+                "gyrofx_kf.vhd",
+                "gyrofx_testbench_pkg.vhd",
+            ]
+        );
+        assert_eq!(
+            names("gyrofx_sequencer"),
+            [
+                "gyrofx_mem_pkg.vhd",
+                "gyrofx_sequencer.vhd",
+                "gyrofx_testbench_pkg.vhd",
+            ]
+        );
+        let system = names("gyrofx_system");
+        let left_out = [
+            "gyrofx_mean_filter.vhd",
+            "gyrofx_mean_filter_serial.vhd",
+            "gyrofx_serial_engine.vhd",
+            "gyrofx_top_serial.vhd",
+        ];
+        let expected: Vec<&str> = super::VHDL_SOURCES
+            .iter()
+            .map(|(n, _)| *n)
+            .filter(|n| !left_out.contains(n))
+            .collect();
+        assert_eq!(system, expected);
     }
 }

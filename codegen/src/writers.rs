@@ -127,7 +127,7 @@ pub fn vector_csv(block: &Block, provenance: &Provenance) -> String {
 /// testbench options in every simulator (plusargs in Verilog, generics in VHDL). Each recipe runs
 /// in the block's folder.
 pub fn makefile(blocks: &[Block], provenance: &Provenance) -> String {
-    let sources = |list: &[(&str, &str)]| -> String {
+    let sources = |list: &[&(&str, &str)]| -> String {
         list.iter()
             .map(|(n, _)| format!("../hdl/{n}"))
             .collect::<Vec<_>>()
@@ -171,8 +171,8 @@ sim-ghdl:{ghdl}
 ",
         header = provenance.line("#"),
         list = names.join(", "),
-        rtl = sources(&RTL_SOURCES),
-        vhdl = sources(&VHDL_SOURCES),
+        rtl = sources(&RTL_SOURCES.iter().collect::<Vec<_>>()),
+        vhdl = sources(&VHDL_SOURCES.iter().collect::<Vec<_>>()),
         phony = names
             .iter()
             .map(|n| format!(" iverilog-{n} verilator-{n} ghdl-{n}"))
@@ -197,10 +197,11 @@ verilator-{name}:
 
 ghdl-{name}:
 \t@echo \"== {name}\"
-\tcd {name} && rm -rf ghdl_work && mkdir ghdl_work && $(GHDL) -a --std=08 -Werror --workdir=ghdl_work $(VHDL) {tb}.vhd
+\tcd {name} && rm -rf ghdl_work && mkdir ghdl_work && $(GHDL) -a --std=08 -Werror --workdir=ghdl_work {vhdl} {tb}.vhd
 \tcd {name} && $(GHDL) --elab-run --std=08 --workdir=ghdl_work {tb} $(TB_GENERICS) --ieee-asserts=disable-at-0 $(if $(filter 1,$(WAVES)),--vcd={tb}.vcd) $(GHDL_RUN_FLAGS)
 ",
             name = b.name,
+            vhdl = sources(&crate::hdl::vhdl_sources_of(b.module)),
         );
     }
     let cocotb = crate::cocotb::tested(blocks);
