@@ -3,5 +3,5 @@
 # when a change to the model, the writers or the default is intended; commit the result.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-GYROFX_UPDATE_GOLDEN=1 cargo test --test golden
+GYROFX_UPDATE_GOLDEN=1 cargo test --test main golden::
 git status --short vectors/

@@ -186,10 +186,6 @@ pub const BLOCKS: [&str; 7] = [
     "system",
 ];
 
-/// How many blocks a rate-plant package has: every block but the system (its loops' output
-/// need not be the chain's input there).
-pub const RATE_PLANT_BLOCK_COUNT: usize = BLOCKS.len() - 1;
-
 /// The chain's blocks (every block but the gyro loop and the system, whose 40 000-sample
 /// closed-loop testbenches take a minute or more in GHDL), as `verify --blocks` takes them: tests about the
 /// chain run only these.
