@@ -91,7 +91,9 @@ fn the_chain_synthesizes_and_wider_formats_cost_more_and_latches_fail() {
     .unwrap();
     let job = gyrofx_codegen::blocks::checked_job(config).unwrap();
     for (name, content) in design_inputs(&job, Design::Chain) {
-        std::fs::write(wide.join(name), content).unwrap();
+        let path = wide.join(name);
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(path, content).unwrap();
     }
     let wide_resources = serde_json::json!({ "resources": measure(&wide).unwrap() });
     for (flow, what) in [
