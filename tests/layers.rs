@@ -105,6 +105,12 @@ fn code(text: &str) -> String {
 /// The top-level modules of the crate at `src` and, for each, the other top-level modules its
 /// files import.
 fn imports(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
+    imports_below(src, "")
+}
+
+/// [`imports`] of the modules below `crate::<inside>` (`inside` empty: the crate's), with
+/// `src` their folder: the CLI's commands are all below `crate::commands`.
+fn imports_below(src: &Path, inside: &str) -> BTreeMap<String, BTreeSet<String>> {
     let mut graph: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
     for file in sources(src) {
         let relative = file.strip_prefix(src).unwrap();
@@ -115,7 +121,10 @@ fn imports(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
         if relative.file_name().is_some_and(|n| n == "tests.rs") {
             continue;
         }
-        let text = code(&std::fs::read_to_string(&file).unwrap());
+        let mut text = code(&std::fs::read_to_string(&file).unwrap());
+        if !inside.is_empty() {
+            text = text.replace(&format!("crate::{inside}::"), "crate::");
+        }
         let edges = graph.entry(top.clone()).or_default();
         for (at, _) in text.match_indices("crate::") {
             let before = text[..at].chars().next_back();
@@ -187,14 +196,35 @@ fn circles(graph: &BTreeMap<String, BTreeSet<String>>) -> Vec<Vec<String>> {
     found
 }
 
-/// The model and the job have no circle between their modules.
+/// The circles codegen still has, each to be broken and then deleted from here: the run
+/// engine (`vectors`) still names block-specific results, and the blocks read the run's
+/// `Results` (issue 28, item 2). Nothing may join one, and no new circle may form.
+const CODEGEN_CIRCLES_LEFT: &[&[&str]] = &[&["blocks", "vectors"]];
+
+/// The model, the job and the CLI have no circle between their modules; codegen none beyond
+/// [`CODEGEN_CIRCLES_LEFT`].
 #[test]
 fn no_crate_has_an_import_circle_between_its_modules() {
-    for krate in ["model", "job"] {
-        let graph = imports(&repository().join(krate).join("src"));
-        assert!(graph.len() > 5, "{krate}: {graph:?}");
-        let found = circles(&graph);
-        assert!(found.is_empty(), "{krate} has import circles: {found:?}");
+    for (krate, src) in [
+        ("model", repository().join("model/src")),
+        ("job", repository().join("job/src")),
+        ("the CLI", repository().join("src/commands")),
+        ("codegen", repository().join("codegen/src")),
+    ] {
+        let inside = if krate == "the CLI" { "commands" } else { "" };
+        let graph = imports_below(&src, inside);
+        assert!(graph.len() > 2, "{krate}: {graph:?}");
+        let allowed: &[&[&str]] = if krate == "codegen" {
+            CODEGEN_CIRCLES_LEFT
+        } else {
+            &[]
+        };
+        for circle in circles(&graph) {
+            assert!(
+                allowed.iter().any(|a| a.iter().eq(circle.iter())),
+                "{krate} has an import circle: {circle:?} (allowed: {allowed:?})"
+            );
+        }
     }
 }
 

@@ -13,7 +13,7 @@ use std::fmt::Write as _;
 use crate::block::Block;
 use crate::hdl::RTL_SOURCES;
 use crate::testbench::verilog::instance;
-use crate::writers::Provenance;
+use crate::text::Provenance;
 
 /// The shared driver, protocol and scoreboard.
 const SHARED: &str = include_str!("cocotb/gyrofx_cocotb.py");

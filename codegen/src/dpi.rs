@@ -14,7 +14,7 @@ use std::fmt::Write as _;
 
 use crate::block::{Block, Signal};
 use crate::testbench::verilog::instance;
-use crate::writers::Provenance;
+use crate::text::Provenance;
 
 /// Folder of the DPI-C testbenches in a package.
 pub const FOLDER: &str = "dpi";

@@ -18,8 +18,9 @@ use crate::generate::{block_files, block_manifest, BlockFile};
 use crate::hdl;
 use crate::output_folder::{Kind, Replace};
 use crate::package::{Package, Staging};
+use crate::text::Provenance;
 use crate::vector_rows::StagedRows;
-use crate::writers::{self, Provenance};
+use crate::writers;
 use gyrofx_job::error::Result;
 use gyrofx_job::job::Job;
 

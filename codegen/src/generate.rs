@@ -13,8 +13,9 @@ use crate::package::{sha256_hex, FileEntry, Package, Staging, MANIFEST};
 use crate::progress::Progress;
 use crate::rom::{self, RomFormat, ROM_FOLDER};
 use crate::testbench::{verilog, vhdl};
+use crate::text::Provenance;
 use crate::vectors::{self, Run};
-use crate::writers::{self, Provenance};
+use crate::writers;
 use gyrofx_job::error::Result;
 use gyrofx_job::job::Job;
 

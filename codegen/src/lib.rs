@@ -13,6 +13,7 @@
 pub mod block;
 pub mod blocks;
 pub mod cocotb;
+pub mod design;
 pub mod dpi;
 pub mod explore;
 pub mod filter_package;
@@ -32,6 +33,7 @@ pub mod simulate;
 pub mod stats;
 pub mod synth;
 pub mod testbench;
+pub mod text;
 pub mod vector_rows;
 pub mod vectors;
 pub mod writers;

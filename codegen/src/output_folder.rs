@@ -17,8 +17,12 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-use crate::package::{sha256_hex, MANIFEST};
 use gyrofx_job::error::{Error, Result};
+use gyrofx_job::hash::{file_sha256, sha256_hex};
+
+/// The package's file list with each file's SHA-256 (with the marker, what makes a folder a
+/// gyrofx output that may be replaced: [`check`]).
+pub const MANIFEST: &str = "manifest.json";
 
 /// The marker file at the root of every package.
 pub const MARKER: &str = ".gyrofx-package";
@@ -202,11 +206,7 @@ pub fn check(out: &Path, kind: Kind, replace: Replace) -> Result<()> {
     };
     let mut foreign = Vec::new();
     let mut changed = Vec::new();
-    if crate::package::file_sha256(&out.join(MANIFEST))
-        .ok()
-        .as_ref()
-        != Some(manifest_sha256)
-    {
+    if file_sha256(&out.join(MANIFEST)).ok().as_ref() != Some(manifest_sha256) {
         changed.push(MANIFEST.to_string());
     }
     for (path, size) in walk(out)? {
@@ -791,7 +791,7 @@ pub fn verify_contents(out: &Path) -> Result<()> {
         .and_then(|text| serde_json::from_str(&text).ok());
     match marker.and_then(|m| m.manifest_sha256) {
         Some(recorded) => {
-            if crate::package::file_sha256(&out.join(MANIFEST)).ok() != Some(recorded) {
+            if file_sha256(&out.join(MANIFEST)).ok() != Some(recorded) {
                 differences.push(format!("{MANIFEST} changed since gyrofx wrote it"));
             }
         }
@@ -822,7 +822,7 @@ pub fn verify_contents(out: &Path) -> Result<()> {
                 meta.len()
             )),
             Ok(_) => {
-                if crate::package::file_sha256(&file).ok().as_ref() != Some(sha256) {
+                if file_sha256(&file).ok().as_ref() != Some(sha256) {
                     differences.push(format!(
                         "{path} changed (its SHA-256 is not the manifest's)"
                     ));

@@ -5,9 +5,7 @@ use std::path::{Path, PathBuf};
 use crate::output_folder::{self, Kind, Marker, Replace, MARKER, OLD_PREFIX};
 use gyrofx_job::error::{Error, Result};
 
-/// The package's file list with each file's SHA-256 (with the marker, what makes a folder a
-/// gyrofx output that may be replaced: [`output_folder::check`]).
-pub const MANIFEST: &str = "manifest.json";
+pub use crate::output_folder::MANIFEST;
 
 /// Files of an output folder, by relative path: built in memory, or already written into the
 /// staging folder (streamed vector files) with their entries.

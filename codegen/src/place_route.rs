@@ -18,10 +18,21 @@ use serde::Serialize;
 
 use crate::block::Block;
 use crate::blocks::{self, RomImages};
+use crate::design;
 use crate::package::Package;
-use crate::synth;
 use gyrofx_job::error::{Error, Result};
 use gyrofx_job::job::Job;
+
+/// Which blocks `synth` also places and routes, on which targets.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct PlaceRequest {
+    /// The targets (none: no place and route).
+    pub targets: Vec<Target>,
+    /// The blocks, from [`BLOCKS`].
+    pub blocks: Vec<&'static str>,
+    /// Tools run at a time.
+    pub jobs: usize,
+}
 
 /// The blocks placed, in the package's order: the chain's blocks, the chain, the chain in the
 /// serial architecture ([`SERIAL_TOP`]), the mean filter beside it in both architectures
@@ -259,7 +270,7 @@ pub struct Placement {
     pub folder: String,
 }
 
-/// The harness around `block`'s configured module ([`synth::configured_module`]): its inputs
+/// The harness around `block`'s configured module ([`design::configured_module`]): its inputs
 /// (`rst`, `ce` first) are one shift register loaded from `serial_in`; its outputs are
 /// captured when `capture` is high and shifted out on `serial_out` otherwise. Every port bit
 /// thus reaches a pin, and nothing the block computes can be optimized away.
@@ -342,7 +353,7 @@ pub fn harness(block: &Block) -> String {
         input_names = names(&inputs),
         shifted_inputs = shift_source(&inputs),
         output_names = names(&outputs),
-        configured = synth::configured_name(block.module),
+        configured = design::configured_name(block.module),
         ports = ports.join(",\n"),
     )
 }
@@ -381,11 +392,11 @@ const HARNESS_FILE: &str = "harness.v";
 /// The yosys script of `target` for `block`, run in the block's folder; it writes
 /// `<target>/stat.json` (and, for iCE40, `<target>/netlist.json` for nextpnr).
 fn yosys_script(block: &Block, target: Target) -> String {
-    let sources: Vec<&str> = synth::sources(block.module)
+    let sources: Vec<&str> = design::sources(block.module)
         .iter()
         .map(|(n, _)| *n)
         .collect();
-    let configured = synth::configured_name(block.module);
+    let configured = design::configured_name(block.module);
     let folder = target.name();
     match target {
         Target::Xilinx => format!(
@@ -394,7 +405,7 @@ fn yosys_script(block: &Block, target: Target) -> String {
              synth_xilinx -flatten -top {configured}\n\
              tee -q -o {folder}/stat.json stat -json\n",
             sources = sources.join(" "),
-            config = synth::CONFIGURED_FILE,
+            config = design::CONFIGURED_FILE,
         ),
         Target::Ice40Up5k | Target::Ice40Hx8k => format!(
             "read_verilog {sources} {config} {HARNESS_FILE}\n\
@@ -404,7 +415,7 @@ fn yosys_script(block: &Block, target: Target) -> String {
              synth_ice40 {dsp}-top {HARNESS} -json {folder}/netlist.json\n\
              tee -q -o {folder}/stat.json stat -json\n",
             sources = sources.join(" "),
-            config = synth::CONFIGURED_FILE,
+            config = design::CONFIGURED_FILE,
             dsp = if target == Target::Ice40Up5k {
                 "-dsp "
             } else {
@@ -696,7 +707,7 @@ fn place(dir: &Path, block: &Block, target: Target) -> Result<Placement> {
     }
     let cells = module_cells(
         &folder.join("stat.json"),
-        &synth::configured_name(block.module),
+        &design::configured_name(block.module),
     )?;
     let mut placement = Placement {
         target,
@@ -826,8 +837,8 @@ fn sample_rate(rate: f64) -> String {
 pub fn place_and_route(
     job: &Job,
     roms: &RomImages,
-    provenance: &crate::writers::Provenance,
-    request: &synth::PlaceRequest,
+    provenance: &crate::text::Provenance,
+    request: &PlaceRequest,
     work: &Path,
     package: &mut Package,
 ) -> Result<Vec<Placement>> {
@@ -858,7 +869,7 @@ pub fn place_and_route(
     for block in &designs {
         let dir = work.join(FOLDER).join(block.name);
         std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
-        let mut files = synth::design_files(block);
+        let mut files = design::design_files(block);
         files.push((HARNESS_FILE.into(), harness(block)));
         for (name, text) in &files {
             let path = dir.join(name);

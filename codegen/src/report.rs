@@ -6,7 +6,7 @@ use serde::Serialize;
 use gyrofx_model::kf::design::{bandwidth_hz, dc_gain, Design};
 use gyrofx_model::kf::{Plan, COEFFICIENT_NAMES};
 
-use crate::writers::hex;
+use crate::text::hex;
 
 /// One quantized coefficient.
 #[derive(Clone, Debug, PartialEq, Serialize)]

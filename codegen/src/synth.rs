@@ -14,11 +14,16 @@ use serde::{Deserialize, Serialize};
 
 use crate::block::Block;
 use crate::blocks::{self, RomImages};
-use crate::hdl;
+
+use crate::design::connections;
+pub use crate::design::{
+    configured_module, configured_name, design_files, sources, CONFIGURED_FILE,
+};
 use crate::output_folder::{self, Kind, Replace};
 use crate::package::Package;
 use crate::place_route;
-use crate::writers::Provenance;
+pub use crate::place_route::PlaceRequest;
+use crate::text::Provenance;
 use gyrofx_job::error::{Error, Result};
 use gyrofx_job::job::Job;
 
@@ -27,7 +32,7 @@ pub const TOP: &str = "gyrofx_top";
 /// Its block in the registry.
 const TOP_BLOCK: &str = "top";
 /// The second design synthesized: one gyro's loop (gyro A's parameters).
-pub const LOOP_TOP: &str = "gyrofx_gyro_loop";
+pub use crate::design::LOOP_TOP;
 /// Its block in the registry.
 const LOOP_BLOCK: &str = "gyro_loop";
 /// The folder of the loop's scripts, logs and RTL in the synthesis package.
@@ -82,50 +87,9 @@ pub enum Parameters {
     Chparam,
 }
 
-/// The module name of a block's wrapper: the block's module with the job's parameters.
-pub fn configured_name(module: &str) -> String {
-    format!("{module}_configured")
-}
-
 /// The name the synthesized netlist's module gets, under the shell named like the RTL module.
 fn netlist_name(module: &str) -> String {
     format!("{module}_netlist")
-}
-
-/// Each port connected to the signal of its name.
-fn connections(block: &Block) -> String {
-    let mut names = block.clock_ports().to_vec();
-    names.extend(block.inputs.iter().map(|s| s.name));
-    names.extend(block.outputs.iter().map(|o| o.signal.name));
-    names
-        .iter()
-        .map(|name| format!("    .{name}({name})"))
-        .collect::<Vec<_>>()
-        .join(",\n")
-}
-
-/// The wrapper synthesized instead of the block's module: the module instantiated with the
-/// job's parameters, as the testbenches instantiate it.
-pub fn configured_module(block: &Block) -> String {
-    let params: Vec<String> = block
-        .params
-        .iter()
-        .map(|p| format!("    .{}({})", p.name, p.value))
-        .collect();
-    format!(
-        "`default_nettype none\n\
-         // {module} with the job's parameters, passed on an instance (not chparam: see\n\
-         // gyrofx's synth docs) so that yosys computes every width as the simulators do.\n\
-         module {name} (\n{ports}\n);\n\
-         {module} #(\n{params}\n) configured (\n{connections}\n);\n\
-         endmodule\n\
-         `default_nettype wire\n",
-        module = block.module,
-        name = configured_name(block.module),
-        ports = block.port_declarations().join(",\n"),
-        params = params.join(",\n"),
-        connections = connections(block),
-    )
 }
 
 /// The netlist file's first module: named like the RTL module, with its parameters (defaults:
@@ -186,15 +150,6 @@ fn chparams(module: &str, params: &[(String, String)]) -> String {
         .map(|(name, value)| format!("chparam -set {name} {value} {module}\n"))
         .collect()
 }
-
-/// The RTL of the block's module: its file and its submodules' (for the chain, not the mean
-/// filter beside it: yosys would load its ROM image while reading it).
-pub fn sources(module: &str) -> Vec<&'static (&'static str, &'static str)> {
-    hdl::verilog_sources_of(module)
-}
-
-/// The file holding [`configured_module`].
-pub const CONFIGURED_FILE: &str = "configured.v";
 
 /// The folder of a design's netlist: `<module>.v`, the shell ([`netlist_shell`]), and
 /// `<module>_netlist.v`, yosys's gate-level netlist (plain Verilog: gates as expressions,
@@ -451,32 +406,6 @@ pub struct Synthesis {
     pub placements: Vec<place_route::Placement>,
 }
 
-/// A block's design files by name: its RTL (the module's file and its submodules'), the ROM
-/// images it reads and the wrapper with the job's parameters ([`configured_module`]).
-pub fn design_files(block: &Block) -> Vec<(String, String)> {
-    let mut files: Vec<(String, String)> = sources(block.module)
-        .into_iter()
-        .map(|(n, s)| (n.to_string(), s.to_string()))
-        .collect();
-    files.extend(block.roms.iter().cloned());
-    // yosys elaborates every module with its own defaults while reading it, and the loop's
-    // NCO and CIC read their ROM images then: give them the images under their default names.
-    if block.module == LOOP_TOP {
-        let image = |rom: &str| {
-            block
-                .roms
-                .iter()
-                .find(|(name, _)| name.starts_with(rom))
-                .map(|(_, text)| text.clone())
-                .expect("the loop block carries both ROMs")
-        };
-        files.push(("nco_sine.mem".into(), image("gyro_loop_nco_sine")));
-        files.push(("cic_taps.mem".into(), image("gyro_loop_cic_taps")));
-    }
-    files.push((CONFIGURED_FILE.into(), configured_module(block)));
-    files
-}
-
 /// One design's inputs (RTL, ROM images, wrapper, netlist shell, both scripts) by file name.
 fn inputs(top: &Block) -> Vec<(String, String)> {
     let mut inputs = design_files(top);
@@ -533,17 +462,6 @@ fn add_design(
         package.add(format!("{prefix}yosys/{name}"), data);
     }
     Ok(())
-}
-
-/// Which blocks `synth` also places and routes, on which targets.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct PlaceRequest {
-    /// The targets (none: no place and route).
-    pub targets: Vec<place_route::Target>,
-    /// The blocks, from [`place_route::BLOCKS`].
-    pub blocks: Vec<&'static str>,
-    /// Tools run at a time.
-    pub jobs: usize,
 }
 
 /// Synthesizes the chain and one gyro's loop for `job`, places and routes the blocks `place`

@@ -16,7 +16,7 @@ use sha2::{Digest, Sha256};
 use crate::block::{Block, RowSink, Signal};
 use crate::package::FileEntry;
 use crate::testbench::header;
-use crate::writers::{push_hex, Provenance};
+use crate::text::{push_hex, Provenance};
 use gyrofx_job::error::{Error, Result};
 
 /// The signals, gates and extra columns of a block's vector files.

@@ -27,8 +27,8 @@ use crate::blocks::kf::TieCases;
 use crate::blocks::{ChainSample, RomImages};
 use crate::progress::Progress;
 pub use crate::stats::ErrorStats;
+use crate::text::Provenance;
 use crate::vector_rows::StagedRows;
-use crate::writers::Provenance;
 use gyrofx_job::config::GyroLoop;
 use gyrofx_job::error::{Error, Result};
 use gyrofx_job::job::Job;
@@ -815,7 +815,7 @@ mod tests {
             );
         }
     }
-    use crate::writers::Provenance;
+    use crate::text::Provenance;
     use gyrofx_job::config::Config;
     use gyrofx_model::kf::FixedKf;
 

@@ -25,8 +25,8 @@ use gyrofx_model::fx::{Overflow, Rounding};
 
 use crate::block::{Block, Param};
 use crate::rom::{self, Rom, RomFormat};
+use crate::text::Provenance;
 use crate::vectors::{Results, Run};
-use crate::writers::Provenance;
 use gyrofx_job::job::Job;
 
 /// One RTL block.

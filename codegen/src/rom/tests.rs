@@ -1,7 +1,7 @@
 //! Tests of the ROM files: every format reads back the packed codes, a corrupted file does not.
 
 use super::*;
-use crate::writers::Provenance;
+use crate::text::Provenance;
 use gyrofx_model::examples;
 
 fn provenance() -> Provenance {

@@ -4,7 +4,7 @@
 use std::fmt::Write as _;
 
 use super::{Rom, RomFormat};
-use crate::writers::Provenance;
+use crate::text::Provenance;
 
 /// `rom` rendered in `format`, headed by the provenance line, the format's name and the ROM's
 /// shape.

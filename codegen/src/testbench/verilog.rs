@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 
 use super::{header, MAX_REPORTED};
 use crate::block::{Block, Output, Signal, Timing};
-use crate::writers::Provenance;
+use crate::text::Provenance;
 
 fn declaration(kind: &str, s: &Signal, prefix: &str, init: bool) -> String {
     let signed = if s.format.signed { "signed " } else { "" };

@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 
 use super::{header, timeout_clocks, MAX_REPORTED};
 use crate::block::{Block, Output, Signal, Timing};
-use crate::writers::Provenance;
+use crate::text::Provenance;
 
 /// The port type of `s` in the VHDL RTL: signed data, `std_logic` flags, unsigned indices.
 fn port_type(s: &Signal) -> String {
