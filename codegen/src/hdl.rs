@@ -51,32 +51,47 @@ pub const RTL_SOURCES: [(&str, &str); 16] = [
     ("gyrofx_system.v", include_str!("../../hdl/gyrofx_system.v")),
 ];
 
-/// The Verilog sources `module` is made of: its own file and those of every module it
-/// instantiates, transitively, in [`RTL_SOURCES`] order. Found from the RTL text itself (an
-/// instance line starts with the module name and ` #(`), so it cannot drift from the RTL.
-pub fn verilog_sources_of(module: &str) -> Vec<&'static (&'static str, &'static str)> {
-    let file = |m: &str| format!("{m}.v");
-    let mut needed = vec![module.to_string()];
+/// The sources of `sources` (file name, text) that `roots` need: their files, and those of
+/// every unit `references` finds named in a needed file's text, transitively, in the order of
+/// `sources` (compile order). `extension` turns a unit name into its file name.
+fn closure(
+    sources: &'static [(&'static str, &'static str)],
+    extension: &str,
+    roots: &[&str],
+    references: fn(&str) -> Vec<String>,
+) -> Vec<&'static (&'static str, &'static str)> {
+    let file = |unit: &str| format!("{unit}{extension}");
+    let mut needed: Vec<String> = roots.iter().map(|r| r.to_string()).collect();
     let mut next = 0;
     while next < needed.len() {
         let name = file(&needed[next]);
         next += 1;
-        let Some((_, source)) = RTL_SOURCES.iter().find(|(n, _)| *n == name) else {
+        let Some((_, source)) = sources.iter().find(|(n, _)| *n == name) else {
             continue;
         };
-        for line in source.lines() {
-            if let Some((instance, _)) = line.split_once(" #(") {
-                let instance = instance.trim();
-                if instance.starts_with("gyrofx_") && !needed.iter().any(|m| m == instance) {
-                    needed.push(instance.to_string());
-                }
+        for unit in references(source) {
+            if unit.starts_with("gyrofx_") && !needed.contains(&unit) {
+                needed.push(unit);
             }
         }
     }
-    RTL_SOURCES
+    sources
         .iter()
         .filter(|(n, _)| needed.iter().any(|m| file(m) == *n))
         .collect()
+}
+
+/// The Verilog sources `module` is made of: its own file and those of every module it
+/// instantiates, transitively, in [`RTL_SOURCES`] order. Found from the RTL text itself (an
+/// instance line starts with the module name and ` #(`), so it cannot drift from the RTL.
+pub fn verilog_sources_of(module: &str) -> Vec<&'static (&'static str, &'static str)> {
+    closure(&RTL_SOURCES, ".v", &[module], |source| {
+        source
+            .lines()
+            .filter_map(|line| line.split_once(" #("))
+            .map(|(instance, _)| instance.trim().to_string())
+            .collect()
+    })
 }
 
 /// The VHDL sources a testbench of `module` analyses: the module's file, the testbench package,
@@ -85,28 +100,22 @@ pub fn verilog_sources_of(module: &str) -> Vec<&'static (&'static str, &'static 
 /// [`verilog_sources_of`], so it cannot drift from the RTL. Analysing these alone, not the
 /// whole `hdl/`, is what makes a short GHDL run short: analysis took most of it.
 pub fn vhdl_sources_of(module: &str) -> Vec<&'static (&'static str, &'static str)> {
-    let mut needed = vec![module.to_string(), "gyrofx_testbench_pkg".to_string()];
-    let mut next = 0;
-    while next < needed.len() {
-        let name = format!("{}.vhd", needed[next]);
-        next += 1;
-        let Some((_, source)) = VHDL_SOURCES.iter().find(|(n, _)| *n == name) else {
-            continue;
-        };
-        for (start, _) in source.match_indices("work.") {
-            let unit: String = source[start + "work.".len()..]
-                .chars()
-                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
-                .collect();
-            if unit.starts_with("gyrofx_") && !needed.contains(&unit) {
-                needed.push(unit);
-            }
-        }
-    }
-    VHDL_SOURCES
-        .iter()
-        .filter(|(n, _)| needed.iter().any(|m| format!("{m}.vhd") == *n))
-        .collect()
+    closure(
+        &VHDL_SOURCES,
+        ".vhd",
+        &[module, "gyrofx_testbench_pkg"],
+        |source| {
+            source
+                .match_indices("work.")
+                .map(|(start, _)| {
+                    source[start + "work.".len()..]
+                        .chars()
+                        .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                        .collect()
+                })
+                .collect()
+        },
+    )
 }
 
 /// The reference RTL in VHDL-2008, in compile order (packages first), and the package the VHDL
