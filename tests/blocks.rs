@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use gyrofx_codegen::blocks::{RomImages, REGISTRY};
-use gyrofx_codegen::writers::Provenance;
+use gyrofx_codegen::text::Provenance;
 use gyrofx_job::config::Config;
 use gyrofx_job::job::Job;
 

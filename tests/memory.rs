@@ -16,7 +16,7 @@ fn run_with_peak_kib(command: &mut std::process::Command) -> (i32, i64) {
     // never by `Child` (which is dropped without a wait).
     let waited = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
     assert_eq!(waited, pid, "wait4");
-    std::mem::forget(child);
+    drop(child);
     (status, usage.ru_maxrss)
 }
 

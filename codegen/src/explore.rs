@@ -673,7 +673,7 @@ pub fn write(
         package.add("best.toml", toml);
     }
     let mut files = package.paths();
-    files.push(crate::package::MANIFEST.into());
+    files.push(crate::output_folder::MANIFEST.into());
     let manifest = serde_json::json!({
         "tool": "gyrofx",
         "version": env!("CARGO_PKG_VERSION"),
@@ -691,7 +691,7 @@ pub fn write(
         "files": package.entries(),
     });
     package.add(
-        crate::package::MANIFEST,
+        crate::output_folder::MANIFEST,
         serde_json::to_string_pretty(&manifest).expect("manifest serializes") + "\n",
     );
     package.write_atomically(out, replace)?;

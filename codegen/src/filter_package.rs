@@ -113,7 +113,7 @@ impl FilterPackage {
             .insert("files".to_string(), json!(package.entries()));
         let mut text = serde_json::to_string_pretty(&manifest).expect("manifest serializes");
         text.push('\n');
-        package.add(crate::package::MANIFEST, text);
+        package.add(crate::output_folder::MANIFEST, text);
         let files = package.paths();
         package.write_staged(self.staging)?;
         Ok(files)

@@ -8,8 +8,9 @@ use serde_json::json;
 use crate::block::{Block, Timing};
 use crate::blocks::{RomImages, REGISTRY};
 use crate::hdl;
+use crate::output_folder::MANIFEST;
 use crate::output_folder::{Kind, Replace};
-use crate::package::{sha256_hex, FileEntry, Package, Staging, MANIFEST};
+use crate::package::{FileEntry, Package, Staging};
 use crate::progress::Progress;
 use crate::rom::{self, RomFormat, ROM_FOLDER};
 use crate::testbench::{verilog, vhdl};
@@ -17,6 +18,7 @@ use crate::text::Provenance;
 use crate::vectors::{self, Run};
 use crate::writers;
 use gyrofx_job::error::Result;
+use gyrofx_job::hash::sha256_hex;
 use gyrofx_job::job::Job;
 
 /// What `generate` reports back.

@@ -2,10 +2,9 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::output_folder::{self, Kind, Marker, Replace, MARKER, OLD_PREFIX};
+use crate::output_folder::{self, Kind, Marker, Replace, MANIFEST, MARKER, OLD_PREFIX};
 use gyrofx_job::error::{Error, Result};
-
-pub use crate::output_folder::MANIFEST;
+use gyrofx_job::hash::sha256_hex;
 
 /// Files of an output folder, by relative path: built in memory, or already written into the
 /// staging folder (streamed vector files) with their entries.
@@ -34,8 +33,6 @@ pub struct FileEntry {
     /// Size in bytes.
     pub bytes: usize,
 }
-
-pub use gyrofx_job::hash::{digest_hex, file_sha256, sha256_hex};
 
 impl Package {
     /// A package of `kind` holding only its marker, which lists `build_outputs`: the paths

@@ -348,7 +348,7 @@ fn same_roms(design: &Path, block_folder: &Path, block: &str) -> Result<()> {
 }
 
 fn read_manifest(folder: &Path, what: &str) -> Result<serde_json::Value> {
-    let path = folder.join(crate::package::MANIFEST);
+    let path = folder.join(crate::output_folder::MANIFEST);
     let text = std::fs::read_to_string(&path).map_err(|e| {
         Error::Simulation(format!(
             "{} is not {what} (no readable {}: {e})",
@@ -393,7 +393,7 @@ impl Netlists {
             if let Some(missing) = paths.iter().find(|p| !p.is_file()) {
                 return Err(Error::Simulation(format!(
                     "{} lists the netlist {}, which is missing",
-                    folder.join(crate::package::MANIFEST).display(),
+                    folder.join(crate::output_folder::MANIFEST).display(),
                     missing.display()
                 )));
             }

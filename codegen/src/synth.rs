@@ -15,14 +15,13 @@ use serde::{Deserialize, Serialize};
 use crate::block::Block;
 use crate::blocks::{self, RomImages};
 
-use crate::design::connections;
-pub use crate::design::{
-    configured_module, configured_name, design_files, sources, CONFIGURED_FILE,
+use crate::design::{
+    configured_name, connections, design_files, sources, CONFIGURED_FILE, LOOP_TOP,
 };
 use crate::output_folder::{self, Kind, Replace};
 use crate::package::Package;
 use crate::place_route;
-pub use crate::place_route::PlaceRequest;
+use crate::place_route::PlaceRequest;
 use crate::text::Provenance;
 use gyrofx_job::error::{Error, Result};
 use gyrofx_job::job::Job;
@@ -31,8 +30,6 @@ use gyrofx_job::job::Job;
 pub const TOP: &str = "gyrofx_top";
 /// Its block in the registry.
 const TOP_BLOCK: &str = "top";
-/// The second design synthesized: one gyro's loop (gyro A's parameters).
-pub use crate::design::LOOP_TOP;
 /// Its block in the registry.
 const LOOP_BLOCK: &str = "gyro_loop";
 /// The folder of the loop's scripts, logs and RTL in the synthesis package.
@@ -559,7 +556,7 @@ pub fn synthesize(
     });
     let mut text = serde_json::to_string_pretty(&manifest).expect("manifest serializes");
     text.push('\n');
-    package.add(crate::package::MANIFEST, text);
+    package.add(crate::output_folder::MANIFEST, text);
     package.write_atomically(out, replace)?;
     Ok(synthesis)
 }
@@ -608,7 +605,7 @@ pub fn cache_key(inputs: &[(String, String)]) -> String {
             text.push('\n');
         }
     }
-    crate::package::sha256_hex(text.as_bytes())
+    gyrofx_job::hash::sha256_hex(text.as_bytes())
 }
 
 /// `yosys -V`, or empty when yosys is missing (the synthesis then fails with its own error).

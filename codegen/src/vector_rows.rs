@@ -193,7 +193,7 @@ impl HashedFile {
         self.writer.flush().map_err(|e| Error::io(&self.path, e))?;
         Ok(FileEntry {
             path: self.relative,
-            sha256: crate::package::digest_hex(&self.hasher.finalize()),
+            sha256: gyrofx_job::hash::digest_hex(&self.hasher.finalize()),
             bytes: self.bytes,
         })
     }

@@ -879,7 +879,7 @@ mod tests {
                     let bytes = std::fs::read(root.path().join(&entry.path)).unwrap();
                     assert!(bytes == text.as_bytes(), "{} differs", entry.path);
                     assert_eq!(entry.bytes, bytes.len());
-                    assert_eq!(entry.sha256, crate::package::sha256_hex(&bytes));
+                    assert_eq!(entry.sha256, gyrofx_job::hash::sha256_hex(&bytes));
                 }
             }
             assert_eq!(streamed.report, kept.report);

@@ -10,7 +10,7 @@ use crate::hdl::{RTL_SOURCES, VHDL_SOURCES};
 use crate::vector_rows::RowLayout;
 use crate::vectors::Run;
 
-pub use crate::text::{hex, push_hex, Provenance};
+use crate::text::Provenance;
 
 /// The block's parameter include: the DUT's parameters as `P_<NAME>` localparams, the vector
 /// count and the vector file names.

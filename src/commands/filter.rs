@@ -10,9 +10,9 @@ use anyhow::{Context, Result};
 
 use gyrofx_codegen::filter_package::FilterPackage;
 use gyrofx_codegen::output_folder;
-use gyrofx_codegen::package::sha256_hex;
-use gyrofx_codegen::writers::Provenance;
+use gyrofx_codegen::text::Provenance;
 use gyrofx_job::config::Config;
+use gyrofx_job::hash::sha256_hex;
 use gyrofx_job::job::{design_bandwidths, plan_for, Job};
 use gyrofx_model::fx::{from_f64, Overflow, Rounding};
 use gyrofx_model::kf::{FixedKf, FloatKf};
@@ -303,7 +303,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
         let recording = serde_json::json!({
             "input": csv.input.display().to_string(),
             "column": csv.column,
-            "sha256": gyrofx_codegen::package::file_sha256(&csv.input)?,
+            "sha256": gyrofx_job::hash::file_sha256(&csv.input)?,
             "samples": values.len(),
             "fs_hz": fs,
             "bandwidth_hz": settings.bandwidths_hz[0],

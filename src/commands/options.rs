@@ -12,7 +12,7 @@ use super::usage;
 
 use gyrofx_codegen::generate::{provenance, Output};
 use gyrofx_codegen::output_folder::Replace;
-use gyrofx_codegen::writers::Provenance;
+use gyrofx_codegen::text::Provenance;
 use gyrofx_job::config::{Config, MAX_SAMPLES, MAX_SEED, PRESETS};
 use gyrofx_job::input::{read_column, read_column_with_gaps};
 use gyrofx_job::job::Job;

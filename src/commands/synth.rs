@@ -5,9 +5,11 @@ use std::process::ExitCode;
 
 use anyhow::Result;
 
+use gyrofx_codegen::design::LOOP_TOP;
 use gyrofx_codegen::generate::Output;
+use gyrofx_codegen::place_route::PlaceRequest;
 use gyrofx_codegen::place_route::{self, Target};
-use gyrofx_codegen::synth::{synthesize, PlaceRequest, LOOP_TOP};
+use gyrofx_codegen::synth::synthesize;
 
 use super::options::{ConfigSource, OutputFolder};
 

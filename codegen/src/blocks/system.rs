@@ -7,7 +7,7 @@
 //! resonators from reset: [`STARTUP_S`] with `enable` low (both loops lock in normal mode, the
 //! chain holds), then two estimator windows with `enable` high. A window of the configured
 //! schedule is 4 × 150 chain samples of 1000 ADC samples each, far too long for a testbench,
-//! so the system's chain runs a short schedule ([`schedule`]: L = [`INTERVAL_LENGTH`],
+//! so the system's chain runs a short schedule ([`gyrofx_job::system::schedule`]: L = [`INTERVAL_LENGTH`],
 //! M = [`BLANK`], the configured W, pattern and stagger direction) with its own estimator
 //! plan and gain ROM; the KF is the configured one. The vectors prove the wiring bit for bit
 //! — each chain period taken in the mode the sequencer describes, the loops' rates into the
@@ -29,7 +29,7 @@ use gyrofx_job::config::GyroLoop as LoopConfig;
 use gyrofx_job::error::{Error, Result};
 use gyrofx_job::job::Job;
 
-pub use gyrofx_job::system::{chain_plan, schedule, BLANK, INTERVAL_LENGTH};
+use gyrofx_job::system::{BLANK, INTERVAL_LENGTH};
 
 /// The system block.
 pub struct System;

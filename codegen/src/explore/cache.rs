@@ -142,7 +142,7 @@ fn module(job: &Job, design: Design) -> &'static str {
     match design {
         Design::Chain if job.serial.is_some() => "gyrofx_top_serial",
         Design::Chain => synth::TOP,
-        Design::GyroLoop => synth::LOOP_TOP,
+        Design::GyroLoop => crate::design::LOOP_TOP,
     }
 }
 
