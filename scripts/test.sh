@@ -5,7 +5,7 @@
 #
 # Installs the simulators and synthesis tools with apt-get where missing (iverilog, verilator,
 # ghdl, yosys, nextpnr-ice40, make, and the DejaVu font the plots use), FuseSoC with pip in a virtualenv, and
-# maturin, numpy and pytest in another (for the Python package in python/):
+# maturin, numpy, pytest and pytest-xdist in another (for the Python package in python/):
 # a missing simulator is a failure, never a skipped test. Then: rustfmt,
 # clippy, Verilator lint of the RTL, and the whole test suite (unit, property, end-to-end
 # with both simulators, golden vectors), then the Python package's wheel and pytest suite. Benchmarks are compiled (clippy --all-targets) but
@@ -110,14 +110,15 @@ cargo test --workspace
 # vectors, and the package's cocotb tests in Icarus (python/tests/test_cocotb.py).
 echo "== python: cargo fmt, clippy, maturin wheel, pytest"
 python_venv="${XDG_CACHE_HOME:-$HOME/.cache}/gyrofx/python-venv"
-if [ ! -x "$python_venv/bin/maturin" ] || ! "$python_venv/bin/python" -c "import numpy, pytest, cocotb" >/dev/null 2>&1; then
-    echo "== installing maturin, numpy, pytest, cocotb into $python_venv"
+if [ ! -x "$python_venv/bin/maturin" ] || ! "$python_venv/bin/python" -c "import numpy, pytest, xdist, cocotb" >/dev/null 2>&1; then
+    echo "== installing maturin, numpy, pytest, pytest-xdist, cocotb into $python_venv"
     python3 -m venv "$python_venv"
-    "$python_venv/bin/pip" install -q "maturin>=1.5,<2" numpy pytest "cocotb>=2.0,<3"
+    "$python_venv/bin/pip" install -q "maturin>=1.5,<2" numpy pytest pytest-xdist "cocotb>=2.0,<3"
 fi
 cargo fmt --manifest-path python/Cargo.toml -- --check
 cargo clippy --manifest-path python/Cargo.toml --all-targets --quiet -- -D warnings
 rm -rf python/target/wheels
 "$python_venv/bin/maturin" build --release --quiet -m python/Cargo.toml --out python/target/wheels
 "$python_venv/bin/pip" install -q --force-reinstall --no-deps python/target/wheels/gyrofx-*.whl
-GYROFX_CLI="$PWD/target/debug/gyrofx" "$python_venv/bin/python" -m pytest -q python/tests
+# One pytest worker per core (pytest-xdist): each cocotb run is one single-threaded simulator.
+GYROFX_CLI="$PWD/target/debug/gyrofx" "$python_venv/bin/python" -m pytest -q -n auto python/tests

@@ -12,7 +12,9 @@ import pytest
 
 from conftest import cli, run_cli
 
-BLOCKS = ["sequencer", "estimator", "kf", "top", "mean_filter", "gyro_loop", "system"]
+# The longest runs first: pytest-xdist hands the tests out in this order (scripts/test.sh runs a
+# worker per core), and a long one handed out last would run alone at the end.
+BLOCKS = ["system", "gyro_loop", "estimator", "kf", "top", "mean_filter", "sequencer"]
 
 
 def environment(**extra):
@@ -51,21 +53,6 @@ def assert_fails(result, scoreboards):
     assert any(line.startswith(f"FAIL mismatches={scoreboards} ") for line in summary(result)), summary(result)
 
 
-@pytest.mark.parametrize("block", BLOCKS)
-def test_the_cocotb_test_passes_on_the_reference_rtl(package, block):
-    assert_passes(make(package, f"cocotb-{block}"))
-
-
-@pytest.mark.parametrize("block", BLOCKS)
-def test_one_flipped_expected_bit_fails_it(package, block):
-    # The flip hits the 40th expected value of each scoreboard: top has two (rate_out and the
-    # registered bias ports), the others one.
-    scoreboards = 2 if block == "top" else 1
-    # The resonator-level blocks' tests run shorter here (the flip comes early).
-    shorter = {"GYROFX_COCOTB_SAMPLES": "1500"} if block in ("gyro_loop", "system") else {}
-    assert_fails(make(package, f"cocotb-{block}", GYROFX_COCOTB_FLIP_EXPECTED="40", **shorter), scoreboards)
-
-
 def test_the_serial_blocks_pass_it_and_a_flipped_bit_fails_it(tmp_path):
     # architecture = "serial": gyrofx_top_serial and gyrofx_mean_filter_serial, their latency
     # written into the tests by gyrofx.
@@ -79,8 +66,10 @@ def test_the_serial_blocks_pass_it_and_a_flipped_bit_fails_it(tmp_path):
     assert settle > 1000
     assert f"OUTPUT_CLOCKS = {settle}\n" in (folder / "cocotb" / "test_top.py").read_text()
     assert_passes(make(folder, "cocotb-top", GYROFX_COCOTB_SAMPLES="400"))
-    # Two scoreboards: rate_out and the registered bias ports.
-    assert_fails(make(folder, "cocotb-top", GYROFX_COCOTB_SAMPLES="400", GYROFX_COCOTB_FLIP_EXPECTED="40"), 2)
+    # Two scoreboards: rate_out and the registered bias ports. The flip comes at the 40th value
+    # of each; 150 samples reach it on both (rate_out is valid outside the blanking only). Each
+    # sample takes over 1000 clocks of cocotb's Python clock: 400 here would add 35 s.
+    assert_fails(make(folder, "cocotb-top", GYROFX_COCOTB_SAMPLES="150", GYROFX_COCOTB_FLIP_EXPECTED="40"), 2)
     # The sequential mean filter beside it: the next sample after its latency.
     assert (folder / "cocotb" / "cocotb_gyrofx_mean_filter_serial.v").exists()
     idle = manifest["mean_filter"]["min_clocks_per_sample"] - 1
@@ -88,6 +77,21 @@ def test_the_serial_blocks_pass_it_and_a_flipped_bit_fails_it(tmp_path):
     assert f"PIPELINE_CLOCKS = {idle}\n" in (folder / "cocotb" / "test_mean_filter.py").read_text()
     assert_passes(make(folder, "cocotb-mean_filter", GYROFX_COCOTB_SAMPLES="1000"))
     assert_fails(make(folder, "cocotb-mean_filter", GYROFX_COCOTB_SAMPLES="1000", GYROFX_COCOTB_FLIP_EXPECTED="40"), 1)
+
+
+@pytest.mark.parametrize("block", BLOCKS)
+def test_the_cocotb_test_passes_on_the_reference_rtl(package, block):
+    assert_passes(make(package, f"cocotb-{block}"))
+
+
+@pytest.mark.parametrize("block", BLOCKS)
+def test_one_flipped_expected_bit_fails_it(package, block):
+    # The flip hits the 40th expected value of each scoreboard: top has two (rate_out and the
+    # registered bias ports), the others one.
+    scoreboards = 2 if block == "top" else 1
+    # The resonator-level blocks' tests run shorter here (the flip comes early).
+    shorter = {"GYROFX_COCOTB_SAMPLES": "1500"} if block in ("gyro_loop", "system") else {}
+    assert_fails(make(package, f"cocotb-{block}", GYROFX_COCOTB_FLIP_EXPECTED="40", **shorter), scoreboards)
 
 
 def test_a_mutated_rtl_line_fails_it(package, tmp_path):
