@@ -333,7 +333,7 @@ int32_t gyrofx_system_step(struct GyrofxSystem *system,
                            int32_t *estimated);
 
 #ifdef __cplusplus
-}  // extern "C"
-#endif  // __cplusplus
+} // extern "C"
+#endif // __cplusplus
 
-#endif  /* GYROFX_H */
+#endif /* GYROFX_H */
