@@ -1,5 +1,6 @@
 //! `gyrofx synth`: the chain synthesizes in yosys with the config's widths, wider formats cost
-//! more, and the check fails on a latch or a missing module without writing anything.
+//! more, the check fails on a latch or a missing module without writing anything, the blocks
+//! place and route, and the netlists pass the package's vectors.
 
 use std::path::Path;
 
@@ -31,14 +32,27 @@ fn copy_tree(from: &Path, to: &Path) {
     }
 }
 
+/// A config whose netlists show chparam's fault
+/// (`netlists_pass_the_vectors_and_chparam_on_untyped_localparams_fails_them`): chparam's
+/// widths keep `P2_I + 1` integer bits of x2's update, P2_I = P2_W − P2_F < 0, and x2 = (g2/S)·y
+/// must pass 2^P2_I. A 0.2 Hz entry (g2 in s18.31, P2_I = −1, g2/S = 6·10⁻³) at 300 °/s does;
+/// the default (P2_I = −8, g2/S ≈ 10⁻⁶) never does at any rate in range.
+const SLOW: &str = "[stimulus]\nrate_dps = 300.0\n[kf]\nbandwidths_hz = [0.2, 10.0, 20.0]\n";
+
+/// One `synth` run serves every check of this module: the gyro loop's synthesis alone is
+/// over 100 s of yosys, and two tests each paid it. The loop netlist's 40 000 samples in
+/// Verilator run on a thread of their own beside the chain's checks.
 #[test]
-fn the_chain_synthesizes_and_wider_formats_cost_more_and_latches_fail() {
+fn the_chain_and_loop_synthesize_place_and_route_and_their_netlists_pass_the_vectors() {
     let dir = tempfile::tempdir().unwrap();
+    let config = write_config(dir.path(), "slow.toml", SLOW);
     let narrow = dir.path().join("narrow");
     let log = ok(&[
         "synth",
         "--out",
         narrow.to_str().unwrap(),
+        "--config",
+        &config,
         "--target",
         "xilinx,ice40-up5k",
         "--blocks",
@@ -47,8 +61,24 @@ fn the_chain_synthesizes_and_wider_formats_cost_more_and_latches_fail() {
         "2",
     ]);
     assert!(log.contains("synthesis check passed"), "{log}");
+    let loop_netlist = {
+        let (root, config, synth) = (dir.path().to_path_buf(), config.clone(), narrow.clone());
+        std::thread::spawn(move || the_loop_netlist_passes_the_vectors(&root, &config, &synth))
+    };
     check_place_and_route(&narrow, &log);
-    let narrow_manifest = manifest(&narrow);
+    wider_formats_cost_more_and_latches_fail(dir.path(), &narrow);
+    netlists_pass_the_vectors_and_chparam_on_untyped_localparams_fails_them(
+        dir.path(),
+        &config,
+        &narrow,
+    );
+    loop_netlist.join().unwrap();
+}
+
+/// The resources in the manifest and report, the wider chain's cost, and the check failing on
+/// a latch or a missing module without writing anything.
+fn wider_formats_cost_more_and_latches_fail(dir: &Path, narrow: &Path) {
+    let narrow_manifest = manifest(narrow);
     let report = std::fs::read_to_string(narrow.join("report.md")).unwrap();
     for flow_what in [("generic", "flip_flops"), ("xilinx", "luts")] {
         let n = resource(&narrow_manifest, flow_what.0, flow_what.1);
@@ -82,10 +112,10 @@ fn the_chain_synthesizes_and_wider_formats_cost_more_and_latches_fail() {
 
     // The wider chain alone (the loop is the same in both): its design files as `synth`
     // writes them, through the same yosys flows.
-    let wide = dir.path().join("wide");
+    let wide = dir.join("wide");
     std::fs::create_dir_all(&wide).unwrap();
     let config = gyrofx_job::config::Config::from_toml(
-        "[kf]\nstate_format = \"s48.38\"\ncoefficient_width = 25\n",
+        &format!("{SLOW}state_format = \"s48.38\"\ncoefficient_width = 25\n"),
         "wide.toml",
     )
     .unwrap();
@@ -117,8 +147,8 @@ fn the_chain_synthesizes_and_wider_formats_cost_more_and_latches_fail() {
     );
 
     // The same scripts on a requantizer whose rounding branch no longer always assigns.
-    let latched = dir.path().join("latched");
-    copy_tree(&narrow, &latched);
+    let latched = dir.join("latched");
+    copy_tree(narrow, &latched);
     let source = std::fs::read_to_string(latched.join("gyrofx_quantize.v")).unwrap();
     let broken = source.replace(
         "3: increment = half_bit;",
@@ -130,15 +160,15 @@ fn the_chain_synthesizes_and_wider_formats_cost_more_and_latches_fail() {
     assert!(error.contains("synthesis check failed"), "{error}");
     assert!(error.contains("dlatch"), "{error}");
 
-    let missing = dir.path().join("missing");
-    copy_tree(&narrow, &missing);
+    let missing = dir.join("missing");
+    copy_tree(narrow, &missing);
     std::fs::remove_file(missing.join("gyrofx_kf.v")).unwrap();
     let error = measure(&missing).unwrap_err().to_string();
     assert!(error.contains("gyrofx_kf"), "{error}");
 
     // A config error leaves no output folder.
-    let bad = write_config(dir.path(), "bad.toml", "[kf]\ncoefficient_width = 0\n");
-    let none = dir.path().join("none");
+    let bad = write_config(dir, "bad.toml", "[kf]\ncoefficient_width = 0\n");
+    let none = dir.join("none");
     let error = fails(&["synth", "--out", none.to_str().unwrap(), "--config", &bad]);
     assert!(error.contains("kf.coefficient_width"), "{error}");
     assert!(!none.exists());
@@ -352,33 +382,9 @@ fn flip_flops(generic_json: &Path) -> u64 {
         .sum()
 }
 
-/// The synthesized netlists run the package's testbenches bit-exact in Icarus and Verilator;
-/// the `chparam` script on RTL whose parameters and width localparams are untyped (what `synth`
-/// did before)
-/// gives a netlist that fails them.
-#[test]
-fn netlists_pass_the_vectors_and_chparam_on_untyped_localparams_fails_them() {
-    use gyrofx_codegen::synth::{generic_script, Parameters};
-
-    let dir = tempfile::tempdir().unwrap();
-    // chparam's widths keep `P2_I + 1` integer bits of x2's update, P2_I = P2_W − P2_F < 0:
-    // x2 = (g2/S)·y must pass 2^P2_I. A 0.2 Hz entry (g2 in s18.31, P2_I = −1, g2/S = 6·10⁻³)
-    // at 300 °/s does; the default (P2_I = −8, g2/S ≈ 10⁻⁶) never does at any rate in range.
-    let config = write_config(
-        dir.path(),
-        "slow.toml",
-        "[stimulus]\nrate_dps = 300.0\n[kf]\nbandwidths_hz = [0.2, 10.0, 20.0]\n",
-    );
-    let synth = dir.path().join("synth");
-    ok(&[
-        "synth",
-        "--out",
-        synth.to_str().unwrap(),
-        "--config",
-        &config,
-    ]);
-    // Another stimulus length: the netlists depend on the formats and coefficients only.
-    let package = dir.path().join("pkg");
+/// The loop's netlist (80 000 cells) in Verilator: 40 000 closed-loop samples, bit-exact.
+fn the_loop_netlist_passes_the_vectors(dir: &Path, config: &str, synth: &Path) {
+    let package = dir.join("loop-package");
     ok(&[
         "generate",
         "--out",
@@ -386,7 +392,43 @@ fn netlists_pass_the_vectors_and_chparam_on_untyped_localparams_fails_them() {
         "--samples",
         "3000",
         "--config",
-        &config,
+        config,
+    ]);
+    let log = ok(&[
+        "verify",
+        "--out",
+        package.to_str().unwrap(),
+        "--netlist",
+        synth.to_str().unwrap(),
+        "--sim",
+        "verilator",
+        "--blocks",
+        "gyro_loop",
+        "--quiet",
+    ]);
+    assert!(log.contains("PASS n=40000"), "{log}");
+}
+
+/// The synthesized chain runs the package's testbench bit-exact in Icarus and Verilator; the
+/// `chparam` script on RTL whose parameters and width localparams are untyped (what `synth` did
+/// before) gives a netlist that fails it.
+fn netlists_pass_the_vectors_and_chparam_on_untyped_localparams_fails_them(
+    dir: &Path,
+    config: &str,
+    synth: &Path,
+) {
+    use gyrofx_codegen::synth::{generic_script, Parameters};
+
+    // Another stimulus length: the netlists depend on the formats and coefficients only.
+    let package = dir.join("pkg");
+    ok(&[
+        "generate",
+        "--out",
+        package.to_str().unwrap(),
+        "--samples",
+        "3000",
+        "--config",
+        config,
     ]);
     let (pkg, syn) = (package.to_str().unwrap(), synth.to_str().unwrap());
     let log = ok(&[
@@ -402,20 +444,6 @@ fn netlists_pass_the_vectors_and_chparam_on_untyped_localparams_fails_them() {
         "--quiet",
     ]);
     assert_eq!(log.matches("PASS n=3001").count(), 2, "{log}");
-    // The loop's netlist (80 000 cells) in Verilator: 40 000 closed-loop samples.
-    let log = ok(&[
-        "verify",
-        "--out",
-        pkg,
-        "--netlist",
-        syn,
-        "--sim",
-        "verilator",
-        "--blocks",
-        "gyro_loop",
-        "--quiet",
-    ]);
-    assert!(log.contains("PASS n=40000"), "{log}");
     // GHDL has no netlist to run.
     let error = fails(&["verify", "--out", pkg, "--netlist", syn, "--sim", "ghdl"]);
     assert!(error.contains("--sim ghdl is not allowed"), "{error}");
@@ -423,8 +451,8 @@ fn netlists_pass_the_vectors_and_chparam_on_untyped_localparams_fails_them() {
     // naming why, before any simulation.
     let error = fails(&["verify", "--out", pkg, "--netlist", syn, "--blocks", "kf"]);
     assert!(error.contains("has no netlist of it"), "{error}");
-    std::fs::create_dir(dir.path().join("default")).unwrap();
-    let other = generate_default(&dir.path().join("default"), "1000");
+    std::fs::create_dir(dir.join("default")).unwrap();
+    let other = generate_default(&dir.join("default"), "1000");
     let error = fails(&[
         "verify",
         "--out",
@@ -440,8 +468,8 @@ fn netlists_pass_the_vectors_and_chparam_on_untyped_localparams_fails_them() {
     );
 
     // The old way: chparam on the module, and parameters and localparams without a type.
-    let old = dir.path().join("chparam");
-    copy_tree(&synth, &old);
+    let old = dir.join("chparam");
+    copy_tree(synth, &old);
     for entry in std::fs::read_dir(&old).unwrap() {
         let path = entry.unwrap().path();
         if path.extension().is_some_and(|e| e == "v") {
@@ -452,7 +480,7 @@ fn netlists_pass_the_vectors_and_chparam_on_untyped_localparams_fails_them() {
             std::fs::write(&path, untyped).unwrap();
         }
     }
-    let params: Vec<(String, String)> = manifest(&synth)["parameters"]
+    let params: Vec<(String, String)> = manifest(synth)["parameters"]
         .as_object()
         .unwrap()
         .iter()
