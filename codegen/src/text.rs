@@ -1,6 +1,6 @@
-//! Leaf text helpers every emitter shares: the generated-by line ([`Provenance`]) and
-//! two's-complement hex of a code in its format. They import nothing of the crate, so any
-//! writer may use them without reaching the package writers.
+//! Leaf text helpers every emitter shares: the generated-by line ([`Provenance`]), template
+//! filling ([`fill`]) and two's-complement hex of a code in its format. They import nothing of
+//! the crate, so any writer may use them without reaching the package writers.
 
 use gyrofx_model::fx::Format;
 
@@ -40,5 +40,72 @@ pub fn push_hex(out: &mut String, code: i128, format: Format) {
     let bits = format.to_bits(code);
     for i in (0..format.hex_digits()).rev() {
         out.push(DIGITS[((bits >> (4 * i)) & 0xf) as usize] as char);
+    }
+}
+
+/// `template` with each `@name@` (a lowercase identifier between two `@`) replaced by its value
+/// in `values`. Any other `@` is kept (a Makefile's `@echo`, a cocotb decorator). The
+/// templates are files under `codegen/templates/`, compiled in, so a placeholder without a
+/// value, or a value no placeholder takes, is a mistake in gyrofx itself.
+///
+/// # Panics
+/// On a placeholder `values` does not name, or a value of `values` the template never uses.
+pub fn fill(template: &str, values: &[(&str, &str)]) -> String {
+    let mut out = String::with_capacity(template.len() + 64);
+    let mut used = vec![false; values.len()];
+    let mut rest = template;
+    while let Some(at) = rest.find('@') {
+        out.push_str(&rest[..at]);
+        let after = &rest[at + 1..];
+        let name_end = after
+            .find(|c: char| !(c.is_ascii_lowercase() || c == '_'))
+            .unwrap_or(after.len());
+        if name_end > 0 && after[name_end..].starts_with('@') {
+            let name = &after[..name_end];
+            let index = values
+                .iter()
+                .position(|(key, _)| *key == name)
+                .unwrap_or_else(|| panic!("template placeholder @{name}@ has no value"));
+            out.push_str(values[index].1);
+            used[index] = true;
+            rest = &after[name_end + 1..];
+        } else {
+            out.push('@');
+            rest = after;
+        }
+    }
+    out.push_str(rest);
+    if let Some(unused) = used.iter().position(|u| !u) {
+        panic!("template value {} has no placeholder", values[unused].0);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fill;
+
+    #[test]
+    fn fill_replaces_placeholders_and_keeps_other_at_signs() {
+        assert_eq!(
+            fill(
+                "\t@echo \"== @name@\" @x@@name@ a@b c@",
+                &[("name", "kf"), ("x", "1")]
+            ),
+            "\t@echo \"== kf\" 1kf a@b c@"
+        );
+        assert_eq!(fill("no placeholder", &[]), "no placeholder");
+    }
+
+    #[test]
+    #[should_panic(expected = "@tb@ has no value")]
+    fn a_placeholder_without_a_value_is_a_bug() {
+        fill("cd @tb@", &[]);
+    }
+
+    #[test]
+    #[should_panic(expected = "value name has no placeholder")]
+    fn a_value_without_a_placeholder_is_a_bug() {
+        fill("cd x", &[("name", "kf")]);
     }
 }

@@ -10,7 +10,7 @@ use crate::hdl::{RTL_SOURCES, VHDL_SOURCES};
 use crate::vector_rows::RowLayout;
 use crate::vectors::Run;
 
-use crate::text::Provenance;
+use crate::text::{fill, Provenance};
 
 /// The block's parameter include: the DUT's parameters as `P_<NAME>` localparams, the vector
 /// count and the vector file names.
@@ -95,151 +95,79 @@ pub fn makefile(blocks: &[Block], provenance: &Provenance) -> String {
             .join(" ")
     };
     let names: Vec<&str> = blocks.iter().map(|b| b.name).collect();
-    let targets = |simulator: &str| -> String {
+    // " <prefix>-<block>" for each block of `names`, as a target list.
+    let targets = |prefixes: &[&str], names: &[&str]| -> String {
         names
             .iter()
-            .map(|n| format!(" {simulator}-{n}"))
-            .collect::<String>()
+            .flat_map(|n| prefixes.iter().map(move |p| format!(" {p}-{n}")))
+            .collect()
     };
-    let mut out = format!(
-        "{header}
-# Runs the testbenches without gyrofx: make sim-iverilog, make sim-verilator, make sim-ghdl (every
-# block), or make <simulator>-<block>. Blocks: {list}.
-# Options, the same in every simulator: MASK=<n> (latency mask: the first n samples of the run
-# and from every reset on are not compared), MAX_REPORTED=<n> (mismatches printed),
-# MAX_MISMATCHES=<n> (stop at the n-th; 0: never), WAVES=1 (VCD dump: tb_<module>.vcd).
-# PLUSARGS / GHDL_RUN_FLAGS pass anything else to the Verilog / GHDL simulation. GHDL's LLVM back
-# end runs the closed-loop testbenches about 3x faster than mcode (Debian: apt-get install
-# ghdl-llvm, then GHDL_BACKEND=llvm).
-IVERILOG ?= iverilog
-VVP ?= vvp
-VERILATOR ?= verilator
-GHDL ?= ghdl
-MASK ?= 0
-MAX_REPORTED ?= 10
-MAX_MISMATCHES ?= 0
-WAVES ?= 0
-RTL := {rtl}
-VHDL := {vhdl}
-TB_PLUSARGS = +mask=$(MASK) +max_reported=$(MAX_REPORTED) +max_mismatches=$(MAX_MISMATCHES) $(if $(filter 1,$(WAVES)),+dump) $(PLUSARGS)
-TB_GENERICS = -gMASK_SAMPLES=$(MASK) -gMAX_REPORTED=$(MAX_REPORTED) -gMAX_MISMATCHES=$(MAX_MISMATCHES)
-
-.PHONY: all sim-iverilog sim-verilator sim-ghdl clean{phony}
-all: sim-iverilog sim-verilator sim-ghdl
-sim-iverilog:{iverilog}
-sim-verilator:{verilator}
-sim-ghdl:{ghdl}
-",
-        header = provenance.line("#"),
-        list = names.join(", "),
-        rtl = sources(&RTL_SOURCES.iter().collect::<Vec<_>>()),
-        vhdl = sources(&VHDL_SOURCES.iter().collect::<Vec<_>>()),
-        phony = names
-            .iter()
-            .map(|n| format!(" iverilog-{n} verilator-{n} ghdl-{n}"))
-            .collect::<String>(),
-        iverilog = targets("iverilog"),
-        verilator = targets("verilator"),
-        ghdl = targets("ghdl"),
+    let mut out = fill(
+        MAKEFILE_HEAD,
+        &[
+            ("header", &provenance.line("#")),
+            ("list", &names.join(", ")),
+            ("rtl", &sources(&RTL_SOURCES.iter().collect::<Vec<_>>())),
+            ("vhdl", &sources(&VHDL_SOURCES.iter().collect::<Vec<_>>())),
+            (
+                "phony",
+                &targets(&["iverilog", "verilator", "ghdl"], &names),
+            ),
+            ("iverilog", &targets(&["iverilog"], &names)),
+            ("verilator", &targets(&["verilator"], &names)),
+            ("ghdl", &targets(&["ghdl"], &names)),
+        ],
     );
     for b in blocks {
-        let tb = format!("tb_{}", b.module);
-        let _ = write!(
-            out,
-            "
-iverilog-{name}:
-\t@echo \"== {name}\"
-\tcd {name} && $(IVERILOG) -g2005 -Wall -s {tb} -o {tb}.vvp $(RTL) {tb}.v && $(VVP) -n {tb}.vvp $(TB_PLUSARGS)
-
-verilator-{name}:
-\t@echo \"== {name}\"
-\tcd {name} && $(VERILATOR) --binary --timing $(if $(filter 1,$(WAVES)),--trace) -Wall -Wno-DECLFILENAME -Wno-UNUSEDSIGNAL -Wno-fatal -j 2 --top-module {tb} -Mdir obj_verilator $(RTL) {tb}.v >verilator_build.log 2>&1 || (cat verilator_build.log; exit 1)
-\tcd {name} && ./obj_verilator/V{tb} $(TB_PLUSARGS)
-
-ghdl-{name}:
-\t@echo \"== {name}\"
-\tcd {name} && rm -rf ghdl_work && mkdir ghdl_work && $(GHDL) -a --std=08 -Werror --workdir=ghdl_work {vhdl} {tb}.vhd
-\tcd {name} && $(GHDL) --elab-run --std=08 --workdir=ghdl_work {tb} $(TB_GENERICS) --ieee-asserts=disable-at-0 $(if $(filter 1,$(WAVES)),--vcd={tb}.vcd) $(GHDL_RUN_FLAGS)
-",
-            name = b.name,
-            vhdl = sources(&crate::hdl::vhdl_sources_of(b.module)),
-        );
+        out.push_str(&fill(
+            MAKEFILE_BLOCK,
+            &[
+                ("name", b.name),
+                ("tb", &format!("tb_{}", b.module)),
+                ("vhdl", &sources(&crate::hdl::vhdl_sources_of(b.module))),
+            ],
+        ));
     }
     let cocotb = crate::cocotb::tested(blocks);
     if !cocotb.is_empty() {
         let names: Vec<&str> = cocotb.iter().map(|b| b.name).collect();
-        let _ = write!(
-            out,
-            "
-# The cocotb tests ({folder}/): make sim-cocotb or make cocotb-<block> ({list}). They need
-# cocotb 2.x and the gyrofx Python package (pip install <gyrofx>/python) for the python3 on
-# PATH. SIM picks cocotb's simulator: icarus (its Verilator support needs 5.036 or later).
-SIM ?= icarus
-.PHONY: sim-cocotb{phony}
-sim-cocotb:{targets}
-",
-            folder = crate::cocotb::FOLDER,
-            list = names.join(", "),
-            phony = names
-                .iter()
-                .map(|n| format!(" cocotb-{n}"))
-                .collect::<String>(),
-            targets = names
-                .iter()
-                .map(|n| format!(" cocotb-{n}"))
-                .collect::<String>(),
-        );
+        out.push_str(&fill(
+            MAKEFILE_COCOTB_HEAD,
+            &[
+                ("folder", crate::cocotb::FOLDER),
+                ("list", &names.join(", ")),
+                ("phony", &targets(&["cocotb"], &names)),
+                ("targets", &targets(&["cocotb"], &names)),
+            ],
+        ));
         for name in names {
-            let _ = write!(
-                out,
-                "
-cocotb-{name}:
-\t@echo \"== {name}\"
-\tcd {name} && $(MAKE) --no-print-directory -f ../{folder}/{name}.mk SIM=$(SIM)
-",
-                folder = crate::cocotb::FOLDER,
-            );
+            out.push_str(&fill(
+                MAKEFILE_COCOTB_BLOCK,
+                &[("name", name), ("folder", crate::cocotb::FOLDER)],
+            ));
         }
     }
     let dpi = crate::dpi::tested(blocks);
     if !dpi.is_empty() {
         let names: Vec<&str> = dpi.iter().map(|b| b.name).collect();
-        let _ = write!(
-            out,
-            "
-# The DPI-C testbenches ({folder}/): make sim-dpi or make dpi-<block> ({list}), in Verilator,
-# against gyrofx's C library: GYROFX_CAPI_LIB=<path to libgyrofx_capi.a> (cargo build --release
-# -p gyrofx-capi in the gyrofx repository). DPI_PLUSARGS: +samples=<n> +seed=<n> +flip=<k>.
-GYROFX_CAPI_LIB ?=
-DPI_PLUSARGS ?=
-.PHONY: sim-dpi{phony}
-sim-dpi:{targets}
-",
-            folder = crate::dpi::FOLDER,
-            list = names.join(", "),
-            phony = names
-                .iter()
-                .map(|n| format!(" dpi-{n}"))
-                .collect::<String>(),
-            targets = names
-                .iter()
-                .map(|n| format!(" dpi-{n}"))
-                .collect::<String>(),
-        );
+        out.push_str(&fill(
+            MAKEFILE_DPI_HEAD,
+            &[
+                ("folder", crate::dpi::FOLDER),
+                ("list", &names.join(", ")),
+                ("phony", &targets(&["dpi"], &names)),
+                ("targets", &targets(&["dpi"], &names)),
+            ],
+        ));
         for block in dpi {
-            let tb = format!("tb_dpi_{}", block.module);
-            let _ = write!(
-                out,
-                "
-dpi-{name}:
-\t@echo \"== {name}\"
-\t@test -n \"$(GYROFX_CAPI_LIB)\" || (echo \"GYROFX_CAPI_LIB is not set: point it at libgyrofx_capi.a (cargo build --release -p gyrofx-capi)\" >&2; exit 2)
-\tcd {name} && $(VERILATOR) --binary --timing -Wno-fatal -Wno-WIDTH -Wno-DECLFILENAME -Wno-UNUSEDSIGNAL -j 2 --top-module {tb} -Mdir obj_dpi $(RTL) ../{folder}/{tb}.sv -LDFLAGS \"$(abspath $(GYROFX_CAPI_LIB)) -lpthread -ldl -lm\" >dpi_build.log 2>&1 || (cat dpi_build.log; exit 1)
-\tcd {name} && ./obj_dpi/V{tb} $(DPI_PLUSARGS)
-",
-                name = block.name,
-                folder = crate::dpi::FOLDER,
-            );
+            out.push_str(&fill(
+                MAKEFILE_DPI_BLOCK,
+                &[
+                    ("name", block.name),
+                    ("tb", &format!("tb_dpi_{}", block.module)),
+                    ("folder", crate::dpi::FOLDER),
+                ],
+            ));
         }
     }
     let _ = write!(
@@ -249,6 +177,16 @@ dpi-{name}:
     );
     out
 }
+
+/// The Makefile's parts (`codegen/templates/makefile/`), filled by [`fill`]: the variables and
+/// the `sim-<simulator>` targets, then per block its three simulator recipes, then the cocotb
+/// and DPI-C targets where a block has them.
+const MAKEFILE_HEAD: &str = include_str!("../templates/makefile/head.mk");
+const MAKEFILE_BLOCK: &str = include_str!("../templates/makefile/block.mk");
+const MAKEFILE_COCOTB_HEAD: &str = include_str!("../templates/makefile/cocotb_head.mk");
+const MAKEFILE_COCOTB_BLOCK: &str = include_str!("../templates/makefile/cocotb_block.mk");
+const MAKEFILE_DPI_HEAD: &str = include_str!("../templates/makefile/dpi_head.mk");
+const MAKEFILE_DPI_BLOCK: &str = include_str!("../templates/makefile/dpi_block.mk");
 
 /// What the package's Makefile writes into it (the simulators' work files, `make clean`
 /// removes them), as the marker lists them ([`crate::output_folder::Marker`]): a

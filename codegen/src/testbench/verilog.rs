@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 
 use super::{header, MAX_REPORTED};
 use crate::block::{Block, Output, Signal, Timing};
-use crate::text::Provenance;
+use crate::text::{fill, Provenance};
 
 fn declaration(kind: &str, s: &Signal, prefix: &str, init: bool) -> String {
     let signed = if s.format.signed { "signed " } else { "" };
@@ -78,172 +78,41 @@ pub fn instance(block: &Block) -> String {
     )
 }
 
-/// The testbench of `block`.
+/// The testbench of `block`: `codegen/templates/testbench/testbench.v` filled with the block's
+/// ports, instance, vector checks and per-sample comparisons.
 pub fn testbench(block: &Block, provenance: &Provenance) -> String {
     let tb = format!("tb_{}", block.module);
-    let stimulus_fields: Vec<&Signal> = block.inputs.iter().collect();
-    let expected_fields: Vec<&Signal> = block.outputs.iter().map(|o| &o.signal).collect();
-    let mut out = String::new();
-    let _ = writeln!(
-        out,
-        "// Language: Verilog 2001 (+ $fatal, supported by Icarus and Verilator)"
-    );
-    let _ = writeln!(out, "{}", provenance.line("//"));
-    let _ = writeln!(
-        out,
-        "`resetall
-`timescale 1ns / 1ps
-`default_nettype none
-
-/*
- * {tb} — self-checking testbench of {module} ({title}).
- *
- * Reads STIMULUS_FILE and EXPECTED_FILE (one line per clock-enable, hex fields,
- * formats declared on line 2 and checked here), drives one sample per ce with an
- * idle clock after every fourth, and compares combinational outputs before the
- * clock edge and registered outputs 1 clock after it. Prints the first
- * mismatches, then PASS n=<N> [masked=<M>] or FAIL mismatches=<M> n=<N> first=<index>,
- * and exits non-zero ($fatal) on a mismatch, a timeout or a bad vector file.
- * Plusargs: +dump writes {tb}.vcd; +mask=<n> does not compare the first n samples
- * of the run and from every reset sample on (latency mask); +max_reported=<n>
- * prints n mismatches (default {max}); +max_mismatches=<n> stops at the n-th.
- */
-module {tb};
-
-`include \"{params}\"
-
-localparam integer CLOCK_PERIOD_NS = 10;
-// 64-bit: long vector sets overflow a 32-bit integer.
-localparam [63:0] TIMEOUT_NS = 64'd{timeout_clocks} * CLOCK_PERIOD_NS;
-
-reg clk = 1'b0;
-always #(CLOCK_PERIOD_NS / 2) clk <= ~clk;
-reg rst = 1'b1;
-reg ce = 1'b0;",
-        module = block.module,
-        title = block.title,
-        max = MAX_REPORTED,
-        params = block.file("params.vh"),
-        timeout_clocks = super::timeout_clocks(block.len(), block.settle_clocks),
-    );
+    let mut ports = String::new();
     for s in &block.inputs {
-        let _ = writeln!(out, "{}", declaration("reg", s, "", true));
+        let _ = writeln!(ports, "{}", declaration("reg", s, "", true));
     }
     for o in &block.outputs {
-        let _ = writeln!(out, "{}", declaration("wire", &o.signal, "", false));
+        let _ = writeln!(ports, "{}", declaration("wire", &o.signal, "", false));
     }
-    // DUT
-    let _ = writeln!(out, "\n{}", instance(block));
-
-    // Variables
-    let _ = writeln!(
-        out,
-        "integer stimulus_fd;
-integer expected_fd;
-integer rom_fd;
-integer fields;
-integer index = 0;
-integer mismatches = 0;
-integer first_mismatch = -1;
-integer mask_samples = 0;
-integer max_reported = {MAX_REPORTED};
-integer max_mismatches = 0;
-integer since_reset = 0;
-integer masked_count = 0;
-reg masked = 1'b0;
-reg stop_at_cap = 1'b0;
-reg [8*1024-1:0] line;
-reg [8*400-1:0] message;
-reg vector_rst;"
-    );
+    let mut vector_declarations = String::new();
     for s in &block.inputs {
-        let _ = writeln!(out, "{}", declaration("reg", s, "vector_", false));
+        let _ = writeln!(
+            vector_declarations,
+            "{}",
+            declaration("reg", s, "vector_", false)
+        );
     }
     for o in &block.outputs {
-        let _ = writeln!(out, "{}", declaration("reg", &o.signal, "expected_", false));
+        let _ = writeln!(
+            vector_declarations,
+            "{}",
+            declaration("reg", &o.signal, "expected_", false)
+        );
     }
     let declared_count = (1 + block.inputs.len()).max(block.outputs.len());
     for i in 0..declared_count {
-        let _ = writeln!(out, "reg [8*40-1:0] declared_{i};");
+        let _ = writeln!(vector_declarations, "reg [8*40-1:0] declared_{i};");
     }
-
-    let _ = writeln!(
-        out,
-        "
-// Prints `message` as a FAIL line and stops with a non-zero exit.
-task fail_setup;
-    begin
-        $display(\"FAIL %0s\", message);
-        $fatal(1, \"{tb}: %0s\", message);
-    end
-endtask
-
-initial begin
-    if ($test$plusargs(\"dump\")) begin
-        $dumpfile(\"{tb}.vcd\");
-        $dumpvars(0, {tb});
-    end
-end
-
-initial begin
-    #(TIMEOUT_NS);
-    $display(\"FAIL timeout after %0d ns (%0d of %0d samples)\", TIMEOUT_NS, index, VECTOR_COUNT);
-    $fatal(1, \"{tb}: timeout\");
-end
-
-initial begin
-    if ($value$plusargs(\"mask=%d\", mask_samples) && mask_samples > 0)
-        $display(\"mask: %0d samples after each reset\", mask_samples);
-    if ($value$plusargs(\"max_reported=%d\", max_reported)) begin end
-    if ($value$plusargs(\"max_mismatches=%d\", max_mismatches)) begin end"
-    );
-    for (rom, _) in &block.roms {
-        let _ = writeln!(
-            out,
-            "    // $readmemh in the DUT only warns about a missing file (Icarus): check it here.
-    rom_fd = $fopen(\"{rom}\", \"r\");
-    if (rom_fd == 0) begin
-        $sformat(message, \"cannot open {rom}\");
-        fail_setup;
-    end
-    $fclose(rom_fd);"
-        );
-    }
-    for (fd, file, fields, with_rst) in [
-        ("stimulus_fd", "STIMULUS_FILE", &stimulus_fields, true),
-        ("expected_fd", "EXPECTED_FILE", &expected_fields, false),
-    ] {
-        let wanted = header(fields, with_rst);
-        let tokens: Vec<&str> = wanted.trim_start_matches("// ").split(' ').collect();
-        let pattern = vec!["%s"; tokens.len()].join(" ");
-        let targets: Vec<String> = (0..tokens.len()).map(|i| format!("declared_{i}")).collect();
-        let compare: Vec<String> = tokens
-            .iter()
-            .enumerate()
-            .map(|(i, t)| format!("declared_{i} != \"{t}\""))
-            .collect();
-        let _ = writeln!(
-            out,
-            "    {fd} = $fopen({file}, \"r\");
-    if ({fd} == 0) begin
-        $sformat(message, \"cannot open %0s\", {file});
-        fail_setup;
-    end
-    fields = $fgets(line, {fd});
-    fields = $fscanf({fd}, \"// {pattern}\\n\", {targets});
-    if (fields != {count} || {compare}) begin
-        $sformat(message, \"%0s declares {declared_pattern}; the testbench expects {wanted_text}\", {file}, {targets});
-        fail_setup;
-    end",
-            declared_pattern = vec!["%0s"; tokens.len()].join(" "),
-            targets = targets.join(", "),
-            count = tokens.len(),
-            compare = compare.join(" || "),
-            wanted_text = wanted.trim_start_matches("// "),
-        );
-    }
-
-    // Main loop
+    let rom_checks: String = block
+        .roms
+        .iter()
+        .map(|(rom, _)| fill(ROM_CHECK, &[("rom", rom)]))
+        .collect();
     let input_scan = vec!["%h"; 1 + block.inputs.len()].join(" ");
     let mut input_targets = vec!["vector_rst".to_string()];
     input_targets.extend(block.inputs.iter().map(|s| format!("vector_{}", s.name)));
@@ -253,37 +122,80 @@ initial begin
         .iter()
         .map(|o| format!("expected_{}", o.signal.name))
         .collect();
-    let _ = writeln!(
-        out,
-        "
-    // Power-on reset.
-    rst = 1'b1;
-    repeat (2) @(posedge clk);
-    @(negedge clk);
-    rst = 1'b0;
+    fill(
+        TESTBENCH,
+        &[
+            ("provenance", &provenance.line("//")),
+            ("tb", &tb),
+            ("module", block.module),
+            ("title", block.title),
+            ("max", &MAX_REPORTED.to_string()),
+            ("params", &block.file("params.vh")),
+            (
+                "timeout_clocks",
+                &super::timeout_clocks(block.len(), block.settle_clocks).to_string(),
+            ),
+            ("ports", &ports),
+            ("instance", &instance(block)),
+            ("vector_declarations", &vector_declarations),
+            ("rom_checks", &rom_checks),
+            ("file_checks", &header_checks(block)),
+            ("input_scan", &input_scan),
+            ("inputs", &input_targets.join(", ")),
+            ("input_count", &input_targets.len().to_string()),
+            ("output_scan", &output_scan),
+            ("outputs", &output_targets.join(", ")),
+            ("output_count", &output_targets.len().to_string()),
+            ("checks", &sample_checks(block)),
+        ],
+    )
+}
 
-    for (index = 0; index < VECTOR_COUNT; index = index + 1) begin
-        fields = $fscanf(stimulus_fd, \"{input_scan}\\n\", {inputs});
-        if (fields != {input_count}) begin
-            $sformat(message, \"%0s: line for sample %0d is missing or malformed\", STIMULUS_FILE, index);
-            fail_setup;
-        end
-        fields = $fscanf(expected_fd, \"{output_scan}\\n\", {outputs});
-        if (fields != {output_count}) begin
-            $sformat(message, \"%0s: line for sample %0d is missing or malformed\", EXPECTED_FILE, index);
-            fail_setup;
-        end
-        if (vector_rst) since_reset = 0;
-        masked = since_reset < mask_samples;
-        if (masked) masked_count = masked_count + 1;
-        since_reset = since_reset + 1;
-        rst = vector_rst;
-        ce = 1'b1;",
-        inputs = input_targets.join(", "),
-        input_count = input_targets.len(),
-        outputs = output_targets.join(", "),
-        output_count = output_targets.len(),
-    );
+/// The testbench and its two per-item parts (`codegen/templates/testbench/`).
+const TESTBENCH: &str = include_str!("../../templates/testbench/testbench.v");
+const ROM_CHECK: &str = include_str!("../../templates/testbench/rom_check.v");
+const HEADER_CHECK: &str = include_str!("../../templates/testbench/header_check.v");
+
+/// The checks that the stimulus and expected files open and declare the fields, in the
+/// order and formats, that the testbench reads.
+fn header_checks(block: &Block) -> String {
+    let stimulus_fields: Vec<&Signal> = block.inputs.iter().collect();
+    let expected_fields: Vec<&Signal> = block.outputs.iter().map(|o| &o.signal).collect();
+    let mut out = String::new();
+    for (fd, file, fields, with_rst) in [
+        ("stimulus_fd", "STIMULUS_FILE", &stimulus_fields, true),
+        ("expected_fd", "EXPECTED_FILE", &expected_fields, false),
+    ] {
+        let wanted = header(fields, with_rst);
+        let tokens: Vec<&str> = wanted.trim_start_matches("// ").split(' ').collect();
+        let targets: Vec<String> = (0..tokens.len()).map(|i| format!("declared_{i}")).collect();
+        let compare: Vec<String> = tokens
+            .iter()
+            .enumerate()
+            .map(|(i, t)| format!("declared_{i} != \"{t}\""))
+            .collect();
+        out.push_str(&fill(
+            HEADER_CHECK,
+            &[
+                ("fd", fd),
+                ("file", file),
+                ("pattern", &vec!["%s"; tokens.len()].join(" ")),
+                ("targets", &targets.join(", ")),
+                ("count", &tokens.len().to_string()),
+                ("compare", &compare.join(" || ")),
+                ("declared_pattern", &vec!["%0s"; tokens.len()].join(" ")),
+                ("wanted_text", wanted.trim_start_matches("// ")),
+            ],
+        ));
+    }
+    out
+}
+
+/// One sample's drive and comparisons, inside the main loop: the inputs, the combinational
+/// outputs before the clock edge, the registered ones after the pipeline's latency, and the
+/// idle clock after every fourth sample.
+fn sample_checks(block: &Block) -> String {
+    let mut out = String::new();
     for s in &block.inputs {
         let _ = writeln!(out, "        {0} = vector_{0};", s.name);
     }
@@ -360,30 +272,6 @@ initial begin
             mismatch(o).replace("\n            ", "\n                ")
         );
     }
-    let _ = writeln!(
-        out,
-        "        end
-        if (stop_at_cap) begin
-            $display(\"FAIL mismatches=%0d n=%0d first=%0d (stopped at max_mismatches)\", mismatches, index + 1, first_mismatch);
-            $fatal(1, \"{tb}: stopped at %0d mismatches\", mismatches);
-        end
-    end
-
-    if (mismatches == 0) begin
-        if (masked_count > 0)
-            $display(\"PASS n=%0d masked=%0d\", VECTOR_COUNT, masked_count);
-        else
-            $display(\"PASS n=%0d\", VECTOR_COUNT);
-        $finish;
-    end else begin
-        $display(\"FAIL mismatches=%0d n=%0d first=%0d\", mismatches, VECTOR_COUNT, first_mismatch);
-        $fatal(1, \"{tb}: %0d mismatches\", mismatches);
-    end
-end
-
-endmodule
-
-`resetall"
-    );
+    let _ = writeln!(out, "        end");
     out
 }
