@@ -46,7 +46,7 @@ fn main() -> ExitCode {
     // folders removed next), remove the staging folders, temporary and lock files, then end as
     // a shell expects of an interrupted program (128 + SIGINT).
     let _ = ctrlc::set_handler(|| {
-        gyrofx_codegen::processes::end_all();
+        gyrofx_lab::processes::end_all();
         gyrofx_codegen::output_folder::remove_registered();
         std::process::exit(130);
     });
@@ -67,7 +67,7 @@ fn main() -> ExitCode {
         Command::Filter(args) => filter::run(args),
         Command::Reproduce(args) => reproduce::run(args),
     };
-    if gyrofx_codegen::processes::ending() || gyrofx_codegen::output_folder::interrupted() {
+    if gyrofx_lab::processes::ending() || gyrofx_codegen::output_folder::interrupted() {
         // A child the handler ended made the command fail: the handler is still removing
         // files, and it ends the process with 130 when done.
         loop {

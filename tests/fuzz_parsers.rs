@@ -7,10 +7,10 @@ use std::io::Write as _;
 use std::str::FromStr;
 
 use gyrofx_codegen::rom::{self, RomFormat};
-use gyrofx_codegen::simulate::Simulator;
 use gyrofx_job::config::Config;
 use gyrofx_job::input::{read_column, read_column_with_gaps};
 use gyrofx_job::job::Job;
+use gyrofx_lab::simulate::Simulator;
 use gyrofx_model::analysis::allan::Grid;
 use gyrofx_model::fx::{Format, Overflow, Rounding};
 use gyrofx_model::kf::design::Method;

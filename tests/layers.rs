@@ -1,6 +1,6 @@
-//! The code's shape: crates depend only downward (model ← job ← codegen ← the CLI; the
-//! Python and C bindings on model and job alone), and inside a crate no two top-level modules
-//! import each other, directly or round a circle.
+//! The code's shape: crates depend only downward (model ← job ← codegen ← lab ← the CLI; the
+//! Python and C bindings on model and job alone), only the lab runs external programs, and
+//! inside a crate no two top-level modules import each other, directly or round a circle.
 //!
 //! A module's imports are read from its source text: every `crate::<module>` path and every
 //! `super::` path that climbs out of its top-level module, in code (comments and the
@@ -201,7 +201,7 @@ fn circles(graph: &BTreeMap<String, BTreeSet<String>>) -> Vec<Vec<String>> {
 /// `Results` (issue 28, item 2). Nothing may join one, and no new circle may form.
 const CODEGEN_CIRCLES_LEFT: &[&[&str]] = &[&["blocks", "vectors"]];
 
-/// The model, the job and the CLI have no circle between their modules; codegen none beyond
+/// The model, the job, the lab and the CLI have no circle between their modules; codegen none beyond
 /// [`CODEGEN_CIRCLES_LEFT`].
 #[test]
 fn no_crate_has_an_import_circle_between_its_modules() {
@@ -210,6 +210,7 @@ fn no_crate_has_an_import_circle_between_its_modules() {
         ("job", repository().join("job/src")),
         ("the CLI", repository().join("src/commands")),
         ("codegen", repository().join("codegen/src")),
+        ("lab", repository().join("lab/src")),
     ] {
         let inside = if krate == "the CLI" { "commands" } else { "" };
         let graph = imports_below(&src, inside);
@@ -257,21 +258,53 @@ fn the_circle_check_finds_a_planted_circle() {
     );
 }
 
-/// The bindings and the job stand on the layers below them only: no dependency on codegen.
+/// Each crate stands on the layers below it only: the bindings and the job on no codegen and
+/// no lab, codegen on no lab.
 #[test]
-fn the_job_and_the_bindings_do_not_depend_on_codegen() {
-    for manifest in [
-        "model/Cargo.toml",
-        "job/Cargo.toml",
-        "capi/Cargo.toml",
-        "python/Cargo.toml",
+fn the_job_and_the_bindings_do_not_depend_on_codegen_nor_codegen_on_the_lab() {
+    for (manifest, above) in [
+        (
+            "model/Cargo.toml",
+            &["gyrofx-job", "gyrofx-codegen", "gyrofx-lab"][..],
+        ),
+        ("job/Cargo.toml", &["gyrofx-codegen", "gyrofx-lab"]),
+        ("capi/Cargo.toml", &["gyrofx-codegen", "gyrofx-lab"]),
+        ("python/Cargo.toml", &["gyrofx-codegen", "gyrofx-lab"]),
+        ("codegen/Cargo.toml", &["gyrofx-lab"]),
     ] {
         let text = std::fs::read_to_string(repository().join(manifest)).unwrap();
-        assert!(
-            !text.contains("gyrofx-codegen"),
-            "{manifest} depends on gyrofx-codegen"
-        );
+        for crate_name in above {
+            assert!(
+                !text.contains(crate_name),
+                "{manifest} depends on {crate_name}"
+            );
+        }
     }
     let job = std::fs::read_to_string(repository().join("job/Cargo.toml")).unwrap();
     assert!(job.contains("gyrofx-model"), "the job stands on the model");
+    let lab = std::fs::read_to_string(repository().join("lab/Cargo.toml")).unwrap();
+    assert!(lab.contains("gyrofx-codegen"), "the lab stands on codegen");
+}
+
+/// The lab is the only code that starts a program: the model, the job and codegen name no
+/// `Command` outside their tests (a simulator or yosys run from codegen would be a lab
+/// module in the wrong crate).
+#[test]
+fn only_the_lab_starts_external_programs() {
+    for src in ["model/src", "job/src", "codegen/src"] {
+        for file in sources(&repository().join(src)) {
+            let code = code(&std::fs::read_to_string(&file).unwrap());
+            for needle in ["Command::new", "process::Command", "Command}", "Command,"] {
+                assert!(
+                    !code.contains(needle),
+                    "{} starts a program ({needle}): that belongs in lab/",
+                    file.display()
+                );
+            }
+        }
+    }
+    let lab = sources(&repository().join("lab/src"));
+    assert!(lab
+        .iter()
+        .any(|file| { code(&std::fs::read_to_string(file).unwrap()).contains("Command::new") }));
 }

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use crate::common::*;
-use gyrofx_codegen::synth::{design_inputs, measure, Design};
+use gyrofx_lab::synth::{design_inputs, measure, Design};
 
 fn manifest(dir: &Path) -> serde_json::Value {
     let text = std::fs::read_to_string(dir.join("manifest.json")).unwrap();
@@ -417,7 +417,7 @@ fn netlists_pass_the_vectors_and_chparam_on_untyped_localparams_fails_them(
     config: &str,
     synth: &Path,
 ) {
-    use gyrofx_codegen::synth::{generic_script, Parameters};
+    use gyrofx_lab::synth::{generic_script, Parameters};
 
     // Another stimulus length: the netlists depend on the formats and coefficients only.
     let package = dir.join("pkg");

@@ -1,13 +1,12 @@
 //! gyrofx-codegen: a job (`gyrofx-job`) → a verification package: the vector / ROM / testbench
-//! writers, the output package, and (until they move to a crate of their own) the simulator,
-//! synthesis and place-and-route runners.
+//! writers and the output package. It runs no external program: simulating, synthesizing and
+//! placing what it writes is `gyrofx-lab`'s.
 //!
 //! Data flows one way: [`gyrofx_job::config::Config`] → [`gyrofx_job::job::Job`] (designs and
 //! every block's plan; [`blocks::checked_job`] adds each block's own check) →
 //! [`vectors`] (one run of the chain, cut into every registered block's [`block::Block`] by
 //! its module in [`blocks`]) → [`writers`] and
 //! [`testbench`] → [`package::Package`], written atomically by [`generate::generate`].
-//! [`simulate`] runs a written package.
 #![warn(missing_docs)]
 
 pub mod block;
@@ -15,23 +14,15 @@ pub mod blocks;
 pub mod cocotb;
 pub mod design;
 pub mod dpi;
-pub mod explore;
 pub mod filter_package;
 pub mod generate;
 pub mod hdl;
-pub mod junit;
 pub mod output_folder;
 pub mod package;
-pub mod place_route;
-pub mod plot;
-pub mod processes;
 pub mod progress;
 pub mod report;
-pub mod reproduce;
 pub mod rom;
-pub mod simulate;
 pub mod stats;
-pub mod synth;
 pub mod testbench;
 pub mod text;
 pub mod vector_rows;

@@ -214,9 +214,9 @@ pub fn run(args: Args) -> Result<ExitCode> {
         }
     }
     if let Some(path) = &plot {
-        let series: Vec<gyrofx_codegen::plot::AllanSeries> = curves
+        let series: Vec<gyrofx_lab::plot::AllanSeries> = curves
             .iter()
-            .map(|(label, points, terms)| gyrofx_codegen::plot::AllanSeries {
+            .map(|(label, points, terms)| gyrofx_lab::plot::AllanSeries {
                 label: label.clone(),
                 points,
                 terms: Some((terms, kind)),
@@ -228,7 +228,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
             allan::Kind::Modified => "Modified Allan deviation",
             allan::Kind::Hadamard => "Overlapping Hadamard deviation",
         };
-        gyrofx_codegen::plot::deviation(path, &series, title)?;
+        gyrofx_lab::plot::deviation(path, &series, title)?;
         if !json {
             println!("plot: {}", path.display());
         }

@@ -124,7 +124,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
     let c = coefficients(&d);
     let runs = disturbances(&d, 2.0);
     if let Some(path) = &plot {
-        gyrofx_codegen::plot::davar(path, &d, &c)?;
+        gyrofx_lab::plot::davar(path, &d, &c)?;
         if !json {
             println!("plot: {}", path.display());
         }

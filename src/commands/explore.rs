@@ -6,10 +6,10 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 
-use gyrofx_codegen::explore::{
+use gyrofx_codegen::progress::Progress;
+use gyrofx_lab::explore::{
     self, default_folder, Costs, GuardBits, Plan, PlanError, Sweep, Target, Vary, MAX_CANDIDATES,
 };
-use gyrofx_codegen::progress::Progress;
 
 use super::options::{count, ConfigSource, OutputFolder};
 use super::usage;
@@ -140,7 +140,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
         gyrofx_codegen::output_folder::Kind::Explore,
         args.out.replace(),
     )?;
-    if gyrofx_codegen::processes::output(std::process::Command::new("yosys").arg("-V")).is_err() {
+    if gyrofx_lab::processes::output(std::process::Command::new("yosys").arg("-V")).is_err() {
         anyhow::bail!("gyrofx explore synthesizes every candidate with yosys, which is not installed (or not on PATH)");
     }
     let costs = Costs::open(&cache).with_context(|| format!("--cache {}", cache.display()))?;

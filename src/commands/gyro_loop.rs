@@ -12,7 +12,7 @@ use gyrofx_model::gyro_loop::figures::{
     characterize_reporting, Characterization, Figure, ModeCharacterization, Procedure, AVERAGES,
 };
 
-use gyrofx_codegen::plot;
+use gyrofx_lab::plot;
 use gyrofx_model::gyro_loop::trace::{switch_trace, TraceSpec};
 
 use super::options::ConfigSource;

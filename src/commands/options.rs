@@ -268,7 +268,7 @@ pub fn check_writable_file(flag: &str, path: &Path) -> Result<()> {
 /// Checks a `--plot` path before any work: `.png` or `.svg`, in a writable folder, and none
 /// of the command's `inputs` ([`check_output`]).
 pub fn check_plot(path: &Path, inputs: &[(&str, Option<&Path>)]) -> Result<()> {
-    gyrofx_codegen::plot::check_path(path).map_err(|e| super::Usage(format!("--plot: {e}")))?;
+    gyrofx_lab::plot::check_path(path).map_err(|e| super::Usage(format!("--plot: {e}")))?;
     check_writable_file("--plot", path)?;
     check_output("--plot", path, false, inputs)
 }

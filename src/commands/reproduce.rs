@@ -8,7 +8,8 @@ use anyhow::Result;
 
 use super::usage;
 
-use gyrofx_codegen::{output_folder, reproduce};
+use gyrofx_codegen::output_folder;
+use gyrofx_lab::reproduce;
 
 /// Run a paper's pipeline on simulated data and print its tables beside gyrofx's, with
 /// the differences explained (markdown): 000, 002, 003, 004.

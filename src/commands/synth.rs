@@ -7,9 +7,9 @@ use anyhow::Result;
 
 use gyrofx_codegen::design::LOOP_TOP;
 use gyrofx_codegen::generate::Output;
-use gyrofx_codegen::place_route::PlaceRequest;
-use gyrofx_codegen::place_route::{self, Target};
-use gyrofx_codegen::synth::synthesize;
+use gyrofx_lab::place_route::PlaceRequest;
+use gyrofx_lab::place_route::{self, Target};
+use gyrofx_lab::synth::synthesize;
 
 use super::options::{ConfigSource, OutputFolder};
 

@@ -6,8 +6,8 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 
-use gyrofx_codegen::junit;
-use gyrofx_codegen::simulate::{self, Simulator};
+use gyrofx_lab::junit;
+use gyrofx_lab::simulate::{self, Simulator};
 
 /// Run a generated package's testbench in a simulator; non-zero exit on failure.
 #[derive(clap::Args)]

@@ -448,14 +448,17 @@ fn atomically(
         _ => Path::new("."),
     };
     let extension = path.extension().and_then(|x| x.to_str()).unwrap_or("png");
-    let staged =
-        crate::output_folder::staged_file(folder, ".gyrofx-plot-", &format!(".{extension}"))
-            .map_err(|e| {
-                plot_error(
-                    path,
-                    format!("cannot create a file in {}: {e}", folder.display()),
-                )
-            })?;
+    let staged = gyrofx_codegen::output_folder::staged_file(
+        folder,
+        ".gyrofx-plot-",
+        &format!(".{extension}"),
+    )
+    .map_err(|e| {
+        plot_error(
+            path,
+            format!("cannot create a file in {}: {e}", folder.display()),
+        )
+    })?;
     draw(staged.path()).map_err(|e| plot_error(path, e))?;
     staged
         .persist(path)

@@ -106,7 +106,7 @@ pub(crate) fn terms(rate: &[f64], rate_hz: f64) -> [f64; 5] {
 /// A plot error (no font), or the package's output errors.
 pub fn write(
     out: &std::path::Path,
-    replace: crate::output_folder::Replace,
+    replace: gyrofx_codegen::output_folder::Replace,
     paper: &str,
     seed: u64,
     report: &str,
@@ -117,9 +117,15 @@ pub fn write(
     )>,
 ) -> Result<Vec<String>> {
     let scratch = tempfile::tempdir().map_err(|e| Error::io(std::env::temp_dir(), e))?;
-    crate::output_folder::check(out, crate::output_folder::Kind::Reproduce, replace)?;
-    let mut package =
-        crate::package::Package::new(crate::output_folder::Kind::Reproduce, Vec::new());
+    gyrofx_codegen::output_folder::check(
+        out,
+        gyrofx_codegen::output_folder::Kind::Reproduce,
+        replace,
+    )?;
+    let mut package = gyrofx_codegen::package::Package::new(
+        gyrofx_codegen::output_folder::Kind::Reproduce,
+        Vec::new(),
+    );
     package.add("report.md", report);
     let series: Vec<crate::plot::AllanSeries> = curves
         .iter()

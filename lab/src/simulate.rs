@@ -90,7 +90,7 @@ impl Default for Options {
     fn default() -> Self {
         Options {
             mask: 0,
-            max_reported: u64::from(crate::testbench::MAX_REPORTED),
+            max_reported: u64::from(gyrofx_codegen::testbench::MAX_REPORTED),
             max_mismatches: 0,
             waves: false,
             blocks: None,
@@ -254,7 +254,7 @@ pub fn run_reporting(
     };
     // The simulators' temporary files (iverilog's) go into a work folder of gyrofx's own: a
     // signal that ends them mid-run leaves none in the system's temporary folder.
-    let temp = crate::output_folder::WorkFolder::new()
+    let temp = gyrofx_codegen::output_folder::WorkFolder::new()
         .map_err(|e| Error::Simulation(format!("cannot create a temporary folder: {e}")))?;
     let mut blocks = Vec::with_capacity(names.len());
     for block in names {
@@ -348,7 +348,7 @@ fn same_roms(design: &Path, block_folder: &Path, block: &str) -> Result<()> {
 }
 
 fn read_manifest(folder: &Path, what: &str) -> Result<serde_json::Value> {
-    let path = folder.join(crate::output_folder::MANIFEST);
+    let path = folder.join(gyrofx_codegen::output_folder::MANIFEST);
     let text = std::fs::read_to_string(&path).map_err(|e| {
         Error::Simulation(format!(
             "{} is not {what} (no readable {}: {e})",
@@ -393,7 +393,9 @@ impl Netlists {
             if let Some(missing) = paths.iter().find(|p| !p.is_file()) {
                 return Err(Error::Simulation(format!(
                     "{} lists the netlist {}, which is missing",
-                    folder.join(crate::output_folder::MANIFEST).display(),
+                    folder
+                        .join(gyrofx_codegen::output_folder::MANIFEST)
+                        .display(),
                     missing.display()
                 )));
             }

@@ -16,10 +16,11 @@ use std::process::Command;
 
 use serde::Serialize;
 
-use crate::block::Block;
-use crate::blocks::{self, RomImages};
-use crate::design;
-use crate::package::Package;
+use gyrofx_codegen::block::Block;
+use gyrofx_codegen::blocks::{self, RomImages};
+use gyrofx_codegen::design;
+use gyrofx_codegen::package::Package;
+use gyrofx_codegen::text::fill;
 use gyrofx_job::error::{Error, Result};
 use gyrofx_job::job::Job;
 
@@ -319,42 +320,34 @@ pub fn harness(block: &Block) -> String {
     }
     ports.extend(inputs.iter().map(|(n, _)| format!("    .{n}({n})")));
     ports.extend(outputs.iter().map(|(n, _)| format!("    .{n}({n})")));
-    format!(
-        "`default_nettype none\n\
-         // Place-and-route harness of {module}: {in_bits} input bits from one shift register,\n\
-         // {out_bits} output bits captured and shifted out, 4 pins.\n\
-         module {HARNESS} (\n\
-         \x20   input wire clk,\n\
-         \x20   input wire serial_in,\n\
-         \x20   input wire capture,\n\
-         \x20   output wire serial_out\n\
-         );\n\
-         {input_regs}\
-         {output_wires}\
-         reg [{out_top}:0] captured = {{{out_bits}{{1'b0}}}};\n\
-         always @(posedge clk) begin\n\
-         \x20   {{{input_names}}} <= {{{shifted_inputs}serial_in}};\n\
-         \x20   captured <= capture ? {{{output_names}}} : {{1'b0, captured[{out_top}:1]}};\n\
-         end\n\
-         assign serial_out = captured[0];\n\
-         {configured} dut (\n{ports}\n);\n\
-         endmodule\n\
-         `default_nettype wire\n",
-        module = block.module,
-        input_regs = inputs
-            .iter()
-            .map(|i| declare("reg", i, true))
-            .collect::<String>(),
-        output_wires = outputs
-            .iter()
-            .map(|o| declare("wire", o, false))
-            .collect::<String>(),
-        out_top = out_bits.max(2) - 1,
-        input_names = names(&inputs),
-        shifted_inputs = shift_source(&inputs),
-        output_names = names(&outputs),
-        configured = design::configured_name(block.module),
-        ports = ports.join(",\n"),
+    fill(
+        HARNESS_TEMPLATE,
+        &[
+            ("module", block.module),
+            ("in_bits", &in_bits.to_string()),
+            ("out_bits", &out_bits.to_string()),
+            ("harness", HARNESS),
+            (
+                "input_regs",
+                &inputs
+                    .iter()
+                    .map(|i| declare("reg", i, true))
+                    .collect::<String>(),
+            ),
+            (
+                "output_wires",
+                &outputs
+                    .iter()
+                    .map(|o| declare("wire", o, false))
+                    .collect::<String>(),
+            ),
+            ("out_top", &(out_bits.max(2) - 1).to_string()),
+            ("input_names", &names(&inputs)),
+            ("shifted_inputs", &shift_source(&inputs)),
+            ("output_names", &names(&outputs)),
+            ("configured", &design::configured_name(block.module)),
+            ("ports", &ports.join(",\n")),
+        ],
     )
 }
 
@@ -389,6 +382,13 @@ fn shift_source(inputs: &[(String, u32)]) -> String {
 /// The file holding [`harness`].
 const HARNESS_FILE: &str = "harness.v";
 
+/// The harness, the per-target yosys scripts and the script that reruns them
+/// (`lab/templates/place_route/`), filled by [`fill`].
+const HARNESS_TEMPLATE: &str = include_str!("../templates/place_route/harness.v");
+const XILINX_SCRIPT: &str = include_str!("../templates/place_route/xilinx.ys");
+const ICE40_SCRIPT: &str = include_str!("../templates/place_route/ice40.ys");
+const RUN_SCRIPT: &str = include_str!("../templates/place_route/run.sh");
+
 /// The yosys script of `target` for `block`, run in the block's folder; it writes
 /// `<target>/stat.json` (and, for iCE40, `<target>/netlist.json` for nextpnr).
 fn yosys_script(block: &Block, target: Target) -> String {
@@ -398,29 +398,35 @@ fn yosys_script(block: &Block, target: Target) -> String {
         .collect();
     let configured = design::configured_name(block.module);
     let folder = target.name();
+    let sources = sources.join(" ");
     match target {
-        Target::Xilinx => format!(
-            "read_verilog {sources} {config}\n\
-             hierarchy -check -top {configured}\n\
-             synth_xilinx -flatten -top {configured}\n\
-             tee -q -o {folder}/stat.json stat -json\n",
-            sources = sources.join(" "),
-            config = design::CONFIGURED_FILE,
+        Target::Xilinx => fill(
+            XILINX_SCRIPT,
+            &[
+                ("sources", &sources),
+                ("config", design::CONFIGURED_FILE),
+                ("configured", &configured),
+                ("folder", folder),
+            ],
         ),
-        Target::Ice40Up5k | Target::Ice40Hx8k => format!(
-            "read_verilog {sources} {config} {HARNESS_FILE}\n\
-             hierarchy -check -top {HARNESS}\n\
-             # The block keeps a module of its own, so that its statistics leave the harness out.\n\
-             setattr -mod -set keep_hierarchy 1 {configured}\n\
-             synth_ice40 {dsp}-top {HARNESS} -json {folder}/netlist.json\n\
-             tee -q -o {folder}/stat.json stat -json\n",
-            sources = sources.join(" "),
-            config = design::CONFIGURED_FILE,
-            dsp = if target == Target::Ice40Up5k {
-                "-dsp "
-            } else {
-                ""
-            },
+        Target::Ice40Up5k | Target::Ice40Hx8k => fill(
+            ICE40_SCRIPT,
+            &[
+                ("sources", &sources),
+                ("config", design::CONFIGURED_FILE),
+                ("harness_file", HARNESS_FILE),
+                ("harness", HARNESS),
+                ("configured", &configured),
+                (
+                    "dsp",
+                    if target == Target::Ice40Up5k {
+                        "-dsp "
+                    } else {
+                        ""
+                    },
+                ),
+                ("folder", folder),
+            ],
         ),
     }
 }
@@ -456,17 +462,12 @@ fn nextpnr_args(target: Target) -> Vec<String> {
 /// The shell script that re-derives a target's figures, run from the block's folder.
 fn run_script(target: Target) -> String {
     let folder = target.name();
-    let mut text = format!(
-        "#!/bin/sh\n\
-         # Re-derives {folder}/stat.json{report}: run from place_and_route/<block>/.\n\
-         set -e\n\
-         yosys -q -l {folder}/yosys.log -s {folder}/synth.ys\n",
-        report = if target == Target::Xilinx {
-            ""
-        } else {
-            " and nextpnr's report.json"
-        },
-    );
+    let report = if target == Target::Xilinx {
+        ""
+    } else {
+        " and nextpnr's report.json"
+    };
+    let mut text = fill(RUN_SCRIPT, &[("folder", folder), ("report", report)]);
     if target != Target::Xilinx {
         text.push_str(&format!(
             "nextpnr-ice40 {}\n",
@@ -837,7 +838,7 @@ fn sample_rate(rate: f64) -> String {
 pub fn place_and_route(
     job: &Job,
     roms: &RomImages,
-    provenance: &crate::text::Provenance,
+    provenance: &gyrofx_codegen::text::Provenance,
     request: &PlaceRequest,
     work: &Path,
     package: &mut Package,

@@ -1,5 +1,5 @@
 use super::*;
-use crate::block::Signal;
+use gyrofx_codegen::block::Signal;
 use gyrofx_model::fx::Format;
 
 fn block(clocked: bool) -> Block {
@@ -12,11 +12,11 @@ fn block(clocked: bool) -> Block {
             Signal::new("z", Format::new(true, 24, 14).unwrap()),
         ],
         vec![
-            crate::block::Output::registered(Signal::new(
+            gyrofx_codegen::block::Output::registered(Signal::new(
                 "rate_out",
                 Format::new(true, 24, 14).unwrap(),
             )),
-            crate::block::Output::pulse(Signal::flag("out_valid")),
+            gyrofx_codegen::block::Output::pulse(Signal::flag("out_valid")),
         ],
     );
     block.clocked = clocked;

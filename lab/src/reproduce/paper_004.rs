@@ -122,7 +122,7 @@ pub fn paper_004(samples: usize, seed: u64) -> Result<Paper004> {
     config.plant.model = "rate".into();
     config.samples = samples;
     config.seed = seed;
-    let job = crate::blocks::checked_job(config)?;
+    let job = gyrofx_codegen::blocks::checked_job(config)?;
     let est = &job.chain.estimator;
     let fs = job.config.stimulus.fs_hz;
     let mut sequencer = Sequencer::new(&est.schedule);

@@ -142,7 +142,7 @@ fn module(job: &Job, design: Design) -> &'static str {
     match design {
         Design::Chain if job.serial.is_some() => "gyrofx_top_serial",
         Design::Chain => synth::TOP,
-        Design::GyroLoop => crate::design::LOOP_TOP,
+        Design::GyroLoop => gyrofx_codegen::design::LOOP_TOP,
     }
 }
 
@@ -169,7 +169,7 @@ fn write(
     });
     let fail =
         |e: &dyn std::fmt::Display| format!("cannot write the cache file {}: {e}", path.display());
-    let mut staged = crate::output_folder::staged_file(folder, ".gyrofx-synth-", ".tmp")
+    let mut staged = gyrofx_codegen::output_folder::staged_file(folder, ".gyrofx-synth-", ".tmp")
         .map_err(|e| fail(&e))?;
     staged
         .write_all(format!("{}\n", serde_json::to_string_pretty(&json).expect("JSON")).as_bytes())

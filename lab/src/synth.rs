@@ -12,17 +12,17 @@ use std::process::Command;
 
 use serde::{Deserialize, Serialize};
 
-use crate::block::Block;
-use crate::blocks::{self, RomImages};
+use gyrofx_codegen::block::Block;
+use gyrofx_codegen::blocks::{self, RomImages};
 
-use crate::design::{
-    configured_name, connections, design_files, sources, CONFIGURED_FILE, LOOP_TOP,
-};
-use crate::output_folder::{self, Kind, Replace};
-use crate::package::Package;
 use crate::place_route;
 use crate::place_route::PlaceRequest;
-use crate::text::Provenance;
+use gyrofx_codegen::design::{
+    configured_name, connections, design_files, sources, CONFIGURED_FILE, LOOP_TOP,
+};
+use gyrofx_codegen::output_folder::{self, Kind, Replace};
+use gyrofx_codegen::package::Package;
+use gyrofx_codegen::text::{fill, Provenance};
 use gyrofx_job::error::{Error, Result};
 use gyrofx_job::job::Job;
 
@@ -198,20 +198,14 @@ fn elaborate(
 pub fn generic_script(module: &str, params: &[(String, String)], parameters: Parameters) -> String {
     let (elaborate, top) = elaborate(module, params, parameters);
     let [_, netlist] = netlist_files(module);
-    format!(
-        "{elaborate}\
-         synth -flatten -top {top} -run :coarse\n\
-         flatten\nproc\n\
-         select -assert-none t:$dlatch t:$adlatch t:$dlatchsr\n\
-         opt -fast\nwreduce\n\
-         tee -q -o coarse.json stat -json\n\
-         synth -flatten -top {top} -run coarse:\n\
-         select -assert-none t:$dlatch t:$adlatch t:$_DLATCH_*\n\
-         check -assert\n\
-         tee -q -o generic.json stat -json\n\
-         rename {top} {netlist_module}\n\
-         write_verilog -noattr {netlist}\n",
-        netlist_module = netlist_name(module),
+    fill(
+        GENERIC_SCRIPT,
+        &[
+            ("elaborate", &elaborate),
+            ("top", &top),
+            ("netlist_module", &netlist_name(module)),
+            ("netlist", &netlist),
+        ],
     )
 }
 
@@ -219,14 +213,14 @@ pub fn generic_script(module: &str, params: &[(String, String)], parameters: Par
 /// `xilinx.json`.
 pub fn xilinx_script(module: &str, params: &[(String, String)], parameters: Parameters) -> String {
     let (elaborate, top) = elaborate(module, params, parameters);
-    format!(
-        "{elaborate}\
-         synth_xilinx -flatten -top {top}\n\
-         select -assert-none t:LDCE t:LDPE\n\
-         check -assert\n\
-         tee -q -o xilinx.json stat -json\n"
-    )
+    fill(XILINX_SCRIPT, &[("elaborate", &elaborate), ("top", &top)])
 }
+
+/// The flows' scripts (`lab/templates/yosys/`): after the elaboration, the generic flow stops at
+/// the coarse netlist to count multipliers and check for latches before optimization can hide
+/// them, then maps to gates and writes the netlist; the Xilinx flow maps to 7-series cells.
+const GENERIC_SCRIPT: &str = include_str!("../templates/yosys/generic.ys");
+const XILINX_SCRIPT: &str = include_str!("../templates/yosys/xilinx.ys");
 
 /// The block's parameters as (name, Verilog value).
 pub fn parameter_values(block: &Block) -> Vec<(String, String)> {
@@ -556,7 +550,7 @@ pub fn synthesize(
     });
     let mut text = serde_json::to_string_pretty(&manifest).expect("manifest serializes");
     text.push('\n');
-    package.add(crate::output_folder::MANIFEST, text);
+    package.add(gyrofx_codegen::output_folder::MANIFEST, text);
     package.write_atomically(out, replace)?;
     Ok(synthesis)
 }

@@ -17,7 +17,7 @@
 //! The error `e = fixed − float` of the KF output (°/s; blanked samples hold the last output,
 //! as the hardware does) gives:
 //!
-//! - rms and max of `|e|` over every sample the KF stepped ([`crate::stats::Accumulator`]), in
+//! - rms and max of `|e|` over every sample the KF stepped ([`gyrofx_codegen::stats::Accumulator`]), in
 //!   output LSB and °/s;
 //! - `σ_e(τ)`, `σ_out(τ)`: the overlapping ADEV ([`OverlappingStream`]) at τ = m/fs, m =
 //!   round(fs · 1 s), of `e` and of the float output, from the first bias estimate on (before
@@ -40,8 +40,10 @@ use gyrofx_model::stimulus::adc;
 use gyrofx_model::system::loop_mode;
 use serde::Serialize;
 
-use crate::stats::Accumulator;
-use crate::vectors::{bw_sel_at, bw_sel_switches, started_loop, EstimatorCounts, KfCounts};
+use gyrofx_codegen::stats::Accumulator;
+use gyrofx_codegen::vectors::{
+    bw_sel_at, bw_sel_switches, started_loop, EstimatorCounts, KfCounts,
+};
 use gyrofx_job::config::GyroLoop;
 use gyrofx_job::error::Result;
 use gyrofx_job::job::Job;

@@ -2,7 +2,7 @@
 //!
 //! A sweep ([`Sweep`]: `--vary KEY=FORMAT..FORMAT`, several flags giving their Cartesian
 //! product, or `--guard-bits A..B` over [`GUARD_BIT_KEYS`]) gives the candidates; each is the
-//! config with those formats, resolved by [`crate::blocks::checked_job`] (a candidate the config's validation
+//! config with those formats, resolved by [`gyrofx_codegen::blocks::checked_job`] (a candidate the config's validation
 //! refuses gets a CSV row with the reason, not a crash). Per candidate:
 //!
 //! - the noise ([`measure`]): the chain's fixed output against its float twin over the
@@ -29,10 +29,10 @@
 
 use std::path::Path;
 
-use crate::output_folder::{Kind, Replace};
-use crate::package::Package;
-use crate::progress::Progress;
 use crate::synth::{Design, Resources};
+use gyrofx_codegen::output_folder::{Kind, Replace};
+use gyrofx_codegen::package::Package;
+use gyrofx_codegen::progress::Progress;
 use gyrofx_job::config::Config;
 use gyrofx_job::error::{Error, Result};
 use gyrofx_job::job::Job;
@@ -143,7 +143,7 @@ impl Plan {
         let record = samples.unwrap_or(config.samples);
         let mut run = config.clone();
         run.samples = record;
-        let job = crate::blocks::checked_job(run).map_err(|e| match (samples, &e) {
+        let job = gyrofx_codegen::blocks::checked_job(run).map_err(|e| match (samples, &e) {
             (Some(n), Error::Config { field, .. }) if field == "samples" => {
                 PlanError::Usage(format!(
                     "--samples {n} is not allowed: 1 to {}",
@@ -274,7 +274,7 @@ fn run_candidate(
         candidate: candidate.clone(),
         outcome,
     };
-    let job = match crate::blocks::checked_job(plan.config_of(candidate)) {
+    let job = match gyrofx_codegen::blocks::checked_job(plan.config_of(candidate)) {
         Ok(job) => job,
         Err(e) => return Ok(row(Err(one_line(&format!("refused: {e}"))))),
     };
@@ -553,7 +553,7 @@ impl Exploration {
         for (key, format) in &row.candidate.formats {
             gyrofx_job::formats::set_format(&mut config, key, *format);
         }
-        crate::blocks::checked_job(config.clone())?;
+        gyrofx_codegen::blocks::checked_job(config.clone())?;
         let c = m.cost();
         let formats = row.candidate.assignments(" = ");
         Ok(Some(format!(
@@ -654,7 +654,7 @@ pub fn write(
     exploration: &Exploration,
     command: &str,
 ) -> Result<Vec<String>> {
-    crate::output_folder::check(out, Kind::Explore, replace)?;
+    gyrofx_codegen::output_folder::check(out, Kind::Explore, replace)?;
     let mut package = Package::new(Kind::Explore, Vec::new());
     package.add("explore.csv", exploration.csv());
     let points = exploration.points();
@@ -673,7 +673,7 @@ pub fn write(
         package.add("best.toml", toml);
     }
     let mut files = package.paths();
-    files.push(crate::output_folder::MANIFEST.into());
+    files.push(gyrofx_codegen::output_folder::MANIFEST.into());
     let manifest = serde_json::json!({
         "tool": "gyrofx",
         "version": env!("CARGO_PKG_VERSION"),
@@ -691,7 +691,7 @@ pub fn write(
         "files": package.entries(),
     });
     package.add(
-        crate::output_folder::MANIFEST,
+        gyrofx_codegen::output_folder::MANIFEST,
         serde_json::to_string_pretty(&manifest).expect("manifest serializes") + "\n",
     );
     package.write_atomically(out, replace)?;

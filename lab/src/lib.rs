@@ -1,0 +1,21 @@
+//! gyrofx-lab: the only code that runs external programs. It takes what codegen writes (a
+//! verification package, a design's files) and runs it: the simulators on a package
+//! ([`simulate`], with [`junit`] summaries), yosys on the chain and the loop ([`synth`]),
+//! yosys and nextpnr per block ([`place_route`]), word-length sweeps costed in yosys
+//! ([`explore`]), the papers' figures ([`reproduce`]) and the plots ([`plot`]). Every child
+//! process starts through [`processes`], which ends them all when a signal ends gyrofx.
+//!
+//! It stands on codegen, the job and the model, and nothing below it knows it exists: the CLI
+//! is its only user.
+#![warn(missing_docs)]
+
+pub mod explore;
+pub mod junit;
+pub mod place_route;
+pub mod plot;
+pub mod processes;
+pub mod reproduce;
+pub mod simulate;
+pub mod synth;
+
+pub use gyrofx_job::error::{Error, Result};
