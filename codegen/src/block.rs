@@ -254,6 +254,38 @@ pub struct Block {
     /// first stage before its outputs show (the KF: 3 with 4 clocks of latency); `None`:
     /// `1 + settle_clocks` ([`Block::clocks_per_sample`]).
     pub sample_spacing: Option<u32>,
+    /// What its DPI-C testbench takes from it (`None`: it has no golden model to call).
+    pub dpi: Option<DpiParts>,
+}
+
+/// What only the block knows of its DPI-C testbench (`crate::dpi` puts these into the frame
+/// every block shares): how its golden model in libgyrofx_capi is called and checked. Each
+/// block keeps the SystemVerilog of its parts beside its module (`dpi_imports.svh`,
+/// `dpi_step.sv`).
+#[derive(Clone, Copy, Debug)]
+pub struct DpiParts {
+    /// The `import "DPI-C"` lines of the model functions it calls (trailing newline ignored).
+    pub imports: &'static str,
+    /// The statements that create its model handles from `plan`.
+    pub handles: &'static str,
+    /// The per-sample body of the stimulus loop (after the driver set `ce`; `k` counts
+    /// samples), from the block as the package has it (its latency may depend on the config).
+    pub step: fn(&Block) -> String,
+    /// Its valid-qualified output stream, if its outputs come as one.
+    pub stream: Option<DpiStream>,
+    /// Samples a run takes by default.
+    pub samples: usize,
+}
+
+/// A valid-qualified output stream, checked against the model whatever the latency.
+#[derive(Clone, Copy, Debug)]
+pub struct DpiStream {
+    /// The valid flag.
+    pub valid: &'static str,
+    /// The output compared with the model's first value.
+    pub value: &'static str,
+    /// The output compared with its second value, if any.
+    pub second: Option<&'static str>,
 }
 
 impl Block {
@@ -319,6 +351,7 @@ impl Block {
             settle_clocks: 0,
             clocked: true,
             sample_spacing: None,
+            dpi: None,
         }
     }
 

@@ -5,9 +5,11 @@ use gyrofx_model::estimator::Plan;
 use serde_json::json;
 
 use super::{flag, mode_params, ChainSample, RomImages, RtlBlock, VectorBuilder};
+use crate::block::DpiParts;
 use crate::block::{Block, Output, Param, Signal};
 use crate::rom::{Rom, RomFormat, ROM_FOLDER};
 use crate::stats::Accumulator;
+use crate::text::fill;
 use crate::vectors::{Results, Run};
 use gyrofx_job::job::Job;
 
@@ -102,6 +104,7 @@ impl RtlBlock for Estimator {
             .push(Param::string("ROM_FILE", &rom.0, "gain ROM"));
         block.roms.push(rom);
         block.settle_clocks = SETTLE_CLOCKS;
+        block.dpi = Some(DPI);
         block
     }
 
@@ -209,4 +212,25 @@ impl VectorBuilder for Vectors<'_> {
         results.bias_stats = Some(self.bias.finish(bound));
         self.block
     }
+}
+
+/// The DPI-C testbench's parts ([`DpiParts`]): the slots from the sequencer's own model (the estimator's protocol), the estimates after the latency.
+const DPI: DpiParts = DpiParts {
+    imports: concat!(
+        include_str!("../sequencer/dpi_imports.svh"),
+        include_str!("dpi_imports.svh")
+    ),
+    handles:
+        "sequencer = gyrofx_sequencer_new(plan);\n        estimator = gyrofx_estimator_new(plan);",
+    step: dpi_step,
+    stream: None,
+    samples: 4000,
+};
+
+/// One sample of the DPI-C testbench's stimulus loop.
+fn dpi_step(_block: &Block) -> String {
+    fill(
+        include_str!("dpi_step.sv").trim_end(),
+        &[("settle", &SETTLE_CLOCKS.to_string())],
+    )
 }

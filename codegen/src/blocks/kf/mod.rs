@@ -9,9 +9,11 @@ use serde_json::json;
 
 use super::{mode_params, ChainSample, RomImages, RtlBlock, VectorBuilder};
 use crate::block::{Block, Output, Param, Signal};
+use crate::block::{DpiParts, DpiStream};
 use crate::report;
 use crate::rom::{Rom, RomFormat, ROM_FOLDER};
 use crate::stats::Accumulator;
+use crate::text::fill;
 use crate::vectors::{Results, Run};
 use gyrofx_job::job::Job;
 
@@ -106,6 +108,7 @@ impl RtlBlock for Kf {
             .params
             .push(Param::string("ROM_FILE", &rom.0, "coefficient ROM"));
         block.roms.push(rom);
+        block.dpi = Some(DPI);
         block
     }
 
@@ -285,4 +288,28 @@ fn directed_segment(plan: &Plan, ties: &[TieCases], block: &mut Block) -> Overfl
         }
     }
     kf.overflow_counts()
+}
+
+/// The DPI-C testbench's parts ([`DpiParts`]): one sample every `SETTLE_CLOCKS` clocks, the rate against the model as a stream.
+const DPI: DpiParts = DpiParts {
+    imports: include_str!("dpi_imports.svh"),
+    handles: "kf = gyrofx_kf_new(plan);",
+    step: dpi_step,
+    stream: Some(DpiStream {
+        valid: "out_valid",
+        value: "rate_out",
+        second: None,
+    }),
+    samples: 4000,
+};
+
+/// One sample of the DPI-C testbench's stimulus loop.
+fn dpi_step(_block: &Block) -> String {
+    fill(
+        include_str!("dpi_step.sv").trim_end(),
+        &[
+            ("idle", &(SETTLE_CLOCKS - 1).to_string()),
+            ("every", &SETTLE_CLOCKS.to_string()),
+        ],
+    )
 }

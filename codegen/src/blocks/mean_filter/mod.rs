@@ -7,6 +7,7 @@ use serde_json::json;
 
 use super::{mode_params, ChainSample, RomImages, RtlBlock, VectorBuilder};
 use crate::block::{Block, Output, Param, Signal};
+use crate::block::{DpiParts, DpiStream};
 use crate::rom::{Rom, RomFormat, ROM_FOLDER};
 use crate::stats::Accumulator;
 use crate::vectors::{Results, Run};
@@ -114,6 +115,7 @@ impl RtlBlock for MeanFilter {
             .params
             .push(Param::string("ROM_FILE", &rom.0, "reciprocal ROM"));
         block.roms.push(rom);
+        block.dpi = Some(DPI);
         block
     }
 
@@ -294,4 +296,30 @@ fn directed(plan: &Plan) -> Vec<Option<i64>> {
     spike[window / 2] = Some(max);
     samples.extend(spike);
     samples
+}
+
+/// The DPI-C testbench's parts ([`DpiParts`]): each mean and its kept count against the model as a stream.
+const DPI: DpiParts = DpiParts {
+    imports: include_str!("dpi_imports.svh"),
+    handles: "filter = gyrofx_mean_filter_new(plan);",
+    step: dpi_step,
+    stream: Some(DpiStream {
+        valid: "y_valid",
+        value: "y",
+        second: Some("kept"),
+    }),
+    samples: 4000,
+};
+
+/// One sample of the DPI-C testbench's stimulus loop.
+fn dpi_step(block: &Block) -> String {
+    let mut step = include_str!("dpi_step.sv").trim_end().to_string();
+    if block.settle_clocks > 0 {
+        // The sequential filter: the next sample once a block's mean is out.
+        step.push_str(&format!(
+            "\n            @(negedge clk);\n            ce = 1'b0;\n            repeat ({}) @(posedge clk);",
+            block.settle_clocks
+        ));
+    }
+    step
 }

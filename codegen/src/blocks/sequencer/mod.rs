@@ -5,6 +5,7 @@
 use gyrofx_model::sequencer::Schedule;
 
 use super::{flag, mode_bit, ChainSample, RomImages, RtlBlock, VectorBuilder};
+use crate::block::DpiParts;
 use crate::block::{Block, Output, Param, Signal};
 use crate::vectors::Results;
 use gyrofx_job::job::Job;
@@ -105,6 +106,7 @@ impl RtlBlock for Sequencer {
             ],
         );
         block.params = params(schedule);
+        block.dpi = Some(DPI);
         block
     }
 
@@ -146,4 +148,21 @@ impl VectorBuilder for Vectors {
     fn finish(self: Box<Self>, _results: &mut Results) -> Block {
         self.block
     }
+}
+
+/// The DPI-C testbench's parts ([`DpiParts`]): every output against the model before the clock edge.
+const DPI: DpiParts = DpiParts {
+    imports: concat!(
+        include_str!("dpi_imports.svh"),
+        include_str!("../estimator/dpi_imports.svh")
+    ),
+    handles: "sequencer = gyrofx_sequencer_new(plan);",
+    step: dpi_step,
+    stream: None,
+    samples: 4000,
+};
+
+/// One sample of the DPI-C testbench's stimulus loop.
+fn dpi_step(_block: &Block) -> String {
+    include_str!("dpi_step.sv").trim_end().to_string()
 }

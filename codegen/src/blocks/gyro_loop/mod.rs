@@ -18,6 +18,7 @@ use serde_json::json;
 
 use super::{flag, mode_params, ChainSample, RomImages, RtlBlock, VectorBuilder};
 use crate::block::{Block, Output, Param, Signal};
+use crate::block::{DpiParts, DpiStream};
 use crate::rom::Rom;
 use crate::vectors::{Results, Run};
 use gyrofx_job::config::GyroLoop as LoopConfig;
@@ -288,6 +289,7 @@ impl RtlBlock for GyroLoop {
         block.params = parameters(plan, &roms.entry(SINE_ROM).0, &roms.entry(TAPS_ROM).0);
         block.roms.push(roms.entry(SINE_ROM));
         block.roms.push(roms.entry(TAPS_ROM));
+        block.dpi = Some(DPI);
         block
     }
 
@@ -408,4 +410,22 @@ pub struct RecordSummary {
     pub first_lock_sample: [Option<usize>; 2],
     /// Decimated outputs.
     pub outputs: usize,
+}
+
+/// The DPI-C testbench's parts ([`DpiParts`]): a mode switch every 701 samples, the DACs and lock after the latency, the rates as a stream; 12 000 samples give a dozen rates.
+const DPI: DpiParts = DpiParts {
+    imports: include_str!("dpi_imports.svh"),
+    handles: "gyro_loop = gyrofx_gyro_loop_new(plan, 0);",
+    step: dpi_step,
+    stream: Some(DpiStream {
+        valid: "out_valid",
+        value: "rate",
+        second: Some("quadrature"),
+    }),
+    samples: 12_000,
+};
+
+/// One sample of the DPI-C testbench's stimulus loop.
+fn dpi_step(_block: &Block) -> String {
+    include_str!("dpi_step.sv").trim_end().to_string()
 }

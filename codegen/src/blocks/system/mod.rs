@@ -29,6 +29,8 @@ use gyrofx_job::config::GyroLoop as LoopConfig;
 use gyrofx_job::error::{Error, Result};
 use gyrofx_job::job::Job;
 
+use crate::block::{DpiParts, DpiStream};
+use crate::text::fill;
 use gyrofx_job::system::{BLANK, INTERVAL_LENGTH};
 
 /// The system block.
@@ -222,6 +224,7 @@ impl RtlBlock for System {
         block.roms.push(coefficients);
         block.roms.push(sine);
         block.roms.push(taps);
+        block.dpi = Some(DPI);
         block
     }
 
@@ -395,6 +398,27 @@ impl VectorBuilder for Vectors<'_> {
         results.system_record = Some(summary);
         self.block
     }
+}
+
+/// The DPI-C testbench's parts ([`DpiParts`]): enable from sample 500, every output after the latency, the rate as a stream; 14 000 samples let the chain finish an estimator window.
+const DPI: DpiParts = DpiParts {
+    imports: include_str!("dpi_imports.svh"),
+    handles: "system = gyrofx_system_new(plan);",
+    step: dpi_step,
+    stream: Some(DpiStream {
+        valid: "out_valid",
+        value: "rate_out",
+        second: None,
+    }),
+    samples: 14_000,
+};
+
+/// One sample of the DPI-C testbench's stimulus loop.
+fn dpi_step(_block: &Block) -> String {
+    fill(
+        include_str!("dpi_step.sv").trim_end(),
+        &[("settle", &SETTLE_CLOCKS.to_string())],
+    )
 }
 
 #[cfg(test)]

@@ -9,8 +9,10 @@ use serde_json::json;
 use super::{estimator, flag, kf, mode_bit, mode_params, sequencer};
 use super::{ChainSample, RomImages, RtlBlock, VectorBuilder};
 use crate::block::{Block, Output, Param, Signal};
+use crate::block::{DpiParts, DpiStream};
 use crate::rom::Rom;
 use crate::stats::Accumulator;
+use crate::text::fill;
 use crate::vectors::{Results, Run};
 use gyrofx_job::job::Job;
 
@@ -189,6 +191,7 @@ impl RtlBlock for Top {
         block.settle_clocks = SETTLE_CLOCKS;
         block.roms.push(gains);
         block.roms.push(coefficients);
+        block.dpi = Some(DPI);
         block
     }
 
@@ -303,4 +306,25 @@ impl VectorBuilder for Vectors<'_> {
         results.chain_stats = Some(std::mem::take(&mut self.errors).finish(bound));
         self.block
     }
+}
+
+/// The DPI-C testbench's parts ([`DpiParts`]): the modes before the edge, the rate as a stream, the estimates after the latency.
+const DPI: DpiParts = DpiParts {
+    imports: include_str!("dpi_imports.svh"),
+    handles: "chain = gyrofx_chain_new(plan);",
+    step: dpi_step,
+    stream: Some(DpiStream {
+        valid: "out_valid",
+        value: "rate_out",
+        second: None,
+    }),
+    samples: 4000,
+};
+
+/// One sample of the DPI-C testbench's stimulus loop.
+fn dpi_step(block: &Block) -> String {
+    fill(
+        include_str!("dpi_step.sv").trim_end(),
+        &[("settle", &block.settle_clocks.to_string())],
+    )
 }

@@ -1,0 +1,3 @@
+import "DPI-C" function chandle gyrofx_kf_new(input chandle plan);
+import "DPI-C" function int gyrofx_kf_reset(input chandle kf);
+import "DPI-C" function int gyrofx_kf_step(input chandle kf, input longint z, input int bw_sel, output longint rate_out);
