@@ -96,6 +96,7 @@ impl RtlBlock for Estimator {
                 Output::registered(Signal::flag("estimated")),
             ],
         );
+        block.dpi = Some(DPI);
         block.params = params(est);
         block.params.extend(mode_params(est.rounding, est.overflow));
         let rom = roms.entry(ROM);
@@ -104,7 +105,6 @@ impl RtlBlock for Estimator {
             .push(Param::string("ROM_FILE", &rom.0, "gain ROM"));
         block.roms.push(rom);
         block.settle_clocks = SETTLE_CLOCKS;
-        block.dpi = Some(DPI);
         block
     }
 

@@ -285,11 +285,11 @@ impl RtlBlock for GyroLoop {
                 Output::gated(Signal::new("quadrature", plan.output.to), "out_valid"),
             ],
         );
+        block.dpi = Some(DPI);
         block.settle_clocks = SETTLE_CLOCKS;
         block.params = parameters(plan, &roms.entry(SINE_ROM).0, &roms.entry(TAPS_ROM).0);
         block.roms.push(roms.entry(SINE_ROM));
         block.roms.push(roms.entry(TAPS_ROM));
-        block.dpi = Some(DPI);
         block
     }
 

@@ -98,6 +98,7 @@ impl RtlBlock for Kf {
                 Output::gated(Signal::new("rate_out", kf.output), "out_valid"),
             ],
         );
+        block.dpi = Some(DPI);
         block.settle_clocks = SETTLE_CLOCKS;
         // The next sample's `e` needs only the new states, not the rounded output.
         block.sample_spacing = Some(SETTLE_CLOCKS);
@@ -108,7 +109,6 @@ impl RtlBlock for Kf {
             .params
             .push(Param::string("ROM_FILE", &rom.0, "coefficient ROM"));
         block.roms.push(rom);
-        block.dpi = Some(DPI);
         block
     }
 

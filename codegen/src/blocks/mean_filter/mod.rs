@@ -59,6 +59,7 @@ impl RtlBlock for MeanFilter {
                 Output::gated(Signal::index("kept", plan.count_bits), "y_valid"),
             ],
         );
+        block.dpi = Some(DPI);
         block
             .params
             .extend(Param::format("IN", plan.input, "input x"));
@@ -115,7 +116,6 @@ impl RtlBlock for MeanFilter {
             .params
             .push(Param::string("ROM_FILE", &rom.0, "reciprocal ROM"));
         block.roms.push(rom);
-        block.dpi = Some(DPI);
         block
     }
 

@@ -105,8 +105,8 @@ impl RtlBlock for Sequencer {
                 Output::combinational(Signal::flag("window_done")),
             ],
         );
-        block.params = params(schedule);
         block.dpi = Some(DPI);
+        block.params = params(schedule);
         block
     }
 

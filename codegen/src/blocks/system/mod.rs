@@ -205,6 +205,7 @@ impl RtlBlock for System {
                 Output::registered(Signal::flag("estimated")),
             ],
         );
+        block.dpi = Some(DPI);
         block.settle_clocks = SETTLE_CLOCKS;
         let gains = roms.entry(GAINS_ROM);
         let coefficients = roms.entry(kf::ROM);
@@ -224,7 +225,6 @@ impl RtlBlock for System {
         block.roms.push(coefficients);
         block.roms.push(sine);
         block.roms.push(taps);
-        block.dpi = Some(DPI);
         block
     }
 

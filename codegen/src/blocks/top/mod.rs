@@ -173,6 +173,7 @@ impl RtlBlock for Top {
                 Output::registered(Signal::flag("estimated")),
             ],
         );
+        block.dpi = Some(DPI);
         block.extra = vec!["float_rate_dps", "ideal_rate_dps", "true_rate_dps"];
         if let Some(program) = &job.serial {
             let code = roms.entry(SERIAL_PROGRAM_ROM);
@@ -191,7 +192,6 @@ impl RtlBlock for Top {
         block.settle_clocks = SETTLE_CLOCKS;
         block.roms.push(gains);
         block.roms.push(coefficients);
-        block.dpi = Some(DPI);
         block
     }
 
