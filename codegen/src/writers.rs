@@ -136,7 +136,6 @@ pub fn makefile(blocks: &[Block], provenance: &Provenance) -> String {
             &[
                 ("folder", crate::cocotb::FOLDER),
                 ("list", &names.join(", ")),
-                ("phony", &targets(&["cocotb"], &names)),
                 ("targets", &targets(&["cocotb"], &names)),
             ],
         ));
@@ -155,7 +154,6 @@ pub fn makefile(blocks: &[Block], provenance: &Provenance) -> String {
             &[
                 ("folder", crate::dpi::FOLDER),
                 ("list", &names.join(", ")),
-                ("phony", &targets(&["dpi"], &names)),
                 ("targets", &targets(&["dpi"], &names)),
             ],
         ));

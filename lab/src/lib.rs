@@ -17,5 +17,3 @@ pub mod processes;
 pub mod reproduce;
 pub mod simulate;
 pub mod synth;
-
-pub use gyrofx_job::error::{Error, Result};

@@ -4,5 +4,5 @@
 # -p gyrofx-capi in the gyrofx repository). DPI_PLUSARGS: +samples=<n> +seed=<n> +flip=<k>.
 GYROFX_CAPI_LIB ?=
 DPI_PLUSARGS ?=
-.PHONY: sim-dpi@phony@
+.PHONY: sim-dpi@targets@
 sim-dpi:@targets@

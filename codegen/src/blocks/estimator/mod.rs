@@ -214,7 +214,8 @@ impl VectorBuilder for Vectors<'_> {
     }
 }
 
-/// The DPI-C testbench's parts ([`DpiParts`]): the slots from the sequencer's own model (the estimator's protocol), the estimates after the latency.
+/// The DPI-C testbench's parts ([`DpiParts`]): the slots from the sequencer's own model (the
+/// estimator's protocol), the estimates after the latency.
 const DPI: DpiParts = DpiParts {
     imports: concat!(
         include_str!("../sequencer/dpi_imports.svh"),

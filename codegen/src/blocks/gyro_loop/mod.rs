@@ -412,7 +412,8 @@ pub struct RecordSummary {
     pub outputs: usize,
 }
 
-/// The DPI-C testbench's parts ([`DpiParts`]): a mode switch every 701 samples, the DACs and lock after the latency, the rates as a stream; 12 000 samples give a dozen rates.
+/// The DPI-C testbench's parts ([`DpiParts`]): a mode switch every 701 samples, the DACs and lock
+/// after the latency, the rates as a stream; 12 000 samples give a dozen rates.
 const DPI: DpiParts = DpiParts {
     imports: include_str!("dpi_imports.svh"),
     handles: "gyro_loop = gyrofx_gyro_loop_new(plan, 0);",

@@ -290,7 +290,8 @@ fn directed_segment(plan: &Plan, ties: &[TieCases], block: &mut Block) -> Overfl
     kf.overflow_counts()
 }
 
-/// The DPI-C testbench's parts ([`DpiParts`]): one sample every `SETTLE_CLOCKS` clocks, the rate against the model as a stream.
+/// The DPI-C testbench's parts ([`DpiParts`]): one sample every `SETTLE_CLOCKS` clocks, the rate
+/// against the model as a stream.
 const DPI: DpiParts = DpiParts {
     imports: include_str!("dpi_imports.svh"),
     handles: "kf = gyrofx_kf_new(plan);",

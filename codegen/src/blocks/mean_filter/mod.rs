@@ -298,7 +298,8 @@ fn directed(plan: &Plan) -> Vec<Option<i64>> {
     samples
 }
 
-/// The DPI-C testbench's parts ([`DpiParts`]): each mean and its kept count against the model as a stream.
+/// The DPI-C testbench's parts ([`DpiParts`]): each mean and its kept count against the model as a
+/// stream.
 const DPI: DpiParts = DpiParts {
     imports: include_str!("dpi_imports.svh"),
     handles: "filter = gyrofx_mean_filter_new(plan);",

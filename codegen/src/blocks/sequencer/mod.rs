@@ -150,7 +150,8 @@ impl VectorBuilder for Vectors {
     }
 }
 
-/// The DPI-C testbench's parts ([`DpiParts`]): every output against the model before the clock edge.
+/// The DPI-C testbench's parts ([`DpiParts`]): every output against the model before the clock
+/// edge.
 const DPI: DpiParts = DpiParts {
     imports: concat!(
         include_str!("dpi_imports.svh"),

@@ -400,7 +400,8 @@ impl VectorBuilder for Vectors<'_> {
     }
 }
 
-/// The DPI-C testbench's parts ([`DpiParts`]): enable from sample 500, every output after the latency, the rate as a stream; 14 000 samples let the chain finish an estimator window.
+/// The DPI-C testbench's parts ([`DpiParts`]): enable from sample 500, every output after the
+/// latency, the rate as a stream; 14 000 samples let the chain finish an estimator window.
 const DPI: DpiParts = DpiParts {
     imports: include_str!("dpi_imports.svh"),
     handles: "system = gyrofx_system_new(plan);",

@@ -308,7 +308,8 @@ impl VectorBuilder for Vectors<'_> {
     }
 }
 
-/// The DPI-C testbench's parts ([`DpiParts`]): the modes before the edge, the rate as a stream, the estimates after the latency.
+/// The DPI-C testbench's parts ([`DpiParts`]): the modes before the edge, the rate as a stream, the
+/// estimates after the latency.
 const DPI: DpiParts = DpiParts {
     imports: include_str!("dpi_imports.svh"),
     handles: "chain = gyrofx_chain_new(plan);",
