@@ -8,8 +8,8 @@
 # plots use), FuseSoC with pip in a virtualenv, and
 # maturin, numpy, pytest and pytest-xdist in another (for the Python package in python/):
 # a missing simulator is a failure, never a skipped test. Then: rustfmt,
-# clippy, Verilator lint of the RTL, and the whole test suite (unit, property, end-to-end
-# with both simulators, golden vectors), then the Python package's wheel and pytest suite. Benchmarks are compiled (clippy --all-targets) but
+# clippy, Verilator lint of the RTL, and the whole test suite with cargo-nextest (unit, property,
+# end-to-end in every simulator, golden vectors, doc tests), then the Python package's wheel and pytest suite. Benchmarks are compiled (clippy --all-targets) but
 # not run: run them with `cargo bench`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -100,11 +100,21 @@ ghdl -a --std=08 -Werror -Wunused -Wbinding -Wbody -Wspecs --workdir="$ghdl_work
     hdl/gyrofx_cic.vhd hdl/gyrofx_gyro_loop.vhd hdl/gyrofx_system.vhd hdl/gyrofx_serial_engine.vhd \
     hdl/gyrofx_top_serial.vhd hdl/gyrofx_testbench_pkg.vhd
 rm -rf "$ghdl_work"
-echo "== cargo test"
+echo "== cargo nextest run (every test binary of the workspace), then the doc tests"
+# cargo-nextest runs the tests: a process per test, one pool over every binary, the longest
+# first (.config/nextest.toml), where `cargo test` ran one binary at a time in name order and
+# left its last long test alone on one core. Rust toolchains here come with it; where one does
+# not, it is built from crates.io once (a few minutes).
+if ! cargo nextest --version >/dev/null 2>&1; then
+    echo "== installing cargo-nextest from crates.io"
+    cargo install --locked --quiet cargo-nextest
+fi
 # The C library's archive (libgyrofx_capi.a) is an artifact of a plain build, not of the test
 # build: tests/dpi.rs links it into a C program, a C++ Verilator harness and the DPI-C testbenches.
 cargo build -p gyrofx-capi
-cargo test --workspace
+cargo nextest run --workspace --no-tests=fail
+# nextest does not run doc tests.
+cargo test --workspace --doc
 
 # The Python package (python/): pyo3 + numpy, built by maturin as an abi3 wheel into a
 # virtualenv from PyPI (reused across runs), then its pytest suite: the model against the CLI's
@@ -117,9 +127,15 @@ if [ ! -x "$python_venv/bin/maturin" ] || ! "$python_venv/bin/python" -c "import
     "$python_venv/bin/pip" install -q "maturin>=1.5,<2" numpy pytest pytest-xdist "cocotb>=2.0,<3"
 fi
 cargo fmt --manifest-path python/Cargo.toml -- --check
+# In the workspace's target folder and its dev profile (the model fully optimised): the crates
+# the workspace's build compiled with the same versions and features are not compiled again
+# (python/Cargo.lock keeps the workspace's versions of the crates both use). A release wheel
+# compiled every crate again, at opt-level 3.
+export CARGO_TARGET_DIR="$PWD/target"
 cargo clippy --manifest-path python/Cargo.toml --all-targets --quiet -- -D warnings
 rm -rf python/target/wheels
-"$python_venv/bin/maturin" build --release --quiet -m python/Cargo.toml --out python/target/wheels
+"$python_venv/bin/maturin" build --profile dev --quiet -m python/Cargo.toml --out python/target/wheels
+unset CARGO_TARGET_DIR
 "$python_venv/bin/pip" install -q --force-reinstall --no-deps python/target/wheels/gyrofx-*.whl
 # One pytest worker per core (pytest-xdist): each cocotb run is one single-threaded simulator.
 GYROFX_CLI="$PWD/target/debug/gyrofx" "$python_venv/bin/python" -m pytest -q -n auto python/tests

@@ -6,7 +6,6 @@
 //! and plots but no best.toml and exits 1; bad arguments name the flag and leave no folder.
 
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
 
 use crate::common::{gyrofx, ok, text};
 
@@ -31,7 +30,7 @@ fn sweep(cache: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
     gyrofx(&args)
 }
 
-/// The first run, shared by the tests that read it: its folder, cache and output.
+/// The first run, which every check below reads: its folder, cache and output.
 struct Fixture {
     _root: tempfile::TempDir,
     root: PathBuf,
@@ -40,24 +39,34 @@ struct Fixture {
     printed: String,
 }
 
-fn fixture() -> &'static Fixture {
-    static FIXTURE: OnceLock<Fixture> = OnceLock::new();
-    FIXTURE.get_or_init(|| {
-        let dir = tempfile::tempdir().unwrap();
-        let root = dir.path().to_path_buf();
-        let out = root.join("sweep");
-        let cache = root.join("cache");
-        let output = sweep(&cache, &out, &["--jobs", "2", "--quiet"]);
-        assert!(output.status.success(), "{}", text(&output));
-        let printed = text(&output);
-        Fixture {
-            _root: dir,
-            root,
-            out,
-            cache,
-            printed,
-        }
-    })
+fn fixture() -> Fixture {
+    let dir = tempfile::tempdir().unwrap();
+    let root = dir.path().to_path_buf();
+    let out = root.join("sweep");
+    let cache = root.join("cache");
+    let output = sweep(&cache, &out, &["--jobs", "2", "--quiet"]);
+    assert!(output.status.success(), "{}", text(&output));
+    let printed = text(&output);
+    Fixture {
+        _root: dir,
+        root,
+        out,
+        cache,
+        printed,
+    }
+}
+
+/// One test reads the first run in every way: the run is over 100 s of yosys, and the test
+/// runner gives each test a process of its own, so a fixture shared by several tests would run
+/// once per test.
+#[test]
+fn the_sweep_its_csv_best_toml_cache_and_unmet_target() {
+    let f = fixture();
+    every_candidate_has_a_row_with_every_column(&f);
+    more_fraction_bits_mean_less_error_and_more_flip_flops(&f);
+    best_toml_is_the_cheapest_that_meets_the_target_and_generates_strictly(&f);
+    a_second_run_takes_every_cost_from_the_cache_and_writes_the_same_csv(&f);
+    a_target_nobody_meets_writes_no_best_toml_and_exits_1(&f);
 }
 
 /// The CSV as a header and rows of fields (the files hold no quoted field: checked).
@@ -97,9 +106,7 @@ fn cache_files(cache: &Path) -> Vec<String> {
     names
 }
 
-#[test]
-fn every_candidate_has_a_row_with_every_column() {
-    let f = fixture();
+fn every_candidate_has_a_row_with_every_column(f: &Fixture) {
     let (header, rows) = table(&f.out.join("explore.csv"));
     for name in [
         "candidate",
@@ -173,9 +180,7 @@ fn every_candidate_has_a_row_with_every_column() {
     }
 }
 
-#[test]
-fn more_fraction_bits_mean_less_error_and_more_flip_flops() {
-    let f = fixture();
+fn more_fraction_bits_mean_less_error_and_more_flip_flops(f: &Fixture) {
     let (header, rows) = table(&f.out.join("explore.csv"));
     let rms: Vec<f64> = rows
         .iter()
@@ -199,9 +204,7 @@ fn more_fraction_bits_mean_less_error_and_more_flip_flops() {
     assert!(generic.windows(2).all(|p| p[1] > p[0]), "{generic:?}");
 }
 
-#[test]
-fn best_toml_is_the_cheapest_that_meets_the_target_and_generates_strictly() {
-    let f = fixture();
+fn best_toml_is_the_cheapest_that_meets_the_target_and_generates_strictly(f: &Fixture) {
     let (header, rows) = table(&f.out.join("explore.csv"));
     let cost = |r: &Vec<String>| {
         (
@@ -253,9 +256,7 @@ fn best_toml_is_the_cheapest_that_meets_the_target_and_generates_strictly() {
     assert!(manifest.contains(&format!("\"state_format\": \"{state}\"")));
 }
 
-#[test]
-fn a_second_run_takes_every_cost_from_the_cache_and_writes_the_same_csv() {
-    let f = fixture();
+fn a_second_run_takes_every_cost_from_the_cache_and_writes_the_same_csv(f: &Fixture) {
     let before = cache_files(&f.cache);
     let again = f.root.join("again");
     let output = sweep(&f.cache, &again, &["--jobs", "1", "--quiet"]);
@@ -273,9 +274,7 @@ fn a_second_run_takes_every_cost_from_the_cache_and_writes_the_same_csv() {
     );
 }
 
-#[test]
-fn a_target_nobody_meets_writes_no_best_toml_and_exits_1() {
-    let f = fixture();
+fn a_target_nobody_meets_writes_no_best_toml_and_exits_1(f: &Fixture) {
     let out = f.root.join("unmet");
     let output = sweep(&f.cache, &out, &["--target", "max-error-lsb<=0", "--quiet"]);
     assert_eq!(output.status.code(), Some(1), "{}", text(&output));
