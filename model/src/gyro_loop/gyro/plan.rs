@@ -9,7 +9,7 @@ use super::settings::{format, LoopSettings};
 use super::{axes, mode_index};
 use crate::fx::{from_f64, CoefficientFormat, Format, Overflow, Rounding};
 use crate::gyro_loop::{
-    cic, demodulator, field_error, nco, pi, quantize_coefficients, PlanError, Point,
+    cic, demodulator, field_error, nco, pi, quantize_coefficients, Coefficient, PlanError, Point,
 };
 use crate::resonator::{Mode, ModeFigures, PhysicsSettings, ResonatorParams};
 
@@ -189,6 +189,93 @@ impl Plan {
     pub fn new(spec: &Spec) -> Result<Plan, PlanError> {
         let s = &spec.settings;
         let (params, front) = (&spec.resonator, &spec.front_end);
+        let checked = Checked::new(spec)?;
+        let blocks = LeafBlocks::new(s, &checked)?;
+        let figures = [Mode::Normal, Mode::Reverse].map(|m| ModeFigures::new(params, m));
+        let (a_nco, cic_gain) = (blocks.nco.amplitude(), blocks.cic.flatness().dc_gain);
+        let physics =
+            figures.map(|f| ModePhysics::new(&f, params, front, a_nco, cic_gain, checked.fs));
+        let (pll, pll_gains, pll_limits) = pll_plan(s, &checked, &blocks, &physics)?;
+        let drive = Drive::new(s, &checked, &blocks, &physics[0])?;
+        let (coefficients, output) = output_stage(s, &checked, &blocks, &physics)?;
+        let lock = lock_plan(s, &checked, blocks.demod_output)?;
+        let mut modes = Vec::with_capacity(2);
+        for (i, f) in figures.iter().enumerate() {
+            modes.push(mode_plan(
+                spec,
+                &checked,
+                &blocks,
+                &pll,
+                &drive,
+                (f, &physics[i]),
+                [coefficients[i], coefficients[2 + i]],
+            )?);
+        }
+        let modes: [ModePlan; 2] = [modes[0], modes[1]];
+        debug_assert_eq!(mode_index(modes[1].mode), 1);
+        Ok(Plan {
+            settings: s.clone(),
+            adc_rate_hz: checked.fs,
+            latency: s.adc_to_dac_latency_samples,
+            adc: checked.adc,
+            nco: blocks.nco,
+            demodulator: blocks.demodulator,
+            pll,
+            agc: drive.agc,
+            agc_error: drive.agc_error,
+            dac: drive.dac_point,
+            cic: blocks.cic,
+            output,
+            lock,
+            modes,
+            design: Design {
+                pll_gains,
+                agc_gains: drive.gains,
+                pll_limits,
+                agc_limits: drive.limits,
+            },
+            dac_newton_per_lsb: front.dac_newton_per_lsb,
+            adc_full_scale_v: front.adc_full_scale_v,
+        })
+    }
+
+    /// The plan of `mode`.
+    pub fn mode(&self, mode: Mode) -> &ModePlan {
+        &self.modes[mode_index(mode)]
+    }
+
+    /// The chain's rate `fs / R`, Hz.
+    pub fn chain_rate_hz(&self) -> f64 {
+        self.adc_rate_hz / f64::from(self.cic.decimation)
+    }
+}
+
+/// The settings checked one by one, in the order a refusal names the first bad one: the
+/// physics, the modes, the ADC, the latency, then the positive design values.
+struct Checked {
+    rounding: Rounding,
+    overflow: Overflow,
+    /// `fs`, Hz.
+    fs: f64,
+    adc: Format,
+    /// Hz.
+    pll_bandwidth: f64,
+    /// Hz.
+    agc_bandwidth: f64,
+    /// Hz either side of the two modes' frequencies.
+    pull: f64,
+    /// Degrees.
+    lock_phase: f64,
+    /// Share of the setpoint.
+    lock_tolerance: f64,
+    /// Milliseconds.
+    hold_ms: f64,
+}
+
+impl Checked {
+    fn new(spec: &Spec) -> Result<Checked, PlanError> {
+        let s = &spec.settings;
+        let (params, front) = (&spec.resonator, &spec.front_end);
         params
             .validate()
             .and_then(|_| front.validate(params))
@@ -228,13 +315,34 @@ impl Plan {
                 format!("0..={MAX_LATENCY}"),
             ));
         }
-        let pll_bandwidth = positive("pll_bandwidth_hz", s.pll_bandwidth_hz)?;
-        let agc_bandwidth = positive("agc_bandwidth_hz", s.agc_bandwidth_hz)?;
-        let pull = positive("pll_pull_range_hz", s.pll_pull_range_hz)?;
-        let lock_phase = positive("lock_phase_deg", s.lock_phase_deg)?;
-        let lock_tolerance = positive("lock_amplitude_tolerance", s.lock_amplitude_tolerance)?;
-        let hold_ms = positive("lock_hold_ms", s.lock_hold_ms)?;
+        Ok(Checked {
+            rounding,
+            overflow,
+            fs,
+            adc,
+            pll_bandwidth: positive("pll_bandwidth_hz", s.pll_bandwidth_hz)?,
+            agc_bandwidth: positive("agc_bandwidth_hz", s.agc_bandwidth_hz)?,
+            pull: positive("pll_pull_range_hz", s.pll_pull_range_hz)?,
+            lock_phase: positive("lock_phase_deg", s.lock_phase_deg)?,
+            lock_tolerance: positive("lock_amplitude_tolerance", s.lock_amplitude_tolerance)?,
+            hold_ms: positive("lock_hold_ms", s.lock_hold_ms)?,
+        })
+    }
+}
 
+/// The blocks whose plans follow from the settings alone: the NCOs, the demodulators and the
+/// CICs.
+struct LeafBlocks {
+    nco: nco::Plan,
+    demodulator: demodulator::Plan,
+    /// The demodulators' output format, which the PIs, the lock detector and the CICs take.
+    demod_output: Format,
+    cic: cic::Plan,
+}
+
+impl LeafBlocks {
+    fn new(s: &LoopSettings, checked: &Checked) -> Result<LeafBlocks, PlanError> {
+        let (rounding, overflow) = (checked.rounding, checked.overflow);
         let nco = nco::Plan::new(&nco::Spec {
             phase_bits: s.nco_phase_bits,
             address_bits: s.nco_address_bits,
@@ -243,7 +351,7 @@ impl Plan {
         .map_err(config_key(NCO_KEYS))?;
         let demod_output = format("demod_output_format", &s.demod_output_format)?;
         let demodulator = demodulator::Plan::new(&demodulator::Spec {
-            input: adc,
+            input: checked.adc,
             reference: nco.output,
             product: format("demod_product_format", &s.demod_product_format)?,
             state: format("demod_state_format", &s.demod_state_format)?,
@@ -270,79 +378,141 @@ impl Plan {
             overflow,
         })
         .map_err(config_key(CIC_KEYS))?;
-        let cic_gain = cic.flatness().dc_gain;
-
-        // Per-mode physics.
-        let a_nco = nco.amplitude();
-        let gains = front.pickoff_gain_v_per_m;
-        let per_fs = |axis: usize| gains[axis] / front.adc_full_scale_v;
-        let latency = s.adc_to_dac_latency_samples;
-        let figures = [Mode::Normal, Mode::Reverse].map(|m| ModeFigures::new(params, m));
-        let physics = figures.map(|f| {
-            let [driven, sensed] = axes(f.mode);
-            let f_nom = f.drive_frequency_hz();
-            let x = PI * f_nom / fs;
-            let hold_gain = libm::sin(x) / x;
-            let tau = f.ring_down_time_constant;
-            let setpoint = per_fs(driven) * params.drive_amplitude_m * a_nco;
-            let plant_gain =
-                per_fs(driven) * a_nco * a_nco * front.dac_newton_per_lsb * hold_gain * tau
-                    / (2.0 * params.mass_kg * f.drive_angular_frequency);
-            let sense = per_fs(sensed) * a_nco * f.scale_factor_m_per_dps() * cic_gain;
-            (f_nom, tau, setpoint, plant_gain, sense, sensed)
-        });
-        let (_, tau, setpoint, plant_gain, _, _) = physics[0];
-
-        // PLL.
-        let kp = pll_bandwidth / (fs * setpoint);
-        let ki = kp / (tau * fs);
-        let frequencies = physics.map(|p| p.0);
-        let lowest = frequencies[0].min(frequencies[1]) - pull;
-        let highest = frequencies[0].max(frequencies[1]) + pull;
-        if lowest <= 0.0 || highest >= fs / 2.0 {
-            return Err(field_error(
-                "loop",
-                "pll_pull_range_hz",
-                pull,
-                format!("a range within (0, fs/2) around {lowest} .. {highest} Hz"),
-            ));
-        }
-        let p = nco.phase.width;
-        let pll_limits = [lowest / fs, highest / fs];
-        let pll = pi::Plan::new(&pi::Spec {
-            input: demod_output,
-            kp,
-            ki,
-            kp_format: CoefficientFormat::Auto {
-                width: s.pll_gain_width,
-            },
-            ki_format: CoefficientFormat::Auto {
-                width: s.pll_gain_width,
-            },
-            integrator: format("pll_integrator_format", &s.pll_integrator_format)?,
-            integrator_limits: pll_limits,
-            output: Format::signed(p, p as i32).expect("the NCO checked P"),
-            rounding,
-            overflow,
+        Ok(LeafBlocks {
+            nco,
+            demodulator,
+            demod_output,
+            cic,
         })
-        .map_err(config_key(PLL_KEYS))?;
-        if pll.integrator.frac < p as i32 {
-            return Err(field_error(
-                "loop",
-                "pll_integrator_format",
-                pll.integrator,
-                format!(
-                    "at least nco_phase_bits = {p} fraction bits (the integrator must resolve the \
-                     NCO's frequency step, 2^-{p} cycles per sample)"
-                ),
-            ));
-        }
+    }
+}
 
-        // AGC.
+/// One mode's nominal physics as the loop sees it, in ADC full-scale units.
+struct ModePhysics {
+    /// The drive frequency, Hz.
+    frequency_hz: f64,
+    /// The drive mode's ring-down time constant, s.
+    tau: f64,
+    /// The drive amplitude the AGC holds, `I_D` (full scale).
+    setpoint: f64,
+    /// `I_D` per DAC LSB of drive, at steady state.
+    plant_gain: f64,
+    /// The sense channel's output per °/s, after the CIC.
+    sense: f64,
+}
+
+impl ModePhysics {
+    fn new(
+        f: &ModeFigures,
+        params: &ResonatorParams,
+        front: &PhysicsSettings,
+        a_nco: f64,
+        cic_gain: f64,
+        fs: f64,
+    ) -> ModePhysics {
+        let per_fs = |axis: usize| front.pickoff_gain_v_per_m[axis] / front.adc_full_scale_v;
+        let [driven, sensed] = axes(f.mode);
+        let f_nom = f.drive_frequency_hz();
+        let x = PI * f_nom / fs;
+        let hold_gain = libm::sin(x) / x;
+        let tau = f.ring_down_time_constant;
+        let setpoint = per_fs(driven) * params.drive_amplitude_m * a_nco;
+        let plant_gain =
+            per_fs(driven) * a_nco * a_nco * front.dac_newton_per_lsb * hold_gain * tau
+                / (2.0 * params.mass_kg * f.drive_angular_frequency);
+        let sense = per_fs(sensed) * a_nco * f.scale_factor_m_per_dps() * cic_gain;
+        ModePhysics {
+            frequency_hz: f_nom,
+            tau,
+            setpoint,
+            plant_gain,
+            sense,
+        }
+    }
+}
+
+/// The PLL, designed on the normal mode: its plan, its gains `[kp, ki]` and its integrator's
+/// limits (cycles per sample) around both modes' frequencies.
+fn pll_plan(
+    s: &LoopSettings,
+    checked: &Checked,
+    blocks: &LeafBlocks,
+    physics: &[ModePhysics; 2],
+) -> Result<(pi::Plan, [f64; 2], [f64; 2]), PlanError> {
+    let (fs, pull) = (checked.fs, checked.pull);
+    let (tau, setpoint) = (physics[0].tau, physics[0].setpoint);
+    let kp = checked.pll_bandwidth / (fs * setpoint);
+    let ki = kp / (tau * fs);
+    let frequencies = [physics[0].frequency_hz, physics[1].frequency_hz];
+    let lowest = frequencies[0].min(frequencies[1]) - pull;
+    let highest = frequencies[0].max(frequencies[1]) + pull;
+    if lowest <= 0.0 || highest >= fs / 2.0 {
+        return Err(field_error(
+            "loop",
+            "pll_pull_range_hz",
+            pull,
+            format!("a range within (0, fs/2) around {lowest} .. {highest} Hz"),
+        ));
+    }
+    let p = blocks.nco.phase.width;
+    let pll_limits = [lowest / fs, highest / fs];
+    let pll = pi::Plan::new(&pi::Spec {
+        input: blocks.demod_output,
+        kp,
+        ki,
+        kp_format: CoefficientFormat::Auto {
+            width: s.pll_gain_width,
+        },
+        ki_format: CoefficientFormat::Auto {
+            width: s.pll_gain_width,
+        },
+        integrator: format("pll_integrator_format", &s.pll_integrator_format)?,
+        integrator_limits: pll_limits,
+        output: Format::signed(p, p as i32).expect("the NCO checked P"),
+        rounding: checked.rounding,
+        overflow: checked.overflow,
+    })
+    .map_err(config_key(PLL_KEYS))?;
+    if pll.integrator.frac < p as i32 {
+        return Err(field_error(
+            "loop",
+            "pll_integrator_format",
+            pll.integrator,
+            format!(
+                "at least nco_phase_bits = {p} fraction bits (the integrator must resolve the \
+                 NCO's frequency step, 2^-{p} cycles per sample)"
+            ),
+        ));
+    }
+    Ok((pll, [kp, ki], pll_limits))
+}
+
+/// The drive: the AGC designed on the normal mode, its error point and the DAC's.
+struct Drive {
+    agc: pi::Plan,
+    /// `a_set − I_D` → the demodulator output format.
+    agc_error: Point,
+    dac: Format,
+    /// `u · cos` → the DAC format.
+    dac_point: Point,
+    /// `[kp, ki]`.
+    gains: [f64; 2],
+    limits: [f64; 2],
+}
+
+impl Drive {
+    fn new(
+        s: &LoopSettings,
+        checked: &Checked,
+        blocks: &LeafBlocks,
+        normal: &ModePhysics,
+    ) -> Result<Drive, PlanError> {
+        let (rounding, overflow) = (checked.rounding, checked.overflow);
+        let (fs, demod_output) = (checked.fs, blocks.demod_output);
         let dac = format("dac_format", &s.dac_format)?;
-        let agc_kp = 2.0 * PI * agc_bandwidth * tau / plant_gain;
-        let agc_ki = agc_kp / (tau * fs);
-        let agc_limits = [0.0, dac.max_value()];
+        let agc_kp = 2.0 * PI * checked.agc_bandwidth * normal.tau / normal.plant_gain;
+        let agc_ki = agc_kp / (normal.tau * fs);
+        let limits = [0.0, dac.max_value()];
         let agc = pi::Plan::new(&pi::Spec {
             input: demod_output,
             kp: agc_kp,
@@ -354,7 +524,7 @@ impl Plan {
                 width: s.agc_gain_width,
             },
             integrator: format("agc_integrator_format", &s.agc_integrator_format)?,
-            integrator_limits: agc_limits,
+            integrator_limits: limits,
             output: format("agc_output_format", &s.agc_output_format)?,
             rounding,
             overflow,
@@ -370,185 +540,180 @@ impl Plan {
             rounding,
             overflow,
         )?;
-        let drive_exact = Format::product(agc.output.to, nco.output)
+        let drive_exact = Format::product(agc.output.to, blocks.nco.output)
             .map_err(crate::gyro_loop::intermediate("loop", "u * cos"))?;
         let dac_point = Point::new("loop", "dac_format", drive_exact, dac, rounding, overflow)?;
-
-        // 1/SF, one format for the four coefficients.
-        let sigma = [1.0, -1.0];
-        let coefficient_values = [
-            sigma[0] / physics[0].4,
-            sigma[1] / physics[1].4,
-            -1.0 / physics[0].4,
-            -1.0 / physics[1].4,
-        ];
-        let coefficients = quantize_coefficients(
-            "loop",
-            "scale_coefficients",
-            &coefficient_values,
-            match &s.scale_coefficient_format {
-                Some(text) => CoefficientFormat::Fixed(format("scale_coefficient_format", text)?),
-                None => CoefficientFormat::Auto {
-                    width: s.scale_coefficient_width,
-                },
-            },
-        )?;
-        let output_format = format("output_format", &s.output_format)?;
-        let output_exact = Format::product(cic.output.to, coefficients[0].format)
-            .map_err(crate::gyro_loop::intermediate("loop", "c * y"))?;
-        let output = Point::new(
-            "loop",
-            "output_format",
-            output_exact,
-            output_format,
-            rounding,
-            overflow,
-        )?;
-
-        // Lock detector.
-        let shift = s.lock_filter_shift;
-        if shift == 0 || demod_output.width + shift + 1 > 64 {
-            return Err(field_error(
-                "loop",
-                "lock_filter_shift",
-                shift,
-                format!(
-                    "1..={} (the filter state has demod_output width + s + 1 bits, at most 64)",
-                    63 - demod_output.width
-                ),
-            ));
-        }
-        let hold = libm::round(hold_ms * 1e-3 * fs);
-        if hold > f64::from(u32::MAX) {
-            return Err(field_error(
-                "loop",
-                "lock_hold_ms",
-                hold_ms,
-                "below 2^32 samples",
-            ));
-        }
-        let lock = LockPlan {
-            shift,
-            hold_samples: hold as u32,
-        };
-
-        let code = |value: f64, to: Format, field: &'static str| -> Result<i64, PlanError> {
-            let q = from_f64(value, to, Rounding::Convergent, Overflow::Saturate)
-                .map_err(|_| field_error("loop", field, value, "a finite number"))?;
-            if q.overflowed {
-                return Err(field_error(
-                    "loop",
-                    field,
-                    value,
-                    format!("a value that fits {to}"),
-                ));
-            }
-            Ok(q.code as i64)
-        };
-        let scale = crate::fx::pow2(shift as i32);
-        let mut modes = Vec::with_capacity(2);
-        for (i, f) in figures.iter().enumerate() {
-            let (f_nom, _, setpoint, plant_gain, sense, _) = physics[i];
-            let nominal_amplitude = setpoint / plant_gain;
-            // The AGC must reach the amplitude that holds q0 with room for its transients.
-            let (limit_key, limit) = if agc.output.to.max_value() < dac.max_value() {
-                ("agc_output_format", agc.output.to)
-            } else {
-                ("dac_format", dac)
-            };
-            if nominal_amplitude > AMPLITUDE_HEADROOM * limit.max_value() {
-                return Err(field_error(
-                    "loop",
-                    limit_key,
-                    limit,
-                    format!(
-                        "a format whose largest value is at least {:.0} LSB: the {} mode's \
-                         nominal drive u_nom = {nominal_amplitude:.1} DAC LSB (drive q0 = {:e} m \
-                         through front_end.dac_newton_per_lsb) over {AMPLITUDE_HEADROOM}",
-                        libm::ceil(nominal_amplitude / AMPLITUDE_HEADROOM),
-                        f.mode.name(),
-                        params.drive_amplitude_m
-                    ),
-                ));
-            }
-            let dac_offset = dac_offset(
-                (f64::from(latency) + 0.5) * f_nom / fs,
-                f_nom / fs,
-                s.demod_lowpass_shift,
-                agc.kp.quantized() * setpoint / (2.0 * nominal_amplitude),
-            );
-            let sense_offset = -0.25 - f.sense_phase / (2.0 * PI);
-            let lock_q = setpoint * libm::sin(lock_phase.to_radians()) * scale;
-            let lock_a = lock_tolerance * setpoint * scale;
-            modes.push(ModePlan {
-                mode: f.mode,
-                figures: *f,
-                setpoint,
-                setpoint_code: code(setpoint, demod_output, "setpoint")?,
-                nominal_frequency_hz: f_nom,
-                frequency: f_nom / fs,
-                pll_preset: pll
-                    .integrator_code(f_nom / fs)
-                    .map_err(|_| field_error("loop", "nominal_frequency", f_nom, "finite"))?,
-                frequency_word: nco.frequency_word(f_nom, fs)?,
-                plant_gain,
-                nominal_amplitude,
-                dac_offset,
-                dac_offset_word: word(&nco, dac_offset)?,
-                sense_offset,
-                sense_offset_word: word(&nco, sense_offset)?,
-                sense_gain_per_dps: sense,
-                rate_coefficient: coefficients[i],
-                quadrature_coefficient: coefficients[2 + i],
-                lock_limits: [
-                    code(
-                        lock_q,
-                        Format::intermediate(true, 64, demod_output.frac).expect("64"),
-                        "lock_phase_deg",
-                    )?,
-                    code(
-                        lock_a,
-                        Format::intermediate(true, 64, demod_output.frac).expect("64"),
-                        "lock_amplitude_tolerance",
-                    )?,
-                ],
-            });
-        }
-        let modes: [ModePlan; 2] = [modes[0], modes[1]];
-        debug_assert_eq!(mode_index(modes[1].mode), 1);
-        Ok(Plan {
-            settings: s.clone(),
-            adc_rate_hz: fs,
-            latency,
-            adc,
-            nco,
-            demodulator,
-            pll,
+        Ok(Drive {
             agc,
             agc_error,
-            dac: dac_point,
-            cic,
-            output,
-            lock,
-            modes,
-            design: Design {
-                pll_gains: [kp, ki],
-                agc_gains: [agc_kp, agc_ki],
-                pll_limits,
-                agc_limits,
-            },
-            dac_newton_per_lsb: front.dac_newton_per_lsb,
-            adc_full_scale_v: front.adc_full_scale_v,
+            dac,
+            dac_point,
+            gains: [agc_kp, agc_ki],
+            limits,
         })
     }
+}
 
-    /// The plan of `mode`.
-    pub fn mode(&self, mode: Mode) -> &ModePlan {
-        &self.modes[mode_index(mode)]
-    }
+/// The `1/SF` coefficients in one format (rate normal, rate reverse, quadrature normal,
+/// quadrature reverse) and the output point `c · y_CIC`.
+fn output_stage(
+    s: &LoopSettings,
+    checked: &Checked,
+    blocks: &LeafBlocks,
+    physics: &[ModePhysics; 2],
+) -> Result<(Vec<Coefficient>, Point), PlanError> {
+    let sigma = [1.0, -1.0];
+    let coefficient_values = [
+        sigma[0] / physics[0].sense,
+        sigma[1] / physics[1].sense,
+        -1.0 / physics[0].sense,
+        -1.0 / physics[1].sense,
+    ];
+    let coefficients = quantize_coefficients(
+        "loop",
+        "scale_coefficients",
+        &coefficient_values,
+        match &s.scale_coefficient_format {
+            Some(text) => CoefficientFormat::Fixed(format("scale_coefficient_format", text)?),
+            None => CoefficientFormat::Auto {
+                width: s.scale_coefficient_width,
+            },
+        },
+    )?;
+    let output_format = format("output_format", &s.output_format)?;
+    let output_exact = Format::product(blocks.cic.output.to, coefficients[0].format)
+        .map_err(crate::gyro_loop::intermediate("loop", "c * y"))?;
+    let output = Point::new(
+        "loop",
+        "output_format",
+        output_exact,
+        output_format,
+        checked.rounding,
+        checked.overflow,
+    )?;
+    Ok((coefficients, output))
+}
 
-    /// The chain's rate `fs / R`, Hz.
-    pub fn chain_rate_hz(&self) -> f64 {
-        self.adc_rate_hz / f64::from(self.cic.decimation)
+/// The lock detector: its filter shift and hold time in samples.
+fn lock_plan(
+    s: &LoopSettings,
+    checked: &Checked,
+    demod_output: Format,
+) -> Result<LockPlan, PlanError> {
+    let shift = s.lock_filter_shift;
+    if shift == 0 || demod_output.width + shift + 1 > 64 {
+        return Err(field_error(
+            "loop",
+            "lock_filter_shift",
+            shift,
+            format!(
+                "1..={} (the filter state has demod_output width + s + 1 bits, at most 64)",
+                63 - demod_output.width
+            ),
+        ));
     }
+    let hold = libm::round(checked.hold_ms * 1e-3 * checked.fs);
+    if hold > f64::from(u32::MAX) {
+        return Err(field_error(
+            "loop",
+            "lock_hold_ms",
+            checked.hold_ms,
+            "below 2^32 samples",
+        ));
+    }
+    Ok(LockPlan {
+        shift,
+        hold_samples: hold as u32,
+    })
+}
+
+/// `value` as a code of `to`, refused (naming `field`) where it does not fit.
+fn code(value: f64, to: Format, field: &'static str) -> Result<i64, PlanError> {
+    let q = from_f64(value, to, Rounding::Convergent, Overflow::Saturate)
+        .map_err(|_| field_error("loop", field, value, "a finite number"))?;
+    if q.overflowed {
+        return Err(field_error(
+            "loop",
+            field,
+            value,
+            format!("a value that fits {to}"),
+        ));
+    }
+    Ok(q.code as i64)
+}
+
+/// One mode's presets, offsets, coefficients and lock limits. `coefficients` is its rate and
+/// quadrature `1/SF`.
+fn mode_plan(
+    spec: &Spec,
+    checked: &Checked,
+    blocks: &LeafBlocks,
+    pll: &pi::Plan,
+    drive: &Drive,
+    (f, physics): (&ModeFigures, &ModePhysics),
+    coefficients: [Coefficient; 2],
+) -> Result<ModePlan, PlanError> {
+    let s = &spec.settings;
+    let (fs, demod_output, nco) = (checked.fs, blocks.demod_output, &blocks.nco);
+    let (agc, dac) = (&drive.agc, drive.dac);
+    let f_nom = physics.frequency_hz;
+    let (setpoint, plant_gain) = (physics.setpoint, physics.plant_gain);
+    let nominal_amplitude = setpoint / plant_gain;
+    // The AGC must reach the amplitude that holds q0 with room for its transients.
+    let (limit_key, limit) = if agc.output.to.max_value() < dac.max_value() {
+        ("agc_output_format", agc.output.to)
+    } else {
+        ("dac_format", dac)
+    };
+    if nominal_amplitude > AMPLITUDE_HEADROOM * limit.max_value() {
+        return Err(field_error(
+            "loop",
+            limit_key,
+            limit,
+            format!(
+                "a format whose largest value is at least {:.0} LSB: the {} mode's \
+                 nominal drive u_nom = {nominal_amplitude:.1} DAC LSB (drive q0 = {:e} m \
+                 through front_end.dac_newton_per_lsb) over {AMPLITUDE_HEADROOM}",
+                libm::ceil(nominal_amplitude / AMPLITUDE_HEADROOM),
+                f.mode.name(),
+                spec.resonator.drive_amplitude_m
+            ),
+        ));
+    }
+    let dac_offset = dac_offset(
+        (f64::from(s.adc_to_dac_latency_samples) + 0.5) * f_nom / fs,
+        f_nom / fs,
+        s.demod_lowpass_shift,
+        agc.kp.quantized() * setpoint / (2.0 * nominal_amplitude),
+    );
+    let sense_offset = -0.25 - f.sense_phase / (2.0 * PI);
+    let scale = crate::fx::pow2(s.lock_filter_shift as i32);
+    let lock_q = setpoint * libm::sin(checked.lock_phase.to_radians()) * scale;
+    let lock_a = checked.lock_tolerance * setpoint * scale;
+    let lock_format = Format::intermediate(true, 64, demod_output.frac).expect("64");
+    Ok(ModePlan {
+        mode: f.mode,
+        figures: *f,
+        setpoint,
+        setpoint_code: code(setpoint, demod_output, "setpoint")?,
+        nominal_frequency_hz: f_nom,
+        frequency: f_nom / fs,
+        pll_preset: pll
+            .integrator_code(f_nom / fs)
+            .map_err(|_| field_error("loop", "nominal_frequency", f_nom, "finite"))?,
+        frequency_word: nco.frequency_word(f_nom, fs)?,
+        plant_gain,
+        nominal_amplitude,
+        dac_offset,
+        dac_offset_word: word(nco, dac_offset)?,
+        sense_offset,
+        sense_offset_word: word(nco, sense_offset)?,
+        sense_gain_per_dps: physics.sense,
+        rate_coefficient: coefficients[0],
+        quadrature_coefficient: coefficients[1],
+        lock_limits: [
+            code(lock_q, lock_format, "lock_phase_deg")?,
+            code(lock_a, lock_format, "lock_amplitude_tolerance")?,
+        ],
+    })
 }
