@@ -111,6 +111,58 @@ fn a_generated_csv_is_valid_input() {
         "200",
     ]);
     assert!(log.contains("angle random walk N"), "{log}");
+
+    // The table says what the JSON of the same run says: the series, a row per τ with its
+    // deviation, and every noise term.
+    let csv = csv.to_str().unwrap();
+    let args = [
+        "allan", "--input", csv, "--column", "y_a_dps", "--rate", "200",
+    ];
+    let table = ok(&args);
+    let json: serde_json::Value =
+        serde_json::from_str(&ok(&[&args[..], &["--json"]].concat())).unwrap();
+    let samples = json["samples"].as_u64().unwrap();
+    assert!(
+        table.starts_with(&format!(
+            "{csv} ({samples} samples at 200 Hz, column y_a_dps), Overlapping deviation\n"
+        )),
+        "{table}"
+    );
+    let rows: Vec<(f64, f64)> = table
+        .lines()
+        .filter_map(|line| {
+            let fields: Vec<&str> = line.split_whitespace().collect();
+            Some((fields.first()?.parse().ok()?, fields.get(1)?.parse().ok()?))
+        })
+        .collect();
+    let taus = json["tau_s"].as_array().unwrap();
+    assert_eq!(rows.len(), taus.len(), "{table}");
+    for ((tau, dev), (want_tau, want_dev)) in rows
+        .iter()
+        .zip(taus.iter().zip(json["adev"].as_array().unwrap()))
+    {
+        let (want_tau, want_dev) = (want_tau.as_f64().unwrap(), want_dev.as_f64().unwrap());
+        assert!(
+            (tau - want_tau).abs() <= 1e-6 * want_tau,
+            "{tau} {want_tau}"
+        );
+        assert!(
+            (dev - want_dev).abs() <= 1e-6 * want_dev,
+            "{dev} {want_dev}"
+        );
+    }
+    for term in [
+        "quantization Q",
+        "angle random walk N",
+        "bias instability B",
+        "rate random walk K",
+        "rate ramp R",
+        "Kalibr: noise density",
+        "noise density (Welch",
+        "slope readings",
+    ] {
+        assert_eq!(table.matches(term).count(), 1, "{term}: {table}");
+    }
 }
 
 #[test]

@@ -1,7 +1,7 @@
 //! `gyrofx allan`: the Allan deviation of rate records with confidence intervals, and the five
 //! noise terms fitted to it.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{bail, Result};
@@ -60,7 +60,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
     } = args;
     let rate = rate.hz()?;
     if let Some(path) = &plot {
-        let inputs: Vec<(&str, Option<&std::path::Path>)> = inputs
+        let inputs: Vec<(&str, Option<&Path>)> = inputs
             .iter()
             .map(|p| ("--input", Some(p.as_path())))
             .collect();
@@ -69,166 +69,37 @@ pub fn run(args: Args) -> Result<ExitCode> {
     let grid: allan::Grid = taus
         .parse()
         .map_err(|e: String| super::Usage(format!("--taus: {e}")))?;
-    let kind = match kind.as_str() {
-        "overlapping" => allan::Kind::Overlapping,
-        "nonoverlapping" => allan::Kind::NonOverlapping,
-        "modified" => allan::Kind::Modified,
-        "hadamard" => allan::Kind::Hadamard,
-        other => usage!("--kind {other} is not a deviation: expected overlapping, nonoverlapping, modified or hadamard"),
-    };
+    let kind = parse_kind(&kind)?;
     let mut results = Vec::new();
     let mut curves = Vec::new();
-    let series: Vec<(&PathBuf, &str)> = inputs
-        .iter()
-        .flat_map(|p| columns.iter().map(move |c| (p, c.as_str())))
-        .collect();
-    for (path, column) in series {
-        let (values, skipped) = read_column_with_gaps(path, column)?;
-        if let Some(note) = super::options::gaps_note(path, column, skipped).filter(|_| !json) {
-            eprintln!("{note}");
-        }
-        if values.len() < 4 {
-            bail!(
-                "{}: {} samples are too few: an Allan deviation needs at least 4 (τ = 1/rate needs 2 differences)",
-                path.display(),
-                values.len()
-            );
-        }
-        // The phase sums N·max|y| and their squares must stay finite, and not underflow.
-        if let Err(e) = gyrofx_model::analysis::check_magnitudes(&values) {
-            bail!("{}: column {column}, {e}", path.display());
-        }
-        if grid == allan::Grid::All && values.len() > ALL_TAUS_MAX_SAMPLES {
-            usage!(
-                "--taus all on {} ({} samples): every factor up to N/2 is a pass over the record, about N²/4 = {:.1e} terms (hours at this size); all takes at most {ALL_TAUS_MAX_SAMPLES} samples: use --taus many (ten per decade) or octave",
-                path.display(),
-                values.len(),
-                (values.len() as f64).powi(2) / 4.0
-            );
-        }
-        // Welch with the largest power-of-two segment up to N/8, at most 2048 (half of the
-        // clamp's 4096: the power of two at or above the clamped length, halved), on its own
-        // thread beside the curve.
-        let segment = (values.len() / 8).clamp(8, 4096).next_power_of_two() / 2;
-        let bar = super::progress::bar(1, &format!("allan: {}", path.display()), quiet);
-        let (points, density) = std::thread::scope(|scope| {
-            let density = scope.spawn(|| {
-                (segment >= 8)
-                    .then(|| gyrofx_model::analysis::spectrum::welch(&values, rate, segment.max(8)))
-                    .and_then(|psd| psd.median_density(rate / 50.0, rate / 5.0))
-            });
-            let points = allan::curve_reporting(kind, &values, rate, grid, &mut |done, total| {
-                bar.set_length(total as u64);
-                bar.set_position(done as u64);
-            });
-            (points, density.join().expect("the spectrum does not panic"))
-        });
-        bar.finish_and_clear();
-        let terms = noise::fit(&points, kind);
-        let report = noise::report(&points, &terms, kind);
-        let label = if columns.len() > 1 {
-            format!("{} [{column}]", path.display())
-        } else {
-            path.display().to_string()
-        };
-        curves.push((label, points.clone(), terms));
-        if json {
-            results.push(serde_json::json!({
-                "input": path.display().to_string(),
-                "column": column,
-                "samples": values.len(),
-                "skipped_empty_cells": skipped,
-                "rate_hz": rate,
-                "kind": format!("{kind:?}").to_lowercase(),
-                "tau_s": points.iter().map(|p| p.tau_s).collect::<Vec<_>>(),
-                "adev": points.iter().map(|p| p.dev).collect::<Vec<_>>(),
-                "adev_lo": points.iter().map(|p| p.lo).collect::<Vec<_>>(),
-                "adev_hi": points.iter().map(|p| p.hi).collect::<Vec<_>>(),
-                "edf": points.iter().map(|p| p.edf).collect::<Vec<_>>(),
-                "noise_alpha": points.iter().map(|p| p.alpha).collect::<Vec<_>>(),
-                "noise": report,
-                "noise_density_dps_per_sqrt_hz": density,
-            }));
-        } else {
-            println!(
-                "{} ({} samples at {rate} Hz, column {column}), {kind:?} deviation",
-                path.display(),
-                values.len()
-            );
-            println!(
-                "{:>12} {:>13} {:>13} {:>13} {:>6} {:>9}",
-                "tau (s)", "dev (°/s)", "lo", "hi", "alpha", "edf"
-            );
-            for p in &points {
-                println!(
-                    "{:>12.6} {:>13.6e} {:>13.6e} {:>13.6e} {:>6} {:>9.1}",
-                    p.tau_s, p.dev, p.lo, p.hi, p.alpha, p.edf
-                );
-            }
-            let line = |name: &str, e: noise::Estimate, unit: &str| {
-                println!(
-                    "  {name:<28} {:>12.5e} [{:.5e}, {:.5e}] {unit}",
-                    e.value, e.lo, e.hi
-                );
+    for path in &inputs {
+        for column in &columns {
+            let (values, skipped) = read_series(path, column, grid, json)?;
+            let analysis = analyse(&values, rate, kind, grid, path, quiet);
+            let series = Series {
+                path,
+                column,
+                samples: values.len(),
+                skipped,
+                rate_hz: rate,
+                kind,
+                analysis,
             };
-            println!(
-                "noise terms (weighted non-negative fit of the {} variance's model, ±1 standard error):",
-                format!("{kind:?}").to_lowercase()
-            );
-            line("quantization Q", report.quantization_urad, "µrad");
-            line("angle random walk N", report.arw_deg_per_sqrt_h, "°/√h");
-            line(
-                "bias instability B",
-                report.bias_instability_deg_per_h,
-                "°/h",
-            );
-            line(
-                "rate random walk K",
-                report.rrw_deg_per_h_per_sqrt_h,
-                "°/h/√h",
-            );
-            if report.rate_ramp_deg_per_h2.value.is_nan() {
-                println!(
-                    "  {:<28} {:>12} (the Hadamard variance cancels a rate ramp)",
-                    "rate ramp R", "-"
-                );
+            if json {
+                results.push(series.json());
             } else {
-                line("rate ramp R", report.rate_ramp_deg_per_h2, "°/h²");
+                print!("{series}");
             }
-            println!(
-                "  Kalibr: noise density {:.5e} rad/s/√Hz, random walk {:.5e} rad/s²/√Hz",
-                report.kalibr_noise_density_rad_per_s_per_sqrt_hz,
-                report.kalibr_random_walk_rad_per_s2_per_sqrt_hz
-            );
-            let opt = |v: Option<f64>| v.map(|v| format!("{v:.5e}")).unwrap_or_else(|| "-".into());
-            println!(
-                "  noise density (Welch, median over fs/50..fs/5): {} °/s/√Hz",
-                opt(density)
-            );
-            println!(
-                "  slope readings: N {} °/√h (τ = 1 s), K {} °/h/√h (τ = 3 s), B {:.5e} °/h (min/0.6643), the kind's response divided out",
-                opt(report.slope_arw_deg_per_sqrt_h),
-                opt(report.slope_rrw_deg_per_h_per_sqrt_h),
-                report.slope_bias_instability_deg_per_h
-            );
+            let label = if columns.len() > 1 {
+                format!("{} [{column}]", path.display())
+            } else {
+                path.display().to_string()
+            };
+            curves.push((label, series.analysis.points, series.analysis.terms));
         }
     }
     if let Some(path) = &plot {
-        let series: Vec<gyrofx_lab::plot::AllanSeries> = curves
-            .iter()
-            .map(|(label, points, terms)| gyrofx_lab::plot::AllanSeries {
-                label: label.clone(),
-                points,
-                terms: Some((terms, kind)),
-            })
-            .collect();
-        let title = match kind {
-            allan::Kind::Overlapping => "Overlapping Allan deviation",
-            allan::Kind::NonOverlapping => "Allan deviation (non-overlapping)",
-            allan::Kind::Modified => "Modified Allan deviation",
-            allan::Kind::Hadamard => "Overlapping Hadamard deviation",
-        };
-        gyrofx_lab::plot::deviation(path, &series, title)?;
+        write_plot(path, &curves, kind)?;
         if !json {
             println!("plot: {}", path.display());
         }
@@ -242,4 +113,241 @@ pub fn run(args: Args) -> Result<ExitCode> {
         println!("{}", serde_json::to_string_pretty(&value)?);
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// `--kind`'s deviation.
+fn parse_kind(kind: &str) -> Result<allan::Kind> {
+    Ok(match kind {
+        "overlapping" => allan::Kind::Overlapping,
+        "nonoverlapping" => allan::Kind::NonOverlapping,
+        "modified" => allan::Kind::Modified,
+        "hadamard" => allan::Kind::Hadamard,
+        other => usage!("--kind {other} is not a deviation: expected overlapping, nonoverlapping, modified or hadamard"),
+    })
+}
+
+/// One column of one input (°/s) and the count of its empty cells, refused where the analysis
+/// cannot take it: too short, magnitudes whose sums would overflow, or too long for `--taus all`.
+fn read_series(
+    path: &Path,
+    column: &str,
+    grid: allan::Grid,
+    json: bool,
+) -> Result<(Vec<f64>, usize)> {
+    let (values, skipped) = read_column_with_gaps(path, column)?;
+    if let Some(note) = super::options::gaps_note(path, column, skipped).filter(|_| !json) {
+        eprintln!("{note}");
+    }
+    if values.len() < 4 {
+        bail!(
+            "{}: {} samples are too few: an Allan deviation needs at least 4 (τ = 1/rate needs 2 differences)",
+            path.display(),
+            values.len()
+        );
+    }
+    // The phase sums N·max|y| and their squares must stay finite, and not underflow.
+    if let Err(e) = gyrofx_model::analysis::check_magnitudes(&values) {
+        bail!("{}: column {column}, {e}", path.display());
+    }
+    if grid == allan::Grid::All && values.len() > ALL_TAUS_MAX_SAMPLES {
+        usage!(
+            "--taus all on {} ({} samples): every factor up to N/2 is a pass over the record, about N²/4 = {:.1e} terms (hours at this size); all takes at most {ALL_TAUS_MAX_SAMPLES} samples: use --taus many (ten per decade) or octave",
+            path.display(),
+            values.len(),
+            (values.len() as f64).powi(2) / 4.0
+        );
+    }
+    Ok((values, skipped))
+}
+
+/// What the analysis gives of one series.
+struct Analysis {
+    points: Vec<allan::Point>,
+    terms: noise::Terms,
+    report: noise::Report,
+    /// The white-noise density, °/s/√Hz: Welch's median over fs/50..fs/5; none on a record
+    /// too short for a segment of 8.
+    density: Option<f64>,
+}
+
+/// The deviation curve (with a progress bar on a terminal), the noise fit, and the spectrum's
+/// density, computed on a thread of its own beside the curve.
+fn analyse(
+    values: &[f64],
+    rate: f64,
+    kind: allan::Kind,
+    grid: allan::Grid,
+    path: &Path,
+    quiet: bool,
+) -> Analysis {
+    // Welch with the largest power-of-two segment up to N/8, at most 2048 (half of the
+    // clamp's 4096: the power of two at or above the clamped length, halved).
+    let segment = (values.len() / 8).clamp(8, 4096).next_power_of_two() / 2;
+    let bar = super::progress::bar(1, &format!("allan: {}", path.display()), quiet);
+    let (points, density) = std::thread::scope(|scope| {
+        let density = scope.spawn(|| {
+            (segment >= 8)
+                .then(|| gyrofx_model::analysis::spectrum::welch(values, rate, segment.max(8)))
+                .and_then(|psd| psd.median_density(rate / 50.0, rate / 5.0))
+        });
+        let points = allan::curve_reporting(kind, values, rate, grid, &mut |done, total| {
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+        });
+        (points, density.join().expect("the spectrum does not panic"))
+    });
+    bar.finish_and_clear();
+    let terms = noise::fit(&points, kind);
+    let report = noise::report(&points, &terms, kind);
+    Analysis {
+        points,
+        terms,
+        report,
+        density,
+    }
+}
+
+/// One analysed series and what it was read from: printed as a table (`Display`) or JSON.
+struct Series<'a> {
+    path: &'a Path,
+    column: &'a str,
+    samples: usize,
+    skipped: usize,
+    rate_hz: f64,
+    kind: allan::Kind,
+    analysis: Analysis,
+}
+
+impl Series<'_> {
+    /// The JSON object of `--json` (the README's fields).
+    fn json(&self) -> serde_json::Value {
+        let points = &self.analysis.points;
+        serde_json::json!({
+            "input": self.path.display().to_string(),
+            "column": self.column,
+            "samples": self.samples,
+            "skipped_empty_cells": self.skipped,
+            "rate_hz": self.rate_hz,
+            "kind": format!("{:?}", self.kind).to_lowercase(),
+            "tau_s": points.iter().map(|p| p.tau_s).collect::<Vec<_>>(),
+            "adev": points.iter().map(|p| p.dev).collect::<Vec<_>>(),
+            "adev_lo": points.iter().map(|p| p.lo).collect::<Vec<_>>(),
+            "adev_hi": points.iter().map(|p| p.hi).collect::<Vec<_>>(),
+            "edf": points.iter().map(|p| p.edf).collect::<Vec<_>>(),
+            "noise_alpha": points.iter().map(|p| p.alpha).collect::<Vec<_>>(),
+            "noise": self.analysis.report,
+            "noise_density_dps_per_sqrt_hz": self.analysis.density,
+        })
+    }
+}
+
+/// The table: the curve with its confidence bounds, then the noise terms and the readings.
+impl std::fmt::Display for Series<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let Analysis {
+            points,
+            report,
+            density,
+            ..
+        } = &self.analysis;
+        let kind = self.kind;
+        writeln!(
+            f,
+            "{} ({} samples at {} Hz, column {}), {kind:?} deviation",
+            self.path.display(),
+            self.samples,
+            self.rate_hz,
+            self.column
+        )?;
+        writeln!(
+            f,
+            "{:>12} {:>13} {:>13} {:>13} {:>6} {:>9}",
+            "tau (s)", "dev (°/s)", "lo", "hi", "alpha", "edf"
+        )?;
+        for p in points {
+            writeln!(
+                f,
+                "{:>12.6} {:>13.6e} {:>13.6e} {:>13.6e} {:>6} {:>9.1}",
+                p.tau_s, p.dev, p.lo, p.hi, p.alpha, p.edf
+            )?;
+        }
+        let line = |f: &mut std::fmt::Formatter<'_>, name: &str, e: noise::Estimate, unit: &str| {
+            writeln!(
+                f,
+                "  {name:<28} {:>12.5e} [{:.5e}, {:.5e}] {unit}",
+                e.value, e.lo, e.hi
+            )
+        };
+        writeln!(
+            f,
+            "noise terms (weighted non-negative fit of the {} variance's model, ±1 standard error):",
+            format!("{kind:?}").to_lowercase()
+        )?;
+        line(f, "quantization Q", report.quantization_urad, "µrad")?;
+        line(f, "angle random walk N", report.arw_deg_per_sqrt_h, "°/√h")?;
+        line(
+            f,
+            "bias instability B",
+            report.bias_instability_deg_per_h,
+            "°/h",
+        )?;
+        line(
+            f,
+            "rate random walk K",
+            report.rrw_deg_per_h_per_sqrt_h,
+            "°/h/√h",
+        )?;
+        if report.rate_ramp_deg_per_h2.value.is_nan() {
+            writeln!(
+                f,
+                "  {:<28} {:>12} (the Hadamard variance cancels a rate ramp)",
+                "rate ramp R", "-"
+            )?;
+        } else {
+            line(f, "rate ramp R", report.rate_ramp_deg_per_h2, "°/h²")?;
+        }
+        writeln!(
+            f,
+            "  Kalibr: noise density {:.5e} rad/s/√Hz, random walk {:.5e} rad/s²/√Hz",
+            report.kalibr_noise_density_rad_per_s_per_sqrt_hz,
+            report.kalibr_random_walk_rad_per_s2_per_sqrt_hz
+        )?;
+        let opt = |v: Option<f64>| v.map(|v| format!("{v:.5e}")).unwrap_or_else(|| "-".into());
+        writeln!(
+            f,
+            "  noise density (Welch, median over fs/50..fs/5): {} °/s/√Hz",
+            opt(*density)
+        )?;
+        writeln!(
+            f,
+            "  slope readings: N {} °/√h (τ = 1 s), K {} °/h/√h (τ = 3 s), B {:.5e} °/h (min/0.6643), the kind's response divided out",
+            opt(report.slope_arw_deg_per_sqrt_h),
+            opt(report.slope_rrw_deg_per_h_per_sqrt_h),
+            report.slope_bias_instability_deg_per_h
+        )
+    }
+}
+
+/// The log-log plot of every series with its fitted terms.
+fn write_plot(
+    path: &Path,
+    curves: &[(String, Vec<allan::Point>, noise::Terms)],
+    kind: allan::Kind,
+) -> Result<()> {
+    let series: Vec<gyrofx_lab::plot::AllanSeries> = curves
+        .iter()
+        .map(|(label, points, terms)| gyrofx_lab::plot::AllanSeries {
+            label: label.clone(),
+            points,
+            terms: Some((terms, kind)),
+        })
+        .collect();
+    let title = match kind {
+        allan::Kind::Overlapping => "Overlapping Allan deviation",
+        allan::Kind::NonOverlapping => "Allan deviation (non-overlapping)",
+        allan::Kind::Modified => "Modified Allan deviation",
+        allan::Kind::Hadamard => "Overlapping Hadamard deviation",
+    };
+    gyrofx_lab::plot::deviation(path, &series, title)?;
+    Ok(())
 }
