@@ -215,15 +215,28 @@ pub fn hex_sha256(data: &[u8]) -> String {
         .to_string()
 }
 
-/// `libgyrofx_capi.a` of this build (the workspace builds it beside the test binaries' folder).
+/// `libgyrofx_capi.a` of this build. The test build writes it: `gyrofx-capi` is a
+/// dev-dependency of these tests, and cargo compiles a library with every crate type it
+/// declares (`staticlib` too) even as a dependency, into the profile's `deps/` folder (a
+/// separate `cargo build -p gyrofx-capi` compiled the model a second time with other features).
+/// A plain build's copy beside the binaries serves where that one is missing.
 pub fn capi_library() -> PathBuf {
     let exe = std::env::current_exe().unwrap();
-    let profile = exe.parent().and_then(Path::parent).unwrap();
-    let library = profile.join("libgyrofx_capi.a");
-    assert!(
-        library.is_file(),
-        "{} is missing: cargo build -p gyrofx-capi makes it (scripts/test.sh does, before the tests)",
-        library.display()
-    );
-    library
+    let deps = exe.parent().unwrap();
+    let profile = deps.parent().unwrap();
+    let candidates = [
+        deps.join("libgyrofx_capi.a"),
+        profile.join("libgyrofx_capi.a"),
+    ];
+    candidates
+        .iter()
+        .find(|library| library.is_file())
+        .unwrap_or_else(|| {
+            panic!(
+                "{} is missing: the test build makes it (cargo build -p gyrofx-capi puts it in {})",
+                candidates[0].display(),
+                profile.display()
+            )
+        })
+        .clone()
 }
