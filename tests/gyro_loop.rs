@@ -1,7 +1,7 @@
 //! `gyrofx loop`: both resonator-level gyros' closed loops against SPEC §1.6's closed forms,
 //! through the command line.
 
-use crate::common::{fails, ok, write_config};
+use crate::common::{fails, ok, write_config, CHAIN_BLOCKS, CHAIN_BLOCK_COUNT};
 
 /// Every figure of one mode from the JSON: (measured, predicted).
 fn figure(mode: &serde_json::Value, name: &str) -> (f64, f64) {
@@ -115,8 +115,23 @@ fn the_resonator_plant_feeds_the_chain_and_reversal_removes_its_bias() {
     }
     assert!(bias(2).abs() < 0.1, "calibrated bias {} °/s", bias(2));
     assert!(bias(3).abs() < 0.1, "filtered bias {} °/s", bias(3));
-    let verify = ok(&["verify", "--out", out_text, "--sim", "iverilog"]);
+    // The chain's blocks: the loop's and the system's vectors do not depend on `--samples`,
+    // so they are the default package's, which the Icarus end-to-end test runs.
+    let verify = ok(&[
+        "verify",
+        "--out",
+        out_text,
+        "--sim",
+        "iverilog",
+        "--blocks",
+        CHAIN_BLOCKS,
+    ]);
     assert!(verify.contains("iverilog: passed"), "{verify}");
+    assert_eq!(
+        verify.matches("PASS n=").count(),
+        CHAIN_BLOCK_COUNT,
+        "{verify}"
+    );
 }
 
 /// `gyrofx loop --plot`: a PNG or an SVG of both gyros across a switch; another extension is a
