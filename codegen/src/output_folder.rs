@@ -472,6 +472,33 @@ pub fn remove_registered() {
     }
 }
 
+/// Creates `folder` and the folders between it and `root`, but never `root` itself, which
+/// must exist: a writer still running when a signal handler has removed the staging folder
+/// `root` then fails instead of bringing it back (`create_dir_all` would recreate it after
+/// the removal, and the process would end leaving it behind).
+///
+/// # Errors
+/// `NotFound` when `root` or a folder below it is gone; `InvalidInput` when `folder` is not
+/// inside `root`; any other error of creating a folder.
+pub fn create_below(root: &Path, folder: &Path) -> std::io::Result<()> {
+    let relative = folder.strip_prefix(root).map_err(|_| {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!("{} is not inside {}", folder.display(), root.display()),
+        )
+    })?;
+    let mut path = root.to_path_buf();
+    for part in relative.components() {
+        path.push(part);
+        match std::fs::create_dir(&path) {
+            Ok(()) => {}
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && path.is_dir() => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(())
+}
+
 /// Creates a new staging folder in `parent`, `.gyrofx-staging-<pid>-<n>`, registered before
 /// it exists so that a signal cannot fall between its creation and its registration.
 ///
@@ -869,6 +896,25 @@ fn vector_count_differences(out: &Path, manifest: &serde_json::Value) -> Vec<Str
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn create_below_makes_the_folders_under_root_but_never_root_again() {
+        let dir = tempfile::tempdir().unwrap();
+        let root = dir.path().join("staging");
+        std::fs::create_dir(&root).unwrap();
+        create_below(&root, &root.join("kf/deeper")).unwrap();
+        assert!(root.join("kf/deeper").is_dir());
+        // Again: the folders exist, which is no error.
+        create_below(&root, &root.join("kf/deeper")).unwrap();
+        create_below(&root, &root).unwrap();
+        // The staging folder removed (a signal handler): it is not brought back.
+        std::fs::remove_dir_all(&root).unwrap();
+        let error = create_below(&root, &root.join("kf")).unwrap_err();
+        assert_eq!(error.kind(), std::io::ErrorKind::NotFound);
+        assert!(!root.exists());
+        let error = create_below(&root, dir.path()).unwrap_err();
+        assert_eq!(error.kind(), std::io::ErrorKind::InvalidInput);
+    }
 
     #[test]
     fn build_output_patterns_match_only_their_paths() {

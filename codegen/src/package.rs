@@ -151,7 +151,7 @@ impl Package {
             });
         for (path, _) in pending.clone() {
             if let Some(folder) = root.join(path).parent() {
-                std::fs::create_dir_all(folder).map_err(|e| Error::io(folder, e))?;
+                output_folder::create_below(root, folder).map_err(|e| Error::io(folder, e))?;
             }
         }
         std::thread::scope(|scope| {

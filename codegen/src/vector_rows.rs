@@ -14,6 +14,7 @@ use gyrofx_model::fx::Format;
 use sha2::{Digest, Sha256};
 
 use crate::block::{Block, RowSink, Signal};
+use crate::output_folder;
 use crate::package::FileEntry;
 use crate::testbench::header;
 use crate::text::{push_hex, Provenance};
@@ -169,7 +170,7 @@ impl HashedFile {
     fn create(root: &Path, relative: String) -> Result<Self> {
         let path = root.join(&relative);
         if let Some(folder) = path.parent() {
-            std::fs::create_dir_all(folder).map_err(|e| Error::io(folder, e))?;
+            output_folder::create_below(root, folder).map_err(|e| Error::io(folder, e))?;
         }
         let file = std::fs::File::create(&path).map_err(|e| Error::io(&path, e))?;
         Ok(HashedFile {
