@@ -196,13 +196,8 @@ fn circles(graph: &BTreeMap<String, BTreeSet<String>>) -> Vec<Vec<String>> {
     found
 }
 
-/// The circles codegen still has, each to be broken and then deleted from here: the run
-/// engine (`vectors`) still names block-specific results, and the blocks read the run's
-/// `Results` (issue 28, item 2). Nothing may join one, and no new circle may form.
-const CODEGEN_CIRCLES_LEFT: &[&[&str]] = &[&["blocks", "vectors"]];
-
-/// The model, the job, the lab and the CLI have no circle between their modules; codegen none
-/// beyond [`CODEGEN_CIRCLES_LEFT`].
+/// No crate has a circle between its modules: the model, the job, codegen, the lab and the
+/// CLI.
 #[test]
 fn no_crate_has_an_import_circle_between_its_modules() {
     for (krate, src) in [
@@ -215,17 +210,8 @@ fn no_crate_has_an_import_circle_between_its_modules() {
         let inside = if krate == "the CLI" { "commands" } else { "" };
         let graph = imports_below(&src, inside);
         assert!(graph.len() > 2, "{krate}: {graph:?}");
-        let allowed: &[&[&str]] = if krate == "codegen" {
-            CODEGEN_CIRCLES_LEFT
-        } else {
-            &[]
-        };
-        for circle in circles(&graph) {
-            assert!(
-                allowed.iter().any(|a| a.iter().eq(circle.iter())),
-                "{krate} has an import circle: {circle:?} (allowed: {allowed:?})"
-            );
-        }
+        let found = circles(&graph);
+        assert!(found.is_empty(), "{krate} has import circles: {found:?}");
     }
 }
 

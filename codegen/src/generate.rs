@@ -6,7 +6,7 @@ use std::path::Path;
 use serde_json::json;
 
 use crate::block::{Block, Timing};
-use crate::blocks::{RomImages, REGISTRY};
+use crate::blocks::{RomImages, Streaming, REGISTRY};
 use crate::hdl;
 use crate::output_folder::MANIFEST;
 use crate::output_folder::{Kind, Replace};
@@ -157,13 +157,14 @@ pub fn build_package(
 ) -> Result<(Package, Summary)> {
     progress.set_phase("chain run");
     let roms = RomImages::new(job, provenance);
-    let streaming = vectors::Streaming {
+    let streaming = Streaming {
         root: staging.path(),
         csv: contents.csv,
         blocks: contents.blocks.as_deref(),
         provenance,
     };
-    let mut run = vectors::run_streamed(job, &roms, progress, streaming)?;
+    let builders = crate::blocks::vector_builders(job, &roms, Some(streaming))?;
+    let mut run = vectors::run(job, builders, progress)?;
     if let Some(names) = &contents.blocks {
         run.blocks.retain(|b| names.iter().any(|n| n == b.name));
     }

@@ -1,7 +1,9 @@
 //! The vector set: one run of the whole chain (plant, sequencer, estimator, KF) with the float
-//! golden chains beside it, sample by sample, handed to every registered block's
-//! [`VectorBuilder`](crate::blocks::VectorBuilder), which cuts its own vectors from it and adds
-//! its directed segments. The run also yields the report's Allan table.
+//! golden chains beside it, sample by sample ([`ChainSample`]), handed to every
+//! [`VectorBuilder`] the caller gives it (the registered blocks' builders), each of which cuts
+//! its own vectors from it, adds its directed segments and reports what it found
+//! ([`BlockResults`]). The run also yields the report's Allan table. The run knows no block:
+//! it owns this interface, and the blocks implement it.
 //!
 //! Schedule of the run: `samples` samples of the configured stimulus, `bw_sel` cycling through
 //! every ROM entry (each for `samples / (2·entries)` samples), and one reset of the whole chain
@@ -9,7 +11,9 @@
 //! included.
 
 use gyrofx_model::analysis::allan::OverlappingStream;
-use gyrofx_model::chain::{FixedChain, FloatChain};
+use std::collections::BTreeMap;
+
+use gyrofx_model::chain::{FixedChain, FloatChain, FloatSample, Sample};
 use gyrofx_model::estimator::OverflowCounts as EstimatorOverflows;
 use gyrofx_model::fx::Format;
 use gyrofx_model::gyro_loop::closed::{ClosedLoop, FixedClosedLoop, FixedHarness, LoopUnderTest};
@@ -23,12 +27,8 @@ use gyrofx_model::system::loop_mode;
 use serde::Serialize;
 
 use crate::block::Block;
-use crate::blocks::kf::TieCases;
-use crate::blocks::{ChainSample, RomImages};
 use crate::progress::Progress;
 pub use crate::stats::ErrorStats;
-use crate::text::Provenance;
-use crate::vector_rows::StagedRows;
 use gyrofx_job::config::GyroLoop;
 use gyrofx_job::error::{Error, Result};
 use gyrofx_job::job::Job;
@@ -42,12 +42,13 @@ pub struct Overflows {
     pub estimator: EstimatorCounts,
     /// The KF in the chain run.
     pub kf_chain: KfCounts,
-    /// The KF's directed segment (full scale included).
-    pub kf_directed: KfCounts,
-    /// The mean filter's output (its full-scale blocks may round past the range).
-    pub mean_filter: u64,
     /// The resonator-level gyros' fixed loops (A, B) on the record; zeros for the other plants.
     pub gyro_loop: [GyroLoopCounts; 2],
+    /// The blocks' own counts on their directed segments, by key ([`BlockResults::overflows`]:
+    /// the KF's `kf_directed`, full scale included; the mean filter's output, `mean_filter`,
+    /// whose full-scale blocks may round past the range). They saturate on purpose.
+    #[serde(flatten)]
+    pub directed: BTreeMap<&'static str, serde_json::Value>,
 }
 
 /// One resonator-level gyro's loop saturations and wraps on the record (the start-up before
@@ -188,27 +189,53 @@ pub struct Report {
     pub lines: Vec<ReportLine>,
 }
 
-/// What the blocks' vector builders report beside their vectors (each fills its own).
+/// One sample of the chain run, as every block's vectors see it.
+pub struct ChainSample<'a> {
+    /// Sample index in the run (resets not counted).
+    pub index: usize,
+    /// KF ROM address in use.
+    pub bw_sel: usize,
+    /// Gyro A's and B's ADC codes (input format).
+    pub y: [i64; 2],
+    /// What the fixed chain did.
+    pub fixed: &'a Sample,
+    /// The float chain with the same quantized coefficients.
+    pub float: &'a FloatSample,
+    /// The float chain with the designed coefficients.
+    pub ideal: &'a FloatSample,
+    /// The estimator's bias registers after the sample (bias format).
+    pub bias_after: [i128; 2],
+    /// Whether a window has produced an estimate since reset, after the sample.
+    pub estimated: bool,
+    /// The true rate, °/s.
+    pub true_rate_dps: f64,
+}
+
+/// Cuts one block's vectors from the chain run, sample by sample.
+pub trait VectorBuilder {
+    /// A synchronous reset of the whole chain before the next sample.
+    fn reset(&mut self);
+
+    /// One sample.
+    fn sample(&mut self, sample: &ChainSample);
+
+    /// After the last sample: appends the block's directed segments, records what it found in
+    /// `results` and returns its vectors.
+    fn finish(self: Box<Self>, results: &mut BlockResults) -> Block;
+}
+
+/// What one block's vector builder reports beside its vectors; the run gathers them by key
+/// ([`Run::stats`], [`Overflows::directed`], [`Run::fact`]).
 #[derive(Debug, Default)]
-pub struct Results {
-    /// The KF's statistics on the chain's KF inputs.
-    pub kf_stats: Option<ErrorStats>,
-    /// The chain output's statistics.
-    pub chain_stats: Option<ErrorStats>,
-    /// The bias estimates' statistics.
-    pub bias_stats: Option<ErrorStats>,
-    /// The mean filter's statistics.
-    pub mean_filter_stats: Option<ErrorStats>,
-    /// The KF's tie cases.
-    pub ties: Option<Vec<TieCases>>,
-    /// Overflows of the KF's directed segment.
-    pub kf_directed: Option<KfCounts>,
-    /// The mean filter's output overflows.
-    pub mean_filter_overflows: Option<u64>,
-    /// What the gyro loop's recorded run covered.
-    pub gyro_loop_record: Option<crate::blocks::gyro_loop::RecordSummary>,
-    /// What the system's recorded run covered.
-    pub system_record: Option<crate::blocks::system::SystemSummary>,
+pub struct BlockResults {
+    /// Fixed-vs-float statistics of its signals, by name (`kf`, `chain`, `bias`,
+    /// `mean_filter`): names are unique across the package's blocks.
+    pub stats: Vec<(&'static str, ErrorStats)>,
+    /// Overflow counts of its directed segments, by key of the manifest's `overflow_counts`.
+    pub overflows: Vec<(&'static str, serde_json::Value)>,
+    /// Facts for its own manifest section (what its recorded run covered, its tie cases), by
+    /// key.
+    pub facts: Vec<(&'static str, serde_json::Value)>,
 }
 
 /// Samples the run keeps each `bw_sel` for: it cycles through the ROM twice.
@@ -233,76 +260,60 @@ pub fn bw_sel_switches(samples: usize, entries: usize) -> u64 {
 /// Everything the run produced.
 #[derive(Debug)]
 pub struct Run {
-    /// The blocks' vectors: sequencer, estimator, kf, top, mean_filter.
+    /// The blocks' vectors, in the order of their builders.
     pub blocks: Vec<Block>,
-    /// KF block: fixed vs float on its own inputs (chain part), in output LSB.
-    pub kf_stats: ErrorStats,
-    /// Chain output: fixed vs the float chain, in output LSB.
-    pub chain_stats: ErrorStats,
-    /// Bias estimates: fixed vs float, in LSB of the bias format.
-    pub bias_stats: ErrorStats,
-    /// Mean filter outputs that fit: fixed vs float (same quantized r), in output LSB; ideal:
-    /// r unquantized.
-    pub mean_filter_stats: ErrorStats,
+    /// Fixed-vs-float statistics by name, as the blocks reported them
+    /// ([`BlockResults::stats`]), e.g. `kf`: the KF on its own inputs, in output LSB.
+    stats: BTreeMap<&'static str, ErrorStats>,
+    /// The blocks' manifest facts by block and key ([`BlockResults::facts`]).
+    facts: BTreeMap<(&'static str, &'static str), serde_json::Value>,
     /// Overflow counts.
     pub overflows: Overflows,
-    /// KF tie cases found.
-    pub ties: Vec<TieCases>,
     /// The Allan report.
     pub report: Report,
     /// Chain samples (excluding resets).
     pub samples: usize,
-    /// What the gyro loop's recorded run covered.
-    pub gyro_loop_record: crate::blocks::gyro_loop::RecordSummary,
-    /// What the system's recorded run covered (resonator packages only).
-    pub system_record: Option<crate::blocks::system::SystemSummary>,
 }
 
-/// Where a streamed run writes its blocks' vector files ([`run_streamed`]).
-#[derive(Clone, Copy, Debug)]
-pub struct Streaming<'a> {
-    /// The staging folder.
-    pub root: &'a std::path::Path,
-    /// Whether the CSV twins are written.
-    pub csv: bool,
-    /// Only these blocks' files (all when `None`); the others' rows are only counted.
-    pub blocks: Option<&'a [String]>,
-    /// The generated-by line's source.
-    pub provenance: &'a Provenance,
+impl Run {
+    /// The fixed-vs-float statistics a block reported as `name`, if one did.
+    pub fn stats(&self, name: &str) -> Option<&ErrorStats> {
+        self.stats.get(name)
+    }
+
+    /// The fact `key` block `block` reported for its manifest section, if it did.
+    pub fn fact(&self, block: &str, key: &str) -> Option<&serde_json::Value> {
+        self.facts
+            .iter()
+            .find(|((b, k), _)| *b == block && *k == key)
+            .map(|(_, v)| v)
+    }
 }
 
-/// Runs the chain for `job` and builds the vectors of every registered block that has them,
-/// kept in memory; `roms` are the images their DUTs read.
+/// Runs the chain for `job`, handing every sample to `builders` (each cuts one block's
+/// vectors, kept in memory or streamed to its files, as the caller set it up), and gathers
+/// what they report. `progress` counts the simulated samples.
 ///
 /// # Errors
-/// Stimulus errors (a bad CSV file).
-pub fn run(job: &Job, roms: &RomImages, progress: &Progress) -> Result<Run> {
-    run_with(job, roms, progress, None)
-}
-
-/// [`run`], each block's rows written as they come into its files under `streaming.root`
-/// ([`StagedRows`]): memory does not grow with the samples. Each block then holds the
-/// entries of the files it wrote ([`Block::finish_rows`]).
+/// Stimulus errors (a bad CSV file); a builder's write errors.
 ///
-/// # Errors
-/// Stimulus errors; write errors.
-pub fn run_streamed(
+/// # Panics
+/// When two builders report statistics or facts under the same key (a programming error).
+pub fn run<'a>(
     job: &Job,
-    roms: &RomImages,
+    builders: Vec<Box<dyn VectorBuilder + 'a>>,
     progress: &Progress,
-    streaming: Streaming,
 ) -> Result<Run> {
-    run_with(job, roms, progress, Some(streaming))
+    run_with(job, builders, progress)
 }
 
 /// Chain samples the gyros are simulated ahead of the chain, a batch at a time.
 const GYRO_BATCH: usize = 2048;
 
-fn run_with(
+fn run_with<'a>(
     job: &Job,
-    roms: &RomImages,
+    mut builders: Vec<Box<dyn VectorBuilder + 'a>>,
     progress: &Progress,
-    streaming: Option<Streaming>,
 ) -> Result<Run> {
     let plan = &job.chain;
     let kf = job.kf();
@@ -326,25 +337,6 @@ fn run_with(
     } else {
         None
     };
-
-    let mut builders: Vec<_> = Vec::new();
-    for registered in crate::blocks::of(job).filter(|b| b.has_vectors()) {
-        let mut block = registered.block(job, roms);
-        if let Some(streaming) = &streaming {
-            let wanted = streaming
-                .blocks
-                .is_none_or(|names| names.iter().any(|n| n == block.name));
-            let sink = if wanted {
-                StagedRows::open(&block, streaming.root, streaming.csv, streaming.provenance)?
-            } else {
-                StagedRows::discard(&block)
-            };
-            block.stream_to(Box::new(sink));
-        }
-        if let Some(builder) = registered.vectors(job, block) {
-            builders.push(builder);
-        }
-    }
 
     // The gyros as the sequencer drives them, and the same gyros without reversal (same
     // noise streams) for the report, simulated a batch ahead of the chain.
@@ -425,35 +417,44 @@ fn run_with(
             }
         }
     }
-    let mut results = Results::default();
-    let mut blocks: Vec<Block> = builders
-        .into_iter()
-        .map(|builder| builder.finish(&mut results))
-        .collect();
-    for block in &mut blocks {
+    let mut stats = BTreeMap::new();
+    let mut facts = BTreeMap::new();
+    let mut directed = BTreeMap::new();
+    let mut blocks = Vec::with_capacity(builders.len());
+    for builder in builders {
+        let mut results = BlockResults::default();
+        let mut block = builder.finish(&mut results);
         block.finish_rows()?;
+        let twice = |what: &str, key: &str| panic!("two blocks report the {what} `{key}`");
+        for (name, value) in results.stats {
+            if stats.insert(name, value).is_some() {
+                twice("statistics", name);
+            }
+        }
+        for (key, value) in results.overflows {
+            if directed.insert(key, value).is_some() {
+                twice("overflow counts", key);
+            }
+        }
+        for (key, value) in results.facts {
+            facts.insert((block.name, key), value);
+        }
+        blocks.push(block);
     }
 
-    const REGISTERED: &str = "a registered block reports it";
     Ok(Run {
         blocks,
-        kf_stats: results.kf_stats.expect(REGISTERED),
-        chain_stats: results.chain_stats.expect(REGISTERED),
-        bias_stats: results.bias_stats.expect(REGISTERED),
-        mean_filter_stats: results.mean_filter_stats.expect(REGISTERED),
+        stats,
+        facts,
         overflows: Overflows {
             adc: gyros.saturations(),
             estimator: fixed.estimator().overflow_counts().into(),
             kf_chain: fixed.kf().overflow_counts().into(),
-            kf_directed: results.kf_directed.expect(REGISTERED),
-            mean_filter: results.mean_filter_overflows.expect(REGISTERED),
             gyro_loop: gyros.loop_counts(),
+            directed,
         },
-        ties: results.ties.expect(REGISTERED),
         report: report.finish(),
         samples: n,
-        gyro_loop_record: results.gyro_loop_record.expect(REGISTERED),
-        system_record: results.system_record,
     })
 }
 
@@ -792,7 +793,6 @@ impl ReportStream {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::blocks::mean_filter::GROSS_ERROR_PERIOD;
 
     #[test]
     fn the_switch_count_is_the_runs_bw_sel_changes() {
@@ -814,171 +814,5 @@ mod tests {
                 "{samples} {entries}"
             );
         }
-    }
-    use crate::text::Provenance;
-    use gyrofx_job::config::Config;
-    use gyrofx_model::kf::FixedKf;
-
-    /// The embedded config with 4000 samples, changed by `edit`, run.
-    fn run_embedded(edit: impl FnOnce(&mut Config)) -> (Job, Run) {
-        let mut config = Config::embedded();
-        config.samples = 4000;
-        edit(&mut config);
-        let job = Job::new(config).unwrap();
-        let provenance = Provenance {
-            version: "test".into(),
-            command: "test".into(),
-            config_sha256: "0".repeat(64),
-        };
-        let progress = Progress::default();
-        let run = run(&job, &RomImages::new(&job, &provenance), &progress).unwrap();
-        let (done, total) = progress.counts();
-        assert!(done <= total && total > 0, "{done} of {total}");
-        (job, run)
-    }
-
-    /// Streamed rows give the bytes the kept rows give (one formatter), the entries name
-    /// the files' real SHA-256 and size, a left-out block writes nothing, and without the CSV
-    /// only the hex files are written.
-    #[test]
-    fn streamed_vector_files_equal_the_kept_rows() {
-        let (job, kept) = run_embedded(|config| config.plant.model = "rate".into());
-        let provenance = Provenance {
-            version: "test".into(),
-            command: "test".into(),
-            config_sha256: "0".repeat(64),
-        };
-        let roms = RomImages::new(&job, &provenance);
-        for (csv, selected) in [(true, None), (false, Some(vec!["kf".to_string()]))] {
-            let root = tempfile::tempdir().unwrap();
-            let streaming = Streaming {
-                root: root.path(),
-                csv,
-                blocks: selected.as_deref(),
-                provenance: &provenance,
-            };
-            let streamed = run_streamed(&job, &roms, &Progress::default(), streaming).unwrap();
-            assert_eq!(streamed.samples, kept.samples);
-            for (s, k) in streamed.blocks.iter().zip(&kept.blocks) {
-                assert_eq!((s.name, s.len()), (k.name, k.len()));
-                let wanted = selected
-                    .as_ref()
-                    .is_none_or(|names| names.iter().any(|n| n == s.name));
-                if !wanted {
-                    assert!(s.written().is_empty());
-                    assert!(!root.path().join(s.name).exists(), "{}", s.name);
-                    continue;
-                }
-                let (stimulus, expected) = crate::writers::vector_hex(k, &provenance);
-                let mut want = vec![stimulus, expected];
-                if csv {
-                    want.push(crate::writers::vector_csv(k, &provenance));
-                }
-                assert_eq!(s.written().len(), want.len(), "{}", s.name);
-                for (entry, text) in s.written().iter().zip(&want) {
-                    let bytes = std::fs::read(root.path().join(&entry.path)).unwrap();
-                    assert!(bytes == text.as_bytes(), "{} differs", entry.path);
-                    assert_eq!(entry.bytes, bytes.len());
-                    assert_eq!(entry.sha256, gyrofx_job::hash::sha256_hex(&bytes));
-                }
-            }
-            assert_eq!(streamed.report, kept.report);
-        }
-    }
-
-    #[test]
-    fn the_default_run_fills_every_block_and_stays_within_the_bounds() {
-        let (job, run) = run_embedded(|_| {});
-        let names: Vec<&str> = run.blocks.iter().map(|b| b.name).collect();
-        assert_eq!(
-            names,
-            [
-                "sequencer",
-                "estimator",
-                "kf",
-                "top",
-                "mean_filter",
-                "gyro_loop",
-                "system"
-            ]
-        );
-        // The system's run: both loops lock during the start-up, the chain then steps once
-        // per decimated output, both gyros switch, and the estimator produces estimates.
-        let system = run
-            .system_record
-            .expect("a resonator package records the system");
-        assert_eq!(run.blocks[6].len(), system.samples);
-        let lock = system.first_lock_sample.expect("both loops lock");
-        assert!(lock < system.startup_samples, "{system:?}");
-        assert_eq!(
-            system.chain_samples,
-            (system.samples - system.startup_samples) / 1000
-        );
-        assert!(system.switches.iter().all(|s| *s >= 4), "{system:?}");
-        let estimate = system.first_estimate_sample.expect("an estimate");
-        assert!(estimate > system.startup_samples && system.outputs > 0);
-        assert!(system.outputs <= system.chain_samples);
-        // The loop's recorded window covers lock acquisition in normal mode, the switch and
-        // the re-lock in reverse mode, with a decimated output every 1000 samples.
-        let record = run.gyro_loop_record;
-        let [normal, reverse] = record.first_lock_sample;
-        let normal = normal.expect("the loop locks in normal mode");
-        let reverse = reverse.expect("the loop re-locks in reverse mode");
-        assert!(normal < record.switch_sample && reverse > record.switch_sample);
-        assert!(reverse < record.samples);
-        assert_eq!(record.outputs, record.samples / 1000);
-        assert_eq!(run.blocks[5].len(), record.samples);
-        // One row per sample plus the reset, in every chain block.
-        for b in [&run.blocks[0], &run.blocks[1], &run.blocks[3]] {
-            assert_eq!(b.len(), 4001, "{}", b.name);
-        }
-        assert!(run.kf_stats.max_lsb <= run.kf_stats.bound_lsb);
-        assert!(run.chain_stats.max_lsb <= run.chain_stats.bound_lsb);
-        assert!(run.bias_stats.max_lsb <= run.bias_stats.bound_lsb);
-        // Each tie input really is a tie from reset, for x1 and the output.
-        let kf = FixedKf::new(job.kf());
-        for tie in &run.ties {
-            assert!(kf.ties(tie.x1.expect("x1 tie"), tie.bw_sel)[0]);
-            assert!(kf.ties(tie.rate_hat.expect("output tie"), tie.bw_sel)[2]);
-        }
-        // Every bw_sel value occurs in the top vectors.
-        let sels: std::collections::BTreeSet<i64> = (0..run.blocks[3].len())
-            .map(|k| run.blocks[3].row(k)[1])
-            .collect();
-        assert_eq!(sels.len(), 3);
-    }
-
-    /// The mean filter's vectors: one output per block of 20, kept counts from 0 (every
-    /// sample rejected) to 20, the gross errors rejected, and fixed within the bound of float.
-    #[test]
-    fn the_mean_filter_vectors_cover_every_case_within_the_bound() {
-        // r = 3 °/s, about 2.6 sigma of the default gyro: only the gross errors (8 r) go.
-        let (_, run) = run_embedded(|config| config.mean_filter.threshold_dps = 3.0);
-        let block = &run.blocks[4];
-        // rst, x, y_valid, y, kept
-        let outputs: Vec<&[i64]> = (0..block.len())
-            .map(|k| block.row(k))
-            .filter(|row| row[2] == 1)
-            .collect();
-        // 4000 samples with a reset at 3600: 180 + 20 blocks, then 6 directed ones.
-        assert_eq!(outputs.len(), 180 + 20 + 6);
-        let kept: std::collections::BTreeSet<i64> = outputs.iter().map(|row| row[4]).collect();
-        assert!(
-            kept.contains(&0) && kept.contains(&20) && kept.contains(&19),
-            "{kept:?}"
-        );
-        // Every block with a gross error (before the reset, blocks start at multiples of 20)
-        // drops at least that sample.
-        let gross_blocks: Vec<usize> = (0..180)
-            .filter(|b| {
-                (20 * b..20 * b + 20).any(|k| k % GROSS_ERROR_PERIOD == GROSS_ERROR_PERIOD / 3)
-            })
-            .collect();
-        assert!(gross_blocks.len() > 50, "{}", gross_blocks.len());
-        for b in gross_blocks {
-            assert!(outputs[b][4] < 20, "block {b} kept its gross error");
-        }
-        assert!(run.mean_filter_stats.max_lsb <= run.mean_filter_stats.bound_lsb);
-        assert!(run.mean_filter_stats.samples >= 200);
     }
 }

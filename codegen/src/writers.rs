@@ -221,6 +221,11 @@ pub fn build_outputs(blocks: &[Block]) -> Vec<String> {
 
 /// The package's README.
 pub fn package_readme(run: &Run, provenance: &Provenance) -> String {
+    // Every package has the chain's blocks, which report these.
+    let stats = |name: &str| {
+        run.stats(name)
+            .unwrap_or_else(|| panic!("no block reported the statistics `{name}`"))
+    };
     let mut out = format!(
         "<!-- {line} -->
 # gyrofx verification package
@@ -285,14 +290,14 @@ Fixed vs float (same quantized coefficients): KF max {kf:.3} LSB (bound {kfb:.3}
 {ch:.3} LSB (bound {chb:.3}), bias estimates max {bi:.3} LSB (bound {bib:.3}), mean filter max
 {mf:.3} LSB (bound {mfb:.3}).
 ",
-        kf = run.kf_stats.max_lsb,
-        kfb = run.kf_stats.bound_lsb,
-        ch = run.chain_stats.max_lsb,
-        chb = run.chain_stats.bound_lsb,
-        bi = run.bias_stats.max_lsb,
-        bib = run.bias_stats.bound_lsb,
-        mf = run.mean_filter_stats.max_lsb,
-        mfb = run.mean_filter_stats.bound_lsb,
+        kf = stats("kf").max_lsb,
+        kfb = stats("kf").bound_lsb,
+        ch = stats("chain").max_lsb,
+        chb = stats("chain").bound_lsb,
+        bi = stats("bias").max_lsb,
+        bib = stats("bias").bound_lsb,
+        mf = stats("mean_filter").max_lsb,
+        mfb = stats("mean_filter").bound_lsb,
     );
     out
 }

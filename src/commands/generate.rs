@@ -167,11 +167,8 @@ pub fn run(args: Args) -> Result<ExitCode> {
             .join(", ")
     );
     println!("kf plan: {}", job.kf());
-    for (what, s) in [
-        ("kf", &run.kf_stats),
-        ("chain", &run.chain_stats),
-        ("bias", &run.bias_stats),
-    ] {
+    for what in ["kf", "chain", "bias"] {
+        let Some(s) = run.stats(what) else { continue };
         println!(
             "{what} fixed vs float: max {:.3} LSB, rms {:.3} LSB, bound {:.3} LSB; vs ideal: max {:.3} LSB, SQNR {:.1} dB",
             s.max_lsb, s.rms_lsb, s.bound_lsb, s.ideal_max_lsb, s.sqnr_db
@@ -179,10 +176,11 @@ pub fn run(args: Args) -> Result<ExitCode> {
     }
     let o = &run.overflows;
     let loops = loop_overflows(&job, o);
+    let directed = &o.directed["kf_directed"];
     println!(
         "overflows: ADC {:?}, means {:?}, biases {:?}, calibrated {:?}, combined {}, KF x1 {} x2 {} rate_hat {} (directed segment: x1 {} x2 {} rate_hat {}){loops}",
         o.adc, o.estimator.mean, o.estimator.bias, o.estimator.calibrated, o.estimator.combined,
-        o.kf_chain.x1, o.kf_chain.x2, o.kf_chain.rate_hat, o.kf_directed.x1, o.kf_directed.x2, o.kf_directed.rate_hat
+        o.kf_chain.x1, o.kf_chain.x2, o.kf_chain.rate_hat, directed["x1"], directed["x2"], directed["rate_hat"]
     );
     println!(
         "report ({} s):",

@@ -2,8 +2,9 @@
 //! (SPEC §1.3, `docs/blocks/calibration.md`). Combinational, inside `gyrofx_top`: it has no
 //! vectors of its own; the top's vectors check it.
 
-use super::{mode_params, RomImages, RtlBlock, VectorBuilder};
+use super::{mode_params, RomImages, RtlBlock};
 use crate::block::{Block, Output, Param, Signal};
+use crate::vectors::VectorBuilder;
 use gyrofx_job::job::Job;
 
 /// The calibration block.

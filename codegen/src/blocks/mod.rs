@@ -3,7 +3,8 @@
 //! A block's module owns everything the generator, the writers, `verify` and `synth` need to
 //! know about it: its ports with their formats and its parameters ([`RtlBlock::block`]), the
 //! ROMs it owns ([`RtlBlock::roms`]), how its vectors are cut from the chain run
-//! ([`RtlBlock::vectors`]) and its section of the manifest ([`RtlBlock::manifest`]). Everything
+//! ([`RtlBlock::vectors`], a [`VectorBuilder`] of the run's interface) and its section of the
+//! manifest ([`RtlBlock::manifest`]). Everything
 //! downstream iterates over [`REGISTRY`]; nothing else matches on block names.
 //!
 //! Adding a block: a model module in `gyrofx-model`, a module here implementing [`RtlBlock`],
@@ -20,13 +21,16 @@ pub mod sequencer;
 pub mod system;
 pub mod top;
 
-use gyrofx_model::chain::{FloatSample, Sample};
+#[cfg(test)]
+mod tests;
+
 use gyrofx_model::fx::{Overflow, Rounding};
 
 use crate::block::{Block, Param};
 use crate::rom::{self, Rom, RomFormat};
 use crate::text::Provenance;
-use crate::vectors::{Results, Run};
+use crate::vector_rows::StagedRows;
+use crate::vectors::{Run, VectorBuilder};
 use gyrofx_job::job::Job;
 
 /// One RTL block.
@@ -127,39 +131,49 @@ pub fn find(name: &str) -> &'static dyn RtlBlock {
         .unwrap_or_else(|| panic!("no block `{name}` in the registry"))
 }
 
-/// One sample of the chain run, as every block's vectors see it.
-pub struct ChainSample<'a> {
-    /// Sample index in the run (resets not counted).
-    pub index: usize,
-    /// KF ROM address in use.
-    pub bw_sel: usize,
-    /// Gyro A's and B's ADC codes (input format).
-    pub y: [i64; 2],
-    /// What the fixed chain did.
-    pub fixed: &'a Sample,
-    /// The float chain with the same quantized coefficients.
-    pub float: &'a FloatSample,
-    /// The float chain with the designed coefficients.
-    pub ideal: &'a FloatSample,
-    /// The estimator's bias registers after the sample (bias format).
-    pub bias_after: [i128; 2],
-    /// Whether a window has produced an estimate since reset, after the sample.
-    pub estimated: bool,
-    /// The true rate, °/s.
-    pub true_rate_dps: f64,
+/// Where the chain run's vector builders write their blocks' files
+/// ([`vector_builders`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Streaming<'a> {
+    /// The staging folder.
+    pub root: &'a std::path::Path,
+    /// Whether the CSV twins are written.
+    pub csv: bool,
+    /// Only these blocks' files (all when `None`); the others' rows are only counted.
+    pub blocks: Option<&'a [String]>,
+    /// The generated-by line's source.
+    pub provenance: &'a Provenance,
 }
 
-/// Cuts one block's vectors from the chain run, sample by sample.
-pub trait VectorBuilder {
-    /// A synchronous reset of the whole chain before the next sample.
-    fn reset(&mut self);
-
-    /// One sample.
-    fn sample(&mut self, sample: &ChainSample);
-
-    /// After the last sample: appends the block's directed segments, records its statistics
-    /// in `results` and returns its vectors.
-    fn finish(self: Box<Self>, results: &mut Results) -> Block;
+/// The vector builders of every block of `job`'s package that has vectors, in registry
+/// order, for [`crate::vectors::run`]. Without `streaming` each keeps its rows in memory;
+/// with it, each writes its rows as they come into its files under `streaming.root`
+/// ([`StagedRows`]), so that memory does not grow with the samples.
+///
+/// # Errors
+/// A vector file that cannot be created.
+pub fn vector_builders<'a>(
+    job: &'a Job,
+    roms: &RomImages,
+    streaming: Option<Streaming>,
+) -> gyrofx_job::error::Result<Vec<Box<dyn VectorBuilder + 'a>>> {
+    let mut builders = Vec::new();
+    for registered in of(job).filter(|b| b.has_vectors()) {
+        let mut block = registered.block(job, roms);
+        if let Some(streaming) = &streaming {
+            let wanted = streaming
+                .blocks
+                .is_none_or(|names| names.iter().any(|n| n == block.name));
+            let sink = if wanted {
+                StagedRows::open(&block, streaming.root, streaming.csv, streaming.provenance)?
+            } else {
+                StagedRows::discard(&block)
+            };
+            block.stream_to(Box::new(sink));
+        }
+        builders.extend(registered.vectors(job, block));
+    }
+    Ok(builders)
 }
 
 /// A ROM's `$readmemh` image: the file a DUT reads.

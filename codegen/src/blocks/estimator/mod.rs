@@ -4,13 +4,13 @@
 use gyrofx_model::estimator::Plan;
 use serde_json::json;
 
-use super::{flag, mode_params, ChainSample, RomImages, RtlBlock, VectorBuilder};
+use super::{flag, mode_params, RomImages, RtlBlock};
 use crate::block::DpiParts;
 use crate::block::{Block, Output, Param, Signal};
 use crate::rom::{Rom, RomFormat, ROM_FOLDER};
 use crate::stats::Accumulator;
 use crate::text::fill;
-use crate::vectors::{Results, Run};
+use crate::vectors::{BlockResults, ChainSample, Run, VectorBuilder};
 use gyrofx_job::job::Job;
 
 /// The estimator block.
@@ -152,7 +152,7 @@ impl RtlBlock for Estimator {
                 "gains": {"designed": est.gains, "quantized": est.quantized_gains(), "all_shifts": est.gains_are_shifts(),
                           "rom": {"file": RomFormat::Mem.file_name(&rom.rom.name), "word_bits": rom.rom.width(), "all_formats": ROM_FOLDER, "order": "bias_a row over [mA0, mB0, mA1, ...], then bias_b row"}},
                 "smoothing_shift": est.smoothing_shift,
-                "fixed_vs_float_bias": run.bias_stats,
+                "fixed_vs_float_bias": run.stats("bias"),
             }),
         ))
     }
@@ -207,9 +207,9 @@ impl VectorBuilder for Vectors<'_> {
         }
     }
 
-    fn finish(self: Box<Self>, results: &mut Results) -> Block {
+    fn finish(self: Box<Self>, results: &mut BlockResults) -> Block {
         let bound = self.plan.bias_error_bound() / self.plan.bias.lsb();
-        results.bias_stats = Some(self.bias.finish(bound));
+        results.stats.push(("bias", self.bias.finish(bound)));
         self.block
     }
 }

@@ -16,11 +16,11 @@ use gyrofx_model::gyro_loop::gyro::Plan;
 use gyrofx_model::resonator::Mode;
 use serde_json::json;
 
-use super::{flag, mode_params, ChainSample, RomImages, RtlBlock, VectorBuilder};
+use super::{flag, mode_params, RomImages, RtlBlock};
 use crate::block::{Block, Output, Param, Signal};
 use crate::block::{DpiParts, DpiStream};
 use crate::rom::Rom;
-use crate::vectors::{Results, Run};
+use crate::vectors::{BlockResults, ChainSample, Run, VectorBuilder};
 use gyrofx_job::config::GyroLoop as LoopConfig;
 use gyrofx_job::job::Job;
 
@@ -38,6 +38,9 @@ pub const NORMAL_S: f64 = 0.1;
 pub const REVERSE_S: f64 = 0.1;
 /// Input rate of the recorded run, °/s.
 pub const RATE_DPS: f64 = 10.0;
+
+/// Key of what the recorded run covered ([`RecordSummary`]) among the block's manifest facts.
+const RECORDED: &str = "recorded";
 
 /// Clocks from the `ce` of a sample to its registered outputs, less the one the testbench
 /// always allows (the RTL's four register stages).
@@ -330,7 +333,7 @@ impl RtlBlock for GyroLoop {
                 "stimulus": format!(
                     "gyro A's fixed loop closed around its resonator from reset at {RATE_DPS} °/s: {NORMAL_S} s normal mode (lock), then {REVERSE_S} s reverse (switch and re-lock); the ADC codes it saw and the mode"
                 ),
-                "recorded": run.gyro_loop_record,
+                "recorded": run.fact(self.name(), RECORDED),
             }),
         ))
     }
@@ -348,7 +351,7 @@ impl VectorBuilder for Vectors<'_> {
 
     fn sample(&mut self, _sample: &ChainSample) {}
 
-    fn finish(mut self: Box<Self>, results: &mut Results) -> Block {
+    fn finish(mut self: Box<Self>, results: &mut BlockResults) -> Block {
         let plan = &self.gyro.plan;
         let normal = (NORMAL_S * plan.adc_rate_hz).round() as usize;
         let total = normal + (REVERSE_S * plan.adc_rate_hz).round() as usize;
@@ -394,13 +397,19 @@ impl VectorBuilder for Vectors<'_> {
         }
         summary.samples = samples.len();
         summary.switch_sample = normal;
-        results.gyro_loop_record = Some(summary);
+        results.facts.push((RECORDED, json!(summary)));
         self.block
     }
 }
 
+/// What the recorded run covered, as `run`'s gyro-loop builder reported it.
+pub fn recorded(run: &Run) -> Option<RecordSummary> {
+    let fact = run.fact(GyroLoop.name(), RECORDED)?;
+    Some(serde_json::from_value(fact.clone()).expect("the builder's own summary"))
+}
+
 /// What the recorded run covered (the manifest's `gyro_loop.recorded`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct RecordSummary {
     /// ADC samples.
     pub samples: usize,

@@ -7,14 +7,14 @@ use gyrofx_model::kf::{FixedKf, FloatKf, OverflowCounts, Plan};
 use serde::Serialize;
 use serde_json::json;
 
-use super::{mode_params, ChainSample, RomImages, RtlBlock, VectorBuilder};
+use super::{mode_params, RomImages, RtlBlock};
 use crate::block::{Block, Output, Param, Signal};
 use crate::block::{DpiParts, DpiStream};
 use crate::report;
 use crate::rom::{Rom, RomFormat, ROM_FOLDER};
 use crate::stats::Accumulator;
 use crate::text::fill;
-use crate::vectors::{Results, Run};
+use crate::vectors::{BlockResults, ChainSample, KfCounts, Run, VectorBuilder};
 use gyrofx_job::job::Job;
 
 /// The KF block.
@@ -29,11 +29,20 @@ pub const ROM: &str = "kf_coefficients";
 
 /// Samples of the full-scale segment at each polarity.
 const FULL_SCALE_SAMPLES: usize = 64;
+
+/// Key of the tie cases found ([`TieCases`]) among the block's manifest facts.
+const TIE_CASES: &str = "tie_cases";
 /// Largest |z| searched for a tie case.
 const TIE_SEARCH_LIMIT: i64 = 1 << 16;
 
+/// The tie cases `run`'s KF builder found.
+pub fn tie_cases(run: &Run) -> Option<Vec<TieCases>> {
+    let fact = run.fact(Kf.name(), TIE_CASES)?;
+    Some(serde_json::from_value(fact.clone()).expect("the builder's own tie cases"))
+}
+
 /// Tie-case inputs found for one KF ROM entry.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct TieCases {
     /// ROM address.
     pub bw_sel: usize,
@@ -156,8 +165,8 @@ impl RtlBlock for Kf {
                 "coefficients": report::coefficients(kf),
                 "rom": {"file": RomFormat::Mem.file_name(&rom.rom.name), "depth": kf.rom.len(), "word_bits": rom.rom.width(), "all_formats": ROM_FOLDER,
                         "packing": "word = {g1, g2}: g1 in the high bits; address = bw_sel"},
-                "tie_cases": run.ties,
-                "fixed_vs_float": run.kf_stats,
+                "tie_cases": run.fact(self.name(), TIE_CASES),
+                "fixed_vs_float": run.stats("kf"),
             }),
         ))
     }
@@ -206,14 +215,17 @@ impl VectorBuilder for Vectors<'_> {
         self.errors.add(fixed, float, ideal, self.plan.output.lsb());
     }
 
-    fn finish(mut self: Box<Self>, results: &mut Results) -> Block {
+    fn finish(mut self: Box<Self>, results: &mut BlockResults) -> Block {
         let steps = self.errors.count();
         let bound = rate_error_bound_lsb(self.plan, steps, self.switches);
         let ties = find_ties(self.plan);
         let directed = directed_segment(self.plan, &ties, &mut self.block);
-        results.kf_stats = Some(std::mem::take(&mut self.errors).finish(bound));
-        results.kf_directed = Some(directed.into());
-        results.ties = Some(ties);
+        let stats = std::mem::take(&mut self.errors).finish(bound);
+        results.stats.push(("kf", stats));
+        results
+            .overflows
+            .push(("kf_directed", json!(KfCounts::from(directed))));
+        results.facts.push((TIE_CASES, json!(ties)));
         self.block
     }
 }

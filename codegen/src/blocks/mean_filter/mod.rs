@@ -5,12 +5,12 @@
 use gyrofx_model::mean_filter::{serial, FixedMeanFilter, FloatMeanFilter, Plan};
 use serde_json::json;
 
-use super::{mode_params, ChainSample, RomImages, RtlBlock, VectorBuilder};
+use super::{mode_params, RomImages, RtlBlock};
 use crate::block::{Block, Output, Param, Signal};
 use crate::block::{DpiParts, DpiStream};
 use crate::rom::{Rom, RomFormat, ROM_FOLDER};
 use crate::stats::Accumulator;
-use crate::vectors::{Results, Run};
+use crate::vectors::{BlockResults, ChainSample, Run, VectorBuilder};
 use gyrofx_job::config::Architecture;
 use gyrofx_job::job::Job;
 
@@ -180,7 +180,7 @@ impl RtlBlock for MeanFilter {
                 "module": module,
                 "latency_clocks": latency,
                 "min_clocks_per_sample": min_spacing,
-                "fixed_vs_float": run.mean_filter_stats,
+                "fixed_vs_float": run.stats("mean_filter"),
         });
         Some(("mean_filter", section))
     }
@@ -251,7 +251,7 @@ impl VectorBuilder for Vectors<'_> {
         self.step(code);
     }
 
-    fn finish(mut self: Box<Self>, results: &mut Results) -> Block {
+    fn finish(mut self: Box<Self>, results: &mut BlockResults) -> Block {
         for sample in directed(self.plan) {
             match sample {
                 Some(code) => self.step(code),
@@ -259,8 +259,11 @@ impl VectorBuilder for Vectors<'_> {
             }
         }
         let bound = self.plan.error_bound_lsb();
-        results.mean_filter_stats = Some(std::mem::take(&mut self.errors).finish(bound));
-        results.mean_filter_overflows = Some(self.overflows);
+        let stats = std::mem::take(&mut self.errors).finish(bound);
+        results.stats.push(("mean_filter", stats));
+        results
+            .overflows
+            .push(("mean_filter", serde_json::json!(self.overflows)));
         self.block
     }
 }

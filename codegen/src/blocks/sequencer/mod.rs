@@ -4,10 +4,10 @@
 
 use gyrofx_model::sequencer::Schedule;
 
-use super::{flag, mode_bit, ChainSample, RomImages, RtlBlock, VectorBuilder};
+use super::{flag, mode_bit, RomImages, RtlBlock};
 use crate::block::DpiParts;
 use crate::block::{Block, Output, Param, Signal};
-use crate::vectors::Results;
+use crate::vectors::{BlockResults, ChainSample, VectorBuilder};
 use gyrofx_job::job::Job;
 
 /// The sequencer block.
@@ -145,7 +145,7 @@ impl VectorBuilder for Vectors {
         );
     }
 
-    fn finish(self: Box<Self>, _results: &mut Results) -> Block {
+    fn finish(self: Box<Self>, _results: &mut BlockResults) -> Block {
         self.block
     }
 }

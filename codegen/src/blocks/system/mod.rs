@@ -21,10 +21,10 @@ use gyrofx_model::resonator::Mode;
 use gyrofx_model::system::{record, GyroPhysics, RecordedSample};
 use serde_json::json;
 
-use super::{flag, gyro_loop, kf, top, ChainSample, RomImages, RtlBlock, VectorBuilder};
+use super::{flag, gyro_loop, kf, top, RomImages, RtlBlock};
 use crate::block::{Block, Output, Param, Signal};
 use crate::rom::Rom;
-use crate::vectors::{Results, Run};
+use crate::vectors::{BlockResults, ChainSample, Run, VectorBuilder};
 use gyrofx_job::config::GyroLoop as LoopConfig;
 use gyrofx_job::error::{Error, Result};
 use gyrofx_job::job::Job;
@@ -44,6 +44,9 @@ pub const WINDOWS: usize = 2;
 /// Seconds of start-up with `enable` low, rounded up to whole chain periods (the loops lock in
 /// about 80 ms).
 pub const STARTUP_S: f64 = 0.1;
+
+/// Key of what the recorded run covered ([`SystemSummary`]) among the block's manifest facts.
+const RECORDED: &str = "recorded";
 /// Input rate of the recorded run, °/s.
 pub const RATE_DPS: f64 = 10.0;
 
@@ -262,7 +265,7 @@ impl RtlBlock for System {
                 "stimulus": format!(
                     "gyro A's and B's loops closed around their resonators from reset at {RATE_DPS} °/s: enable low for {STARTUP_S} s (rounded up to whole chain periods; both lock in normal mode), then high for {WINDOWS} windows of the schedule above; bw_sel 0 in the first window, then the next ROM entry"
                 ),
-                "recorded": run.system_record,
+                "recorded": run.fact(self.name(), RECORDED),
             }),
         ))
     }
@@ -275,8 +278,15 @@ struct Vectors<'a> {
     block: Block,
 }
 
+/// What the recorded system run covered, as `run`'s system builder reported it (resonator
+/// packages only).
+pub fn recorded(run: &Run) -> Option<SystemSummary> {
+    let fact = run.fact(System.name(), RECORDED)?;
+    Some(serde_json::from_value(fact.clone()).expect("the builder's own summary"))
+}
+
 /// What the recorded system run covered (the manifest's `system.recorded`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct SystemSummary {
     /// ADC samples.
     pub samples: usize,
@@ -303,7 +313,7 @@ impl VectorBuilder for Vectors<'_> {
 
     fn sample(&mut self, _sample: &ChainSample) {}
 
-    fn finish(mut self: Box<Self>, results: &mut Results) -> Block {
+    fn finish(mut self: Box<Self>, results: &mut BlockResults) -> Block {
         let loops: [&LoopConfig; 2] = [&self.job.gyro_loops[0], &self.job.gyro_loops[1]];
         let schedule = &self.plan.estimator.schedule;
         let decimation = loops[0].plan.cic.decimation as usize;
@@ -395,7 +405,7 @@ impl VectorBuilder for Vectors<'_> {
             },
         )
         .expect("the config check validated the physics");
-        results.system_record = Some(summary);
+        results.facts.push((RECORDED, json!(summary)));
         self.block
     }
 }

@@ -7,13 +7,13 @@ use gyrofx_model::serial::Program;
 use serde_json::json;
 
 use super::{estimator, flag, kf, mode_bit, mode_params, sequencer};
-use super::{ChainSample, RomImages, RtlBlock, VectorBuilder};
+use super::{RomImages, RtlBlock};
 use crate::block::{Block, Output, Param, Signal};
 use crate::block::{DpiParts, DpiStream};
 use crate::rom::Rom;
 use crate::stats::Accumulator;
 use crate::text::fill;
-use crate::vectors::{Results, Run};
+use crate::vectors::{BlockResults, ChainSample, Run, VectorBuilder};
 use gyrofx_job::job::Job;
 
 /// The top block.
@@ -224,7 +224,7 @@ impl RtlBlock for Top {
             "architecture": architecture,
             "latency_clocks": settle + 1,
             "min_clocks_per_sample": settle + 1,
-            "fixed_vs_float": run.chain_stats,
+            "fixed_vs_float": run.stats("chain"),
         });
         if let Some(program) = &job.serial {
             chain["serial"] = json!({
@@ -299,11 +299,13 @@ impl VectorBuilder for Vectors<'_> {
         }
     }
 
-    fn finish(mut self: Box<Self>, results: &mut Results) -> Block {
+    fn finish(mut self: Box<Self>, results: &mut BlockResults) -> Block {
         let bound = self
             .plan
             .rate_error_bound_lsb(self.errors.count(), self.switches);
-        results.chain_stats = Some(std::mem::take(&mut self.errors).finish(bound));
+        results
+            .stats
+            .push(("chain", std::mem::take(&mut self.errors).finish(bound)));
         self.block
     }
 }
