@@ -63,41 +63,42 @@ begin
         report "gyrofx_quantize: ROUNDING = " & integer'image(ROUNDING) & " must be 0..5"
         severity failure;
 
+    -- Each part is one process with variables, not a signal per step: a simulator then
+    -- evaluates a quantization point in two delta cycles instead of seven (the closed loops
+    -- have dozens of them; their GHDL runs took a third longer).
     g_exact : if SHIFT = 0 generate
         rounded <= resize(value_in, Q_W);
     end generate;
 
     g_round : if SHIFT > 0 generate
-        signal quotient : signed(Q_W - 1 downto 0);
-        signal remainder : std_logic_vector(SHIFT - 1 downto 0);
-        signal negative : std_logic;
-        signal any_dropped : std_logic;
-        signal half_bit : std_logic;
-        signal below_half : std_logic;
-        signal increment : std_logic;
-    begin
-        quotient <= resize(value_in(IN_W - 1 downto SHIFT), Q_W);
-        remainder <= std_logic_vector(value_in(SHIFT - 1 downto 0));
-        negative <= value_in(IN_W - 1);
-        any_dropped <= or remainder;
-        half_bit <= remainder(SHIFT - 1);
-
-        g_one : if SHIFT = 1 generate
-            below_half <= '0';
-        end generate;
-        g_more : if SHIFT > 1 generate
-            below_half <= or remainder(SHIFT - 2 downto 0);
-        end generate;
-
-        with ROUNDING select increment <=
-            any_dropped                                 when 1,
-            any_dropped and negative                    when 2,
-            half_bit                                    when 3,
-            half_bit and (below_half or not negative)   when 4,
-            half_bit and (below_half or quotient(0))    when 5,
-            '0'                                         when others;
-
-        rounded <= quotient + signed'('0' & increment);
+        round : process (value_in)
+            variable quotient : signed(Q_W - 1 downto 0);
+            variable remainder : std_logic_vector(SHIFT - 1 downto 0);
+            variable negative : std_logic;
+            variable any_dropped : std_logic;
+            variable half_bit : std_logic;
+            variable below_half : std_logic;
+            variable increment : std_logic;
+        begin
+            quotient := resize(value_in(IN_W - 1 downto SHIFT), Q_W);
+            remainder := std_logic_vector(value_in(SHIFT - 1 downto 0));
+            negative := value_in(IN_W - 1);
+            any_dropped := or remainder;
+            half_bit := remainder(SHIFT - 1);
+            below_half := '0';
+            if SHIFT > 1 then
+                below_half := or remainder(SHIFT - 2 downto 0);
+            end if;
+            case ROUNDING is
+                when 1 => increment := any_dropped;
+                when 2 => increment := any_dropped and negative;
+                when 3 => increment := half_bit;
+                when 4 => increment := half_bit and (below_half or not negative);
+                when 5 => increment := half_bit and (below_half or quotient(0));
+                when others => increment := '0';
+            end case;
+            rounded <= quotient + signed'('0' & increment);
+        end process;
     end generate;
 
     g_fits : if Q_W <= OUT_W generate
@@ -106,16 +107,22 @@ begin
     end generate;
 
     g_check : if Q_W > OUT_W generate
-        -- Fits when every bit above the output's sign bit equals the sign.
-        signal top : std_logic_vector(Q_W - OUT_W downto 0);
-        signal fits : std_logic;
-        signal clamped : signed(OUT_W - 1 downto 0);
-    begin
-        top <= std_logic_vector(rounded(Q_W - 1 downto OUT_W - 1));
-        fits <= (and top) or not (or top);
-        clamped <= ('1', others => '0') when rounded(Q_W - 1) = '1' else ('0', others => '1');
-        value_out <= rounded(OUT_W - 1 downto 0) when fits = '1' or SATURATE = 0 else clamped;
-        overflow <= not fits;
+        check : process (rounded)
+            -- Fits when every bit above the output's sign bit equals the sign.
+            variable top : std_logic_vector(Q_W - OUT_W downto 0);
+            variable fits : std_logic;
+        begin
+            top := std_logic_vector(rounded(Q_W - 1 downto OUT_W - 1));
+            fits := (and top) or not (or top);
+            if fits = '1' or SATURATE = 0 then
+                value_out <= rounded(OUT_W - 1 downto 0);
+            elsif rounded(Q_W - 1) = '1' then
+                value_out <= ('1', others => '0');
+            else
+                value_out <= ('0', others => '1');
+            end if;
+            overflow <= not fits;
+        end process;
     end generate;
 
 end architecture;

@@ -377,7 +377,12 @@ begin
             else
                 a_word <= (others => '0');
             end if;
-            product <= a_operand * b_word;
+            -- Only the product registered in phase 2 is used (by the instruction executing in
+            -- phase 3): a clock enable there keeps a simulator from computing it at the other
+            -- three clocks. The Verilog registers it at every clock; the ports are the same.
+            if phase = 2 then
+                product <= a_operand * b_word;
+            end if;
         end if;
     end process;
 
