@@ -132,7 +132,10 @@ cargo fmt --manifest-path python/Cargo.toml -- --check
 # compiled again. python/Cargo.lock keeps the workspace's versions, and the feature
 # `workspace-features` (with the root Cargo.toml's side) the workspace's features below the
 # model and the job. Fresh: clippy 52 s, the wheel 73 s (107 and 121 s without the aligned
-# features); the model and the job themselves are still compiled once more, cause not found.
+# features). The model and the job themselves are compiled once more: python/ is a workspace of
+# its own, so Cargo sees them at another path than the workspace does (a local crate's
+# fingerprint hashes its path relative to its workspace: `model/src/lib.rs` there,
+# `/…/model/src/lib.rs` here), about 40 CPU-s.
 export CARGO_TARGET_DIR="$PWD/target"
 cargo clippy --manifest-path python/Cargo.toml --all-targets --features workspace-features --quiet -- -D warnings
 rm -rf python/target/wheels
