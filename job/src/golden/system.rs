@@ -1,0 +1,136 @@
+//! The port-level golden model of the whole gyro (`gyrofx_system`).
+
+use super::{check_bw_sel, check_code, check_flag, PortResult};
+use gyrofx_model::chain;
+use gyrofx_model::gyro_loop::gyro as gyro_loop;
+use gyrofx_model::resonator::Mode;
+use gyrofx_model::system::FixedSystem;
+
+/// The system's output ports (`gyrofx_system`), in the RTL's order.
+pub const SYSTEM_OUTPUTS: [&str; 13] = [
+    "dac_a_x",
+    "dac_a_y",
+    "dac_b_x",
+    "dac_b_y",
+    "locked_a",
+    "locked_b",
+    "mode_a",
+    "mode_b",
+    "out_valid",
+    "rate_out",
+    "bias_a",
+    "bias_b",
+    "estimated",
+];
+
+/// The system's input ports after `enable` and `bw_sel`, in the RTL's order.
+pub const SYSTEM_ADC_PORTS: [&str; 4] = ["adc_a_x", "adc_a_y", "adc_b_x", "adc_b_y"];
+
+/// Why a plan has no system: the rate plant's loops do not feed its chain.
+pub const NO_SYSTEM: &str = "plant.model = \"rate\" has no system block (its loops do not feed the chain): allowed with plant.model = \"resonator\"";
+
+/// The whole gyro (`gyrofx_system`): both gyros' loops feeding the chain, whose sequencer
+/// commands their modes.
+#[derive(Clone, Debug)]
+pub struct System {
+    loops: [gyro_loop::Plan; 2],
+    chain: chain::Plan,
+    model: FixedSystem,
+    /// `rate_out` of the chain's last output: the RTL holds it between pulses.
+    held: i64,
+}
+
+impl System {
+    /// From reset: gyro A's and B's loop plans and the system's chain plan.
+    pub fn new(loops: [&gyro_loop::Plan; 2], chain: &chain::Plan) -> System {
+        System {
+            loops: loops.map(Clone::clone),
+            chain: chain.clone(),
+            model: FixedSystem::new(loops, chain),
+            held: 0,
+        }
+    }
+
+    /// Gyro A's and B's loop plans.
+    pub fn loops(&self) -> &[gyro_loop::Plan; 2] {
+        &self.loops
+    }
+
+    /// The chain's plan (its short schedule).
+    pub fn chain_plan(&self) -> &chain::Plan {
+        &self.chain
+    }
+
+    /// The synchronous reset.
+    pub fn reset(&mut self) {
+        self.model = FixedSystem::new([&self.loops[0], &self.loops[1]], &self.chain);
+        self.held = 0;
+    }
+
+    /// The modes `[mode_a, mode_b]` (1 normal, 0 reverse) the loops take at the next sample if
+    /// `enable` is high there: what a plant needs before it produces that sample.
+    pub fn next_modes(&self) -> [i64; 2] {
+        self.model
+            .upcoming_modes()
+            .map(|m| i64::from(m == Mode::Normal))
+    }
+
+    /// The checked inputs of one sample: `(enable, bw_sel)`.
+    ///
+    /// # Errors
+    /// A flag other than 0/1, `bw_sel` beyond the ROM or an ADC code outside its format.
+    pub fn check(
+        &self,
+        enable: i64,
+        bw_sel: i64,
+        adc: [i64; 4],
+        suffix: &str,
+    ) -> PortResult<(bool, usize)> {
+        let enable = check_flag(enable, &format!("enable{suffix}"))?;
+        let bw_sel = check_bw_sel(bw_sel, self.chain.kf.rom.len(), &format!("bw_sel{suffix}"))?;
+        for (code, port) in adc.into_iter().zip(SYSTEM_ADC_PORTS) {
+            check_code(code, self.loops[0].adc, &format!("{port}{suffix}"))?;
+        }
+        Ok((enable, bw_sel))
+    }
+
+    /// One ADC sample: the output ports ([`SYSTEM_OUTPUTS`] order) after it, `mode_a`/`mode_b`
+    /// the modes of the next sample when `enable` is high; `rate_out` holds its last value
+    /// where `out_valid` is 0, as the RTL's does.
+    ///
+    /// # Errors
+    /// As [`System::check`].
+    pub fn step(&mut self, enable: i64, bw_sel: i64, adc: [i64; 4]) -> PortResult<[i64; 13]> {
+        let (enable, bw_sel) = self.check(enable, bw_sel, adc, "")?;
+        Ok(self.step_checked(enable, bw_sel, adc))
+    }
+
+    /// [`System::step`] on checked inputs.
+    pub fn step_checked(&mut self, enable: bool, bw_sel: usize, adc: [i64; 4]) -> [i64; 13] {
+        let step = self
+            .model
+            .step([[adc[0], adc[1]], [adc[2], adc[3]]], enable, bw_sel);
+        let rate = step.chain.and_then(|c| c.rate);
+        if let Some(rate) = rate {
+            self.held = rate;
+        }
+        let upcoming = self.model.upcoming_modes();
+        let estimator = self.model.chain().estimator();
+        let [bias_a, bias_b] = estimator.bias();
+        [
+            step.dac[0][0],
+            step.dac[0][1],
+            step.dac[1][0],
+            step.dac[1][1],
+            i64::from(step.locked[0]),
+            i64::from(step.locked[1]),
+            i64::from(upcoming[0] == Mode::Normal),
+            i64::from(upcoming[1] == Mode::Normal),
+            i64::from(rate.is_some()),
+            self.held,
+            bias_a as i64,
+            bias_b as i64,
+            i64::from(estimator.estimated()),
+        ]
+    }
+}
