@@ -530,8 +530,8 @@ fn truncating_instead_of_rounding_in_the_rtl_fails_the_chain_testbench() {
         (
             "ghdl",
             "gyrofx_quantize.vhd",
-            "half_bit                                    when 3,",
-            "'0'                                         when 3,",
+            "when 3 => increment := half_bit;",
+            "when 3 => increment := '0';",
         ),
     ];
     for (sim, file, rounding, truncation) in mutations {
