@@ -256,6 +256,10 @@ pub struct Block {
     pub sample_spacing: Option<u32>,
     /// What its DPI-C testbench takes from it (`None`: it has no golden model to call).
     pub dpi: Option<DpiParts>,
+    /// Its cocotb test module (`None`: it has no golden model to check against): the block's
+    /// own `cocotb_test.py`, written to the package as `cocotb/test_<name>.py` with its
+    /// pipeline constants set ([`crate::cocotb`]).
+    pub cocotb_test: Option<&'static str>,
 }
 
 /// What only the block knows of its DPI-C testbench (`crate::dpi` puts these into the frame
@@ -352,6 +356,7 @@ impl Block {
             clocked: true,
             sample_spacing: None,
             dpi: None,
+            cocotb_test: None,
         }
     }
 

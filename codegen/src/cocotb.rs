@@ -18,27 +18,13 @@ use crate::text::Provenance;
 /// The shared driver, protocol and scoreboard.
 const SHARED: &str = include_str!("cocotb/gyrofx_cocotb.py");
 
-/// Blocks with a cocotb test (those with a golden model, [`gyrofx_job::golden::BLOCKS`]), with the
-/// test module.
-pub const TESTS: [(&str, &str); 7] = [
-    ("sequencer", include_str!("cocotb/test_sequencer.py")),
-    ("estimator", include_str!("cocotb/test_estimator.py")),
-    ("kf", include_str!("cocotb/test_kf.py")),
-    ("top", include_str!("cocotb/test_top.py")),
-    ("mean_filter", include_str!("cocotb/test_mean_filter.py")),
-    ("gyro_loop", include_str!("cocotb/test_gyro_loop.py")),
-    ("system", include_str!("cocotb/test_system.py")),
-];
-
 /// Folder of the cocotb files in a package.
 pub const FOLDER: &str = "cocotb";
 
-/// The blocks of `blocks` that have a cocotb test, in the package's order.
+/// The blocks of `blocks` that have a cocotb test ([`Block::cocotb_test`]), in the package's
+/// order.
 pub fn tested(blocks: &[Block]) -> Vec<&Block> {
-    blocks
-        .iter()
-        .filter(|b| TESTS.iter().any(|(name, _)| *name == b.name))
-        .collect()
+    blocks.iter().filter(|b| b.cocotb_test.is_some()).collect()
 }
 
 /// Every file of the package's `cocotb/` folder: `(path, text)`.
@@ -50,11 +36,7 @@ pub fn files(blocks: &[Block], provenance: &Provenance) -> Vec<(String, String)>
     let python = |text: &str| format!("{}\n{text}", provenance.line("#"));
     let mut files = vec![(format!("{FOLDER}/gyrofx_cocotb.py"), python(SHARED))];
     for block in tested {
-        let test = TESTS
-            .iter()
-            .find(|(name, _)| *name == block.name)
-            .map(|(_, text)| *text)
-            .expect("tested blocks have a test");
+        let test = block.cocotb_test.expect("tested blocks have a test");
         files.push((
             format!("{FOLDER}/test_{}.py", block.name),
             python(&with_pipeline(test, block)),
@@ -178,13 +160,4 @@ pub fn build_outputs(blocks: &[Block]) -> Vec<String> {
         out.push(format!("{FOLDER}/__pycache__/"));
     }
     out
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn every_block_with_a_golden_model_has_a_cocotb_test() {
-        let names: Vec<&str> = super::TESTS.iter().map(|(name, _)| *name).collect();
-        assert_eq!(names, gyrofx_job::golden::BLOCKS);
-    }
 }

@@ -29,35 +29,18 @@ use gyrofx_job::job::Job;
 pub struct PlaceRequest {
     /// The targets (none: no place and route).
     pub targets: Vec<Target>,
-    /// The blocks, from [`BLOCKS`].
+    /// The blocks, from [`placed_blocks`].
     pub blocks: Vec<&'static str>,
     /// Tools run at a time.
     pub jobs: usize,
 }
 
-/// The blocks placed, in the package's order: the chain's blocks, the chain, the chain in the
-/// serial architecture ([`SERIAL_TOP`]), the mean filter beside it in both architectures
-/// ([`SERIAL_MEAN_FILTER`]) and one gyro's loop (the
-/// system, two loops and the chain, is left out: it is larger than the loop that already does
-/// not fit).
-pub const BLOCKS: &[&str] = &[
-    "sequencer",
-    "estimator",
-    "calibration",
-    "kf",
-    "top",
-    SERIAL_TOP,
-    "mean_filter",
-    SERIAL_MEAN_FILTER,
-    "gyro_loop",
-];
-
-/// `gyrofx_top_serial` compiled from the job's chain whatever its `architecture`, so that one
-/// run measures both architectures (with `architecture = "serial"`, `top` is the same design).
-pub const SERIAL_TOP: &str = "top_serial";
-
-/// `gyrofx_mean_filter_serial` with the job's mean filter whatever its `architecture`.
-pub const SERIAL_MEAN_FILTER: &str = "mean_filter_serial";
+/// The names of the blocks placed, in the package's order: each block that places itself
+/// ([`gyrofx_codegen::blocks::RtlBlock::placement`]; the system does not), its serial variant
+/// beside it (`top_serial`, `mean_filter_serial`).
+pub fn placed_blocks() -> Vec<&'static str> {
+    blocks::placed_names()
+}
 
 /// The harness module around a placed block.
 pub const HARNESS: &str = "gyrofx_place_route_harness";
@@ -193,30 +176,27 @@ pub fn check_tools(targets: &[Target]) -> Result<()> {
     }
 }
 
-/// Parses a comma-separated list of [`BLOCKS`] (`all`: every one), in [`BLOCKS`]'s order.
+/// Parses a comma-separated list of [`placed_blocks`] (`all`: every one), in their order.
 ///
 /// # Errors
 /// A message naming the value and the names allowed.
 pub fn parse_blocks(text: &str) -> std::result::Result<Vec<&'static str>, String> {
+    let placed = placed_blocks();
     let mut chosen = Vec::new();
     for name in text.split(',').map(str::trim) {
         if name == "all" {
-            chosen.extend(BLOCKS);
+            chosen.extend(&placed);
             continue;
         }
-        let block = BLOCKS.iter().find(|b| **b == name).ok_or_else(|| {
+        let block = placed.iter().find(|b| **b == name).ok_or_else(|| {
             format!(
                 "--blocks {name:?} is not a placed block: {} or all, comma-separated",
-                BLOCKS.join(", ")
+                placed.join(", ")
             )
         })?;
         chosen.push(*block);
     }
-    Ok(BLOCKS
-        .iter()
-        .copied()
-        .filter(|b| chosen.contains(b))
-        .collect())
+    Ok(placed.into_iter().filter(|b| chosen.contains(b)).collect())
 }
 
 /// One block on one target.
@@ -829,7 +809,7 @@ fn sample_rate(rate: f64) -> String {
     }
 }
 
-/// Places the blocks `request` names (from [`BLOCKS`]) of `job` on its targets in `work`, its
+/// Places the blocks `request` names (from [`placed_blocks`]) of `job` on its targets in `work`, its
 /// `jobs` at a time, and adds every block's design files, scripts, statistics, reports and logs
 /// to `package` under [`FOLDER`]. Results in target order, then block order.
 ///
@@ -847,23 +827,20 @@ pub fn place_and_route(
     let mut designs: Vec<Block> = Vec::new();
     let mut serial: Option<(Job, RomImages)> = None;
     for name in names {
-        let of = match *name {
-            SERIAL_TOP => Some("top"),
-            SERIAL_MEAN_FILTER => Some("mean_filter"),
-            _ => None,
-        };
-        if let Some(of) = of {
+        let (registered, is_serial) =
+            blocks::placed(name).unwrap_or_else(|| panic!("{name} is not a placed block"));
+        if is_serial {
             if serial.is_none() {
                 let job = job.serial_variant()?;
                 let roms = RomImages::new(&job, provenance);
                 serial = Some((job, roms));
             }
             let (serial_job, serial_roms) = serial.as_ref().expect("set above");
-            let mut block = blocks::find(of).block(serial_job, serial_roms);
-            block.name = *name;
+            let mut block = registered.block(serial_job, serial_roms);
+            block.name = name;
             designs.push(block);
         } else {
-            designs.push(blocks::find(name).block(job, roms));
+            designs.push(registered.block(job, roms));
         }
     }
     let mut design_files = Vec::new();

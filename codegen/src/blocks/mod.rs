@@ -78,6 +78,12 @@ pub trait RtlBlock: Sync {
     /// testbench of its own (its vectors are its parent's).
     fn vectors<'a>(&self, job: &'a Job, block: Block) -> Option<Box<dyn VectorBuilder + 'a>>;
 
+    /// Whether `synth --place-route` places and routes it, and under which name its serial
+    /// variant goes beside it.
+    fn placement(&self) -> Placement {
+        Placement::Alone
+    }
+
     /// Its section of the package manifest (key and value), if it has one.
     fn manifest(
         &self,
@@ -87,6 +93,43 @@ pub trait RtlBlock: Sync {
     ) -> Option<(&'static str, serde_json::Value)> {
         None
     }
+}
+
+/// How `synth --place-route` places and routes a block.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Placement {
+    /// Not placed.
+    No,
+    /// Placed as the job builds it.
+    Alone,
+    /// Placed as the job builds it, and beside it, under this name, as the job's serial
+    /// variant builds it (whatever the job's architecture, so that one run measures both).
+    WithSerial(&'static str),
+}
+
+/// The names `synth` places and routes under, in registry order: each placed block, its
+/// serial variant after it.
+pub fn placed_names() -> Vec<&'static str> {
+    REGISTRY
+        .iter()
+        .flat_map(|b| match b.placement() {
+            Placement::No => vec![],
+            Placement::Alone => vec![b.name()],
+            Placement::WithSerial(serial) => vec![b.name(), serial],
+        })
+        .collect()
+}
+
+/// The block placed under `name` ([`placed_names`]), and whether that name is its serial
+/// variant.
+pub fn placed(name: &str) -> Option<(&'static dyn RtlBlock, bool)> {
+    REGISTRY.iter().find_map(|b| match b.placement() {
+        Placement::Alone if b.name() == name => Some((*b, false)),
+        Placement::WithSerial(serial) if b.name() == name || serial == name => {
+            Some((*b, serial == name))
+        }
+        _ => None,
+    })
 }
 
 /// Every block, in the order of the package (the chain's signal flow, then the blocks beside

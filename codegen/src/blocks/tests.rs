@@ -175,3 +175,33 @@ fn the_mean_filter_vectors_cover_every_case_within_the_bound() {
     assert!(stats.max_lsb <= stats.bound_lsb);
     assert!(stats.samples >= 200);
 }
+
+/// The blocks with a golden model (those the Python and C bindings step) are exactly those
+/// with a cocotb test and a DPI-C testbench, in the package's order.
+#[test]
+fn every_block_with_a_golden_model_has_a_cocotb_test_and_dpi_parts() {
+    let mut config = gyrofx_job::config::Config::embedded();
+    config.samples = 100;
+    let job = Job::new(config).unwrap();
+    let provenance = crate::text::Provenance {
+        version: "test".into(),
+        command: "test".into(),
+        config_sha256: "0".repeat(64),
+    };
+    let roms = RomImages::new(&job, &provenance);
+    let blocks: Vec<_> = super::of(&job).map(|b| b.block(&job, &roms)).collect();
+    let with_test: Vec<&str> = blocks
+        .iter()
+        .filter(|b| b.cocotb_test.is_some())
+        .map(|b| b.name)
+        .collect();
+    assert_eq!(with_test, gyrofx_job::golden::BLOCKS);
+    for block in &blocks {
+        assert_eq!(
+            block.dpi.is_some(),
+            block.cocotb_test.is_some(),
+            "{}",
+            block.name
+        );
+    }
+}

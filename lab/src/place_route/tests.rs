@@ -79,7 +79,7 @@ fn target_and_block_lists_parse_and_name_what_is_wrong() {
         "{error}"
     );
     assert_eq!(parse_blocks("top, kf").unwrap(), vec!["kf", "top"]);
-    assert_eq!(parse_blocks("all").unwrap(), BLOCKS.to_vec());
+    assert_eq!(parse_blocks("all").unwrap(), placed_blocks());
     let error = parse_blocks("system").unwrap_err();
     assert!(
         error.contains("\"system\"") && error.contains("mean_filter"),

@@ -97,6 +97,7 @@ impl RtlBlock for Estimator {
             ],
         );
         block.dpi = Some(DPI);
+        block.cocotb_test = Some(include_str!("cocotb_test.py"));
         block.params = params(est);
         block.params.extend(mode_params(est.rounding, est.overflow));
         let rom = roms.entry(ROM);

@@ -289,6 +289,7 @@ impl RtlBlock for GyroLoop {
             ],
         );
         block.dpi = Some(DPI);
+        block.cocotb_test = Some(include_str!("cocotb_test.py"));
         block.settle_clocks = SETTLE_CLOCKS;
         block.params = parameters(plan, &roms.entry(SINE_ROM).0, &roms.entry(TAPS_ROM).0);
         block.roms.push(roms.entry(SINE_ROM));

@@ -108,6 +108,7 @@ impl RtlBlock for Kf {
             ],
         );
         block.dpi = Some(DPI);
+        block.cocotb_test = Some(include_str!("cocotb_test.py"));
         block.settle_clocks = SETTLE_CLOCKS;
         // The next sample's `e` needs only the new states, not the rounded output.
         block.sample_spacing = Some(SETTLE_CLOCKS);

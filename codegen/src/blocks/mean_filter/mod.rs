@@ -5,7 +5,7 @@
 use gyrofx_model::mean_filter::{serial, FixedMeanFilter, FloatMeanFilter, Plan};
 use serde_json::json;
 
-use super::{mode_params, RomImages, RtlBlock};
+use super::{mode_params, Placement, RomImages, RtlBlock};
 use crate::block::{Block, Output, Param, Signal};
 use crate::block::{DpiParts, DpiStream};
 use crate::rom::{Rom, RomFormat, ROM_FOLDER};
@@ -38,6 +38,12 @@ impl RtlBlock for MeanFilter {
         "gyrofx_mean_filter"
     }
 
+    /// `gyrofx_mean_filter_serial` is placed beside it, with the job's mean filter whatever
+    /// its `architecture`.
+    fn placement(&self) -> Placement {
+        Placement::WithSerial("mean_filter_serial")
+    }
+
     fn title(&self) -> &'static str {
         "mean filter with gross-error rejection (paper 003)"
     }
@@ -60,6 +66,7 @@ impl RtlBlock for MeanFilter {
             ],
         );
         block.dpi = Some(DPI);
+        block.cocotb_test = Some(include_str!("cocotb_test.py"));
         block
             .params
             .extend(Param::format("IN", plan.input, "input x"));

@@ -106,6 +106,7 @@ impl RtlBlock for Sequencer {
             ],
         );
         block.dpi = Some(DPI);
+        block.cocotb_test = Some(include_str!("cocotb_test.py"));
         block.params = params(schedule);
         block
     }

@@ -21,7 +21,7 @@ use gyrofx_model::resonator::Mode;
 use gyrofx_model::system::{record, GyroPhysics, RecordedSample};
 use serde_json::json;
 
-use super::{flag, gyro_loop, kf, top, RomImages, RtlBlock};
+use super::{flag, gyro_loop, kf, top, Placement, RomImages, RtlBlock};
 use crate::block::{Block, Output, Param, Signal};
 use crate::rom::Rom;
 use crate::vectors::{BlockResults, ChainSample, Run, VectorBuilder};
@@ -156,6 +156,11 @@ impl RtlBlock for System {
         job.system_chain.is_some()
     }
 
+    /// Two loops and the chain: larger than the one loop, which already does not fit.
+    fn placement(&self) -> Placement {
+        Placement::No
+    }
+
     fn roms(&self, job: &Job) -> Vec<Rom> {
         match &job.system_chain {
             Some(plan) => {
@@ -209,6 +214,7 @@ impl RtlBlock for System {
             ],
         );
         block.dpi = Some(DPI);
+        block.cocotb_test = Some(include_str!("cocotb_test.py"));
         block.settle_clocks = SETTLE_CLOCKS;
         let gains = roms.entry(GAINS_ROM);
         let coefficients = roms.entry(kf::ROM);

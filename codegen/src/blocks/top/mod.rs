@@ -7,7 +7,7 @@ use gyrofx_model::serial::Program;
 use serde_json::json;
 
 use super::{estimator, flag, kf, mode_bit, mode_params, sequencer};
-use super::{RomImages, RtlBlock};
+use super::{Placement, RomImages, RtlBlock};
 use crate::block::{Block, Output, Param, Signal};
 use crate::block::{DpiParts, DpiStream};
 use crate::rom::Rom;
@@ -137,6 +137,12 @@ impl RtlBlock for Top {
         "gyrofx_top"
     }
 
+    /// `gyrofx_top_serial` is placed beside it, compiled from the job's chain whatever its
+    /// `architecture` (with `architecture = "serial"`, `top` is the same design).
+    fn placement(&self) -> Placement {
+        Placement::WithSerial("top_serial")
+    }
+
     fn roms(&self, job: &Job) -> Vec<Rom> {
         match &job.serial {
             Some(program) => vec![
@@ -174,6 +180,7 @@ impl RtlBlock for Top {
             ],
         );
         block.dpi = Some(DPI);
+        block.cocotb_test = Some(include_str!("cocotb_test.py"));
         block.extra = vec!["float_rate_dps", "ideal_rate_dps", "true_rate_dps"];
         if let Some(program) = &job.serial {
             let code = roms.entry(SERIAL_PROGRAM_ROM);
