@@ -379,7 +379,8 @@ impl Compiler {
         self.push_full(op, self.cond, index, false, dest, coefficient);
     }
 
-    /// `Q(v)` into `to` at `dest` (RAM address, plus the run-time `index`).
+    /// `Q(v)` into `to` at `dest` (RAM address, plus the run-time `index`): the rounded
+    /// quotient, then, when it may not fit, the clamp or the wrap.
     fn quantize(
         &mut self,
         node: &'static str,
@@ -388,6 +389,32 @@ impl Compiler {
         dest: u16,
         index: RamIndex,
     ) -> Result<(), CompileError> {
+        let mark = self.ram_top;
+        if let Some(quotient) = self.rounded_quotient(node, v, to, dest, index)? {
+            let copy = [Term {
+                source: Source::Ram(quotient),
+                coefficient: self.constant(1),
+                cond: None,
+            }];
+            match self.overflow {
+                Overflow::Saturate => self.saturate(node, quotient, &copy, to, dest, index)?,
+                Overflow::Wrap => self.wrap(node, quotient, &copy, to, dest, index)?,
+            }
+        }
+        self.ram_top = mark;
+        Ok(())
+    }
+
+    /// Pass 1: the quotient of `v` rounded to `to`'s fraction bits, straight into `dest` when
+    /// it always fits `to` (then `None`), else into scratch RAM (returned).
+    fn rounded_quotient(
+        &mut self,
+        node: &'static str,
+        v: Value,
+        to: Format,
+        dest: u16,
+        index: RamIndex,
+    ) -> Result<Option<Value>, CompileError> {
         let drop = v.frac - to.frac;
         let m = if drop > 0 {
             (drop as u32).div_ceil(LIMB_BITS)
@@ -404,14 +431,11 @@ impl Compiler {
         }];
         let quotient_width =
             (v.width as i32 + t - (LIMB_BITS * m) as i32 + i32::from(rounds)).max(1) as u32;
-        let kd = limbs_of(to.width);
-        let mark = self.ram_top;
         // The sign picks the rounding (toward zero, half away) and the clamp.
         self.push(Op::Sign, v.address + v.limbs as u16 - 1, 0);
-        // Pass 1: the rounded quotient.
         let direct = quotient_width <= to.width;
         let (kq, q_address, q_index) = if direct {
-            (kd, dest, index)
+            (limbs_of(to.width), dest, index)
         } else {
             let kq = limbs_of(quotient_width);
             (kq, self.allocate(kq), RamIndex::None)
@@ -439,113 +463,125 @@ impl Compiler {
                 self.store(op, q_address + (c - m) as u16, q_index, 0);
             }
         }
-        if direct {
-            self.ram_top = mark;
-            return Ok(());
-        }
-        let quotient = Value {
+        Ok((!direct).then_some(Value {
             address: q_address,
             limbs: kq,
             width: quotient_width,
             frac: to.frac,
-        };
-        let copy = [Term {
+        }))
+    }
+
+    /// Passes 2 and 3 of a saturating `Q`: whether `quotient` fits `to`, then its low limbs
+    /// or the clamp into `dest` (`copy` is the quotient times one).
+    fn saturate(
+        &mut self,
+        node: &'static str,
+        quotient: Value,
+        copy: &[Term],
+        to: Format,
+        dest: u16,
+        index: RamIndex,
+    ) -> Result<(), CompileError> {
+        let kd = limbs_of(to.width);
+        let top_bits = to.width - LIMB_BITS * (kd - 1);
+        let u = (LIMB_BITS - (to.width - 1) % LIMB_BITS) % LIMB_BITS;
+        let m2 = (to.width - 1 + u) / LIMB_BITS;
+        let columns = (quotient.width + u).div_ceil(LIMB_BITS);
+        let aligned = [Term {
             source: Source::Ram(quotient),
-            coefficient: self.constant(1),
+            coefficient: self.power(node, u as i32)?,
             cond: None,
         }];
-        let top_bits = to.width - LIMB_BITS * (kd - 1);
-        match self.overflow {
-            Overflow::Saturate => {
-                // Pass 2: does the quotient fit `to.width` bits?
-                let u = (LIMB_BITS - (to.width - 1) % LIMB_BITS) % LIMB_BITS;
-                let m2 = (to.width - 1 + u) / LIMB_BITS;
-                let columns = (quotient_width + u).div_ceil(LIMB_BITS);
-                let aligned = [Term {
-                    source: Source::Ram(quotient),
-                    coefficient: self.power(node, u as i32)?,
-                    cond: None,
-                }];
-                assert!(
-                    self.max_column(&aligned) < columns,
-                    "{node}: pass 2 misses limbs"
-                );
-                self.push(Op::Zero, 0, 0);
-                for c in 0..columns {
-                    self.macs(&aligned, c);
-                    let op = if c < m2 {
-                        Op::Drop
-                    } else if c + 1 < columns {
-                        Op::High
-                    } else {
-                        Op::Fits
-                    };
-                    self.push(op, 0, 0);
-                }
-                // Pass 3: the low limbs, or the clamp.
-                let largest_top = self.constant_limb(((1i32 << (top_bits - 1)) - 1) as i16);
-                self.push(Op::Zero, 0, 0);
-                for c in 0..kd {
-                    self.macs(&copy, c);
-                    if c + 1 < kd {
-                        self.store(Op::StoreLow, dest + c as u16, index, 0);
-                    } else {
-                        self.store(Op::StoreTop, dest + c as u16, index, largest_top);
-                    }
-                }
-            }
-            Overflow::Wrap => {
-                self.push(Op::Zero, 0, 0);
-                for c in 0..kd - 1 {
-                    self.macs(&copy, c);
-                    self.store(Op::Emit, dest + c as u16, index, 0);
-                }
-                let top = dest + kd as u16 - 1;
-                if top_bits == LIMB_BITS {
-                    self.macs(&copy, kd - 1);
-                    self.store(Op::EmitTop, top, index, 0);
-                } else {
-                    // sext(limb mod 2^b) = ((limb · 2^(15−b)) as 15-bit signed) · 2^b / 2^15.
-                    let limb = Value {
-                        address: q_address + kd as u16 - 1,
-                        limbs: 1,
-                        width: LIMB_BITS + 1,
-                        frac: 0,
-                    };
-                    let up = self.power(node, (LIMB_BITS - top_bits) as i32)?;
-                    let back = self.power(node, top_bits as i32)?;
-                    let temp = self.allocate(1);
-                    self.push(Op::Zero, 0, 0);
-                    self.macs(
-                        &[Term {
-                            source: Source::Ram(limb),
-                            coefficient: up,
-                            cond: None,
-                        }],
-                        0,
-                    );
-                    self.push(Op::EmitTop, temp, 0);
-                    self.push(Op::Zero, 0, 0);
-                    let temp_value = Value {
-                        address: temp,
-                        limbs: 1,
-                        width: LIMB_BITS,
-                        frac: 0,
-                    };
-                    self.macs(
-                        &[Term {
-                            source: Source::Ram(temp_value),
-                            coefficient: back,
-                            cond: None,
-                        }],
-                        0,
-                    );
-                    self.push(Op::Drop, 0, 0);
-                    self.store(Op::EmitTop, top, index, 0);
-                }
+        assert!(
+            self.max_column(&aligned) < columns,
+            "{node}: pass 2 misses limbs"
+        );
+        self.push(Op::Zero, 0, 0);
+        for c in 0..columns {
+            self.macs(&aligned, c);
+            let op = if c < m2 {
+                Op::Drop
+            } else if c + 1 < columns {
+                Op::High
+            } else {
+                Op::Fits
+            };
+            self.push(op, 0, 0);
+        }
+        let largest_top = self.constant_limb(((1i32 << (top_bits - 1)) - 1) as i16);
+        self.push(Op::Zero, 0, 0);
+        for c in 0..kd {
+            self.macs(copy, c);
+            if c + 1 < kd {
+                self.store(Op::StoreLow, dest + c as u16, index, 0);
+            } else {
+                self.store(Op::StoreTop, dest + c as u16, index, largest_top);
             }
         }
-        self.ram_top = mark;
+        Ok(())
+    }
+
+    /// A wrapping `Q`: `quotient`'s low `to.width` bits into `dest`, the top limb
+    /// sign-extended from its kept bits (`copy` is the quotient times one).
+    fn wrap(
+        &mut self,
+        node: &'static str,
+        quotient: Value,
+        copy: &[Term],
+        to: Format,
+        dest: u16,
+        index: RamIndex,
+    ) -> Result<(), CompileError> {
+        let kd = limbs_of(to.width);
+        let top_bits = to.width - LIMB_BITS * (kd - 1);
+        self.push(Op::Zero, 0, 0);
+        for c in 0..kd - 1 {
+            self.macs(copy, c);
+            self.store(Op::Emit, dest + c as u16, index, 0);
+        }
+        let top = dest + kd as u16 - 1;
+        if top_bits == LIMB_BITS {
+            self.macs(copy, kd - 1);
+            self.store(Op::EmitTop, top, index, 0);
+            return Ok(());
+        }
+        // sext(limb mod 2^b) = ((limb · 2^(15−b)) as 15-bit signed) · 2^b / 2^15.
+        let limb = Value {
+            address: quotient.address + kd as u16 - 1,
+            limbs: 1,
+            width: LIMB_BITS + 1,
+            frac: 0,
+        };
+        let up = self.power(node, (LIMB_BITS - top_bits) as i32)?;
+        let back = self.power(node, top_bits as i32)?;
+        let temp = self.allocate(1);
+        self.push(Op::Zero, 0, 0);
+        self.macs(
+            &[Term {
+                source: Source::Ram(limb),
+                coefficient: up,
+                cond: None,
+            }],
+            0,
+        );
+        self.push(Op::EmitTop, temp, 0);
+        self.push(Op::Zero, 0, 0);
+        let temp_value = Value {
+            address: temp,
+            limbs: 1,
+            width: LIMB_BITS,
+            frac: 0,
+        };
+        self.macs(
+            &[Term {
+                source: Source::Ram(temp_value),
+                coefficient: back,
+                cond: None,
+            }],
+            0,
+        );
+        self.push(Op::Drop, 0, 0);
+        self.store(Op::EmitTop, top, index, 0);
         Ok(())
     }
 
@@ -584,28 +620,46 @@ fn check_signed(node: &'static str, format: Format) -> Result<(), CompileError> 
 /// Largest data RAM and coefficient ROM the instruction word addresses.
 pub const MAX_WORDS: usize = 1 << 12;
 
-/// The chain of `plan` as the engine's program.
+/// Where the chain's state lives in the data RAM: what every stage of the program reads.
+struct State {
+    /// The interval sums of gyro A and B.
+    accumulator: [Value; 2],
+    /// First address of each gyro's interval means.
+    means: [u16; 2],
+    /// log2 of the RAM stride between two intervals' means.
+    ram_index_shift: u32,
+    /// Limbs of one mean.
+    mean_limbs: u32,
+    /// The bias estimates of A and B.
+    bias: [Value; 2],
+    /// The KF's states x1 and x2.
+    x: [Value; 2],
+    /// RAM words of the state; scratch values go above them.
+    state_words: usize,
+}
+
+impl State {
+    /// Interval `k`'s mean of gyro `g`.
+    fn mean(&self, g: usize, k: u32, format: Format) -> Value {
+        Value {
+            address: self.means[g] + (k << self.ram_index_shift) as u16,
+            limbs: self.mean_limbs,
+            width: format.width,
+            frac: format.frac,
+        }
+    }
+}
+
+/// The chain of `plan` as the engine's program: the state cleared on the first sample since
+/// reset, calibration and the combined rate, the KF, the interval sums and means, the
+/// window's bias estimates, then the outputs. Each stage is a function below, in that order.
 ///
 /// # Errors
 /// [`CompileError`] for an unsigned format, a right alignment or a memory too large.
 pub fn compile(plan: &Plan) -> Result<Program, CompileError> {
     let est = &plan.estimator;
     let kf = &plan.kf;
-    for (node, f) in [
-        ("estimator.input_format", est.input),
-        ("estimator.accumulator", est.accumulator),
-        ("estimator.reciprocal", est.reciprocal),
-        ("estimator.mean_format", est.mean),
-        ("estimator.gain_format", est.gain),
-        ("estimator.bias_format", est.bias),
-        ("estimator.calibrated_format", est.calibrated),
-        ("kf.state_format", kf.state),
-        ("kf.output_format", kf.output),
-        ("kf.g1", kf.coefficient[0]),
-        ("kf.g2", kf.coefficient[1]),
-    ] {
-        check_signed(node, f)?;
-    }
+    check_formats(plan)?;
     let mut c = Compiler {
         input: est.input,
         overflow: est.overflow,
@@ -618,225 +672,14 @@ pub fn compile(plan: &Plan) -> Result<Program, CompileError> {
         bound: 0,
         bound_high: 0,
     };
-
-    // State: accumulators, means (a power-of-two stride per interval), biases, KF states.
-    let accumulator = [0, 1].map(|_| c.value(est.accumulator.width, est.input.frac));
-    let mean_limbs = limbs_of(est.mean.width);
-    let ram_index_shift = mean_limbs.next_power_of_two().trailing_zeros();
-    let intervals = est.schedule.intervals as u32;
-    let means = [0, 1].map(|_| c.allocate(intervals << ram_index_shift));
-    let mean_value = |g: usize, k: u32| Value {
-        address: means[g] + (k << ram_index_shift) as u16,
-        limbs: mean_limbs,
-        width: est.mean.width,
-        frac: est.mean.frac,
-    };
-    let bias = [0, 1].map(|_| c.value(est.bias.width, est.bias.frac));
-    let x = [0, 1].map(|_| c.value(kf.state.width, kf.state.frac));
-    let state_words = c.ram_top;
-    // The first sample since reset clears the state first: reset itself is instant.
-    c.cond = Cond::Fresh;
-    c.push(Op::Zero, 0, 0);
-    for a in 0..state_words {
-        c.push(Op::Emit, a as u16, 0);
-    }
-    c.cond = Cond::Always;
-
-    // The KF's gains: one region per ROM word, bw_sel's stride a power of two.
-    let gain_limbs = [0, 1].map(|i| limbs_of(kf.coefficient[i].width));
-    let region = (gain_limbs[0] + gain_limbs[1]).next_power_of_two();
-    let coefficient_index_shift = region.trailing_zeros();
-    // The gains first, at the ROM's start; the constants follow.
-    let mut kf_gain = [0, 1].map(|i| Coefficient {
-        limbs: (0..gain_limbs[i])
-            .map(|l| (l, (l + if i == 1 { gain_limbs[0] } else { 0 }) as u16, 0))
-            .collect(),
-        bound: 0,
-        by_bw_sel: true,
-    });
-    c.coefficients = vec![0; kf.rom.len() * region as usize];
-    for (w, word) in kf.rom.iter().enumerate() {
-        for i in 0..2 {
-            kf_gain[i].bound = kf_gain[i].bound.max(word[i].unsigned_abs());
-            for l in 0..gain_limbs[i] {
-                // Split at the format's limb count: a small word's sign fills its top limbs.
-                let limb = limb_at(word[i], l, gain_limbs[i]);
-                let address =
-                    w * region as usize + (l + if i == 1 { gain_limbs[0] } else { 0 }) as usize;
-                c.coefficients[address] = limb;
-                let slot = &mut kf_gain[i].limbs[l as usize];
-                slot.2 = slot.2.max(u128::from(limb.unsigned_abs()));
-            }
-        }
-    }
-
-    // Calibration with the estimates of earlier windows.
-    let calibration_frac = est.input.frac.max(est.bias.frac);
-    let mut out = Vec::new();
-    for (g, bias_g) in bias.iter().enumerate() {
-        let (positive, negative) = if g == 0 {
-            (Cond::ModeA, Cond::NotModeA)
-        } else {
-            (Cond::ModeB, Cond::NotModeB)
-        };
-        let y_scale = c.power("calibration", calibration_frac - est.input.frac)?;
-        let b_shift = calibration_frac - est.bias.frac;
-        let b_minus = c.constant(-(1i128 << b_shift));
-        let b_plus = c.power("calibration", b_shift)?;
-        let corrected = c.materialize(
-            &[
-                term(Source::Input(g), y_scale),
-                when(positive, Source::Ram(*bias_g), b_minus),
-                when(negative, Source::Ram(*bias_g), b_plus),
-            ],
-            calibration_frac,
-        );
-        let o = c.value(est.calibrated.width, est.calibrated.frac);
-        c.quantize(
-            "calibration",
-            corrected,
-            est.calibrated,
-            o.address,
-            RamIndex::None,
-        )?;
-        c.ram_top = o.address as usize + o.limbs as usize;
-        out.push(o);
-    }
-    let z = c.value(est.calibrated.width, est.calibrated.frac);
-    c.cond = Cond::AnyValid;
-    let one = c.constant(1);
-    let two = c.constant(2);
-    let pair = c.materialize(
-        &[
-            when(Cond::BothValid, Source::Ram(out[0]), one.clone()),
-            when(Cond::BothValid, Source::Ram(out[1]), one.clone()),
-            when(Cond::OnlyA, Source::Ram(out[0]), two.clone()),
-            when(Cond::OnlyB, Source::Ram(out[1]), two),
-        ],
-        est.calibrated.frac + 1,
-    );
-    c.quantize("combined", pair, est.calibrated, z.address, RamIndex::None)?;
-
-    // KF: e = z − x1 − x2; x_i = Q(x_i · 2^s_i + g_i · e); rate = Q(x1).
-    let z_scale = c.power("kf.e", kf.state.frac - kf.input.frac)?;
-    let minus_one = c.constant(-1);
-    let e = c.materialize(
-        &[
-            term(Source::Ram(z), z_scale),
-            term(Source::Ram(x[0]), minus_one.clone()),
-            term(Source::Ram(x[1]), minus_one),
-        ],
-        kf.state.frac,
-    );
-    for i in 0..2 {
-        let mark = c.ram_top;
-        let frac = kf.product[i].frac;
-        let x_scale = c.power(if i == 0 { "kf.x1" } else { "kf.x2" }, frac - kf.state.frac)?;
-        let sum = c.materialize(
-            &[
-                term(Source::Ram(x[i]), x_scale),
-                term(Source::Ram(e), kf_gain[i].clone()),
-            ],
-            frac,
-        );
-        c.quantize("kf.state", sum, kf.state, x[i].address, RamIndex::None)?;
-        c.ram_top = mark;
-    }
-    let rate = c.value(kf.output.width, kf.output.frac);
-    c.quantize("kf.output", x[0], kf.output, rate.address, RamIndex::None)?;
-    for l in 0..rate.limbs {
-        c.push(Op::Out, rate.address + l as u16, OUTPUT_RATE);
-    }
-    c.ram_top = state_words;
-
-    // Interval sums and means.
-    let reciprocal = c.constant(est.reciprocal_code);
-    for g in 0..2 {
-        c.cond = if g == 0 { Cond::ValidA } else { Cond::ValidB };
-        let one = c.constant(1);
-        c.materialize_into(
-            &[
-                term(Source::Ram(accumulator[g]), one.clone()),
-                term(Source::Input(g), one),
-            ],
-            accumulator[g],
-        );
-        c.cond = if g == 0 { Cond::DoneA } else { Cond::DoneB };
-        let scaled = c.materialize(
-            &[term(Source::Ram(accumulator[g]), reciprocal.clone())],
-            est.input.frac + est.reciprocal.frac,
-        );
-        let index = if g == 0 {
-            RamIndex::IntervalA
-        } else {
-            RamIndex::IntervalB
-        };
-        c.quantize("estimator.mean", scaled, est.mean, means[g], index)?;
-        c.zero_into(accumulator[g]);
-        c.ram_top = state_words;
-    }
-
-    // Window: b_new = Q(G m), smoothed after the first window.
-    c.cond = Cond::Window;
-    for (g, &bias_g) in bias.iter().enumerate() {
-        let mut terms = Vec::new();
-        for (j, &gain) in est.rom[g].iter().enumerate() {
-            if gain != 0 {
-                let coefficient = c.constant(gain);
-                terms.push(term(
-                    Source::Ram(mean_value(j % 2, (j / 2) as u32)),
-                    coefficient,
-                ));
-            }
-        }
-        let dot = c.materialize(&terms, est.dot.frac);
-        if est.smoothing_shift == 0 {
-            c.quantize(
-                "estimator.bias",
-                dot,
-                est.bias,
-                bias_g.address,
-                RamIndex::None,
-            )?;
-        } else {
-            let s = est.smoothing_shift;
-            let new = c.value(est.bias.width, est.bias.frac);
-            c.quantize("estimator.bias", dot, est.bias, new.address, RamIndex::None)?;
-            let keep = c.constant((1i128 << s) - 1);
-            let one = c.constant(1);
-            let smoothed = c.materialize(
-                &[
-                    term(Source::Ram(bias_g), keep),
-                    term(Source::Ram(new), one.clone()),
-                ],
-                est.bias.frac + s as i32,
-            );
-            let t = c.value(est.bias.width, est.bias.frac);
-            c.quantize(
-                "estimator.smoothing",
-                smoothed,
-                est.bias,
-                t.address,
-                RamIndex::None,
-            )?;
-            // The first window takes the new estimate, later ones the smoothed one.
-            c.materialize_into(&[term(Source::Ram(new), one.clone())], bias_g);
-            c.cond = Cond::WindowEstimated;
-            c.materialize_into(&[term(Source::Ram(t), one)], bias_g);
-            c.cond = Cond::Window;
-        }
-        c.ram_top = state_words;
-    }
-    c.push(Op::SetEstimated, 0, 0);
-    c.cond = Cond::Always;
-    for (g, output) in [OUTPUT_BIAS_A, OUTPUT_BIAS_B].into_iter().enumerate() {
-        for l in 0..bias[g].limbs {
-            c.push(Op::Out, bias[g].address + l as u16, output);
-        }
-    }
-    c.push(Op::End, 0, 0);
+    let state = c.allocate_state(plan);
+    let (kf_gain, coefficient_index_shift) = c.kf_gains(kf);
+    let z = c.calibrate_and_combine(est, &state)?;
+    c.kf_step(kf, &state, z, &kf_gain)?;
+    c.interval_means(est, &state)?;
+    c.window(est, &state)?;
+    c.outputs(&state);
     let sample = std::mem::take(&mut c.code);
-
     for (memory, words) in [
         ("data RAM", c.ram_high),
         ("coefficient ROM", c.coefficients.len()),
@@ -862,8 +705,8 @@ pub fn compile(plan: &Plan) -> Result<Program, CompileError> {
         sample,
         coefficients: c.coefficients,
         ram_words: c.ram_high,
-        state_words,
-        ram_index_shift,
+        state_words: state.state_words,
+        ram_index_shift: state.ram_index_shift,
         coefficient_index_shift,
         accumulator_bits: signed_bits(c.bound_high).max(17),
         input_limbs,
@@ -874,6 +717,305 @@ pub fn compile(plan: &Plan) -> Result<Program, CompileError> {
         overflow: est.overflow,
         layout,
     })
+}
+
+/// Every format the engine computes in is signed.
+fn check_formats(plan: &Plan) -> Result<(), CompileError> {
+    let est = &plan.estimator;
+    let kf = &plan.kf;
+    for (node, f) in [
+        ("estimator.input_format", est.input),
+        ("estimator.accumulator", est.accumulator),
+        ("estimator.reciprocal", est.reciprocal),
+        ("estimator.mean_format", est.mean),
+        ("estimator.gain_format", est.gain),
+        ("estimator.bias_format", est.bias),
+        ("estimator.calibrated_format", est.calibrated),
+        ("kf.state_format", kf.state),
+        ("kf.output_format", kf.output),
+        ("kf.g1", kf.coefficient[0]),
+        ("kf.g2", kf.coefficient[1]),
+    ] {
+        check_signed(node, f)?;
+    }
+    Ok(())
+}
+
+impl Compiler {
+    /// The state in the RAM (accumulators, means at a power-of-two stride per interval,
+    /// biases, KF states), and the code that clears it on the first sample since reset (reset
+    /// itself is instant).
+    fn allocate_state(&mut self, plan: &Plan) -> State {
+        let est = &plan.estimator;
+        let kf = &plan.kf;
+        let accumulator = [0, 1].map(|_| self.value(est.accumulator.width, est.input.frac));
+        let mean_limbs = limbs_of(est.mean.width);
+        let ram_index_shift = mean_limbs.next_power_of_two().trailing_zeros();
+        let intervals = est.schedule.intervals as u32;
+        let means = [0, 1].map(|_| self.allocate(intervals << ram_index_shift));
+        let bias = [0, 1].map(|_| self.value(est.bias.width, est.bias.frac));
+        let x = [0, 1].map(|_| self.value(kf.state.width, kf.state.frac));
+        let state_words = self.ram_top;
+        self.cond = Cond::Fresh;
+        self.push(Op::Zero, 0, 0);
+        for a in 0..state_words {
+            self.push(Op::Emit, a as u16, 0);
+        }
+        self.cond = Cond::Always;
+        State {
+            accumulator,
+            means,
+            ram_index_shift,
+            mean_limbs,
+            bias,
+            x,
+            state_words,
+        }
+    }
+
+    /// The KF's gains at the ROM's start, one region per ROM word (`bw_sel`'s stride a power
+    /// of two; the constants follow), and log2 of that stride.
+    fn kf_gains(&mut self, kf: &crate::kf::Plan) -> ([Coefficient; 2], u32) {
+        let gain_limbs = [0, 1].map(|i| limbs_of(kf.coefficient[i].width));
+        let region = (gain_limbs[0] + gain_limbs[1]).next_power_of_two();
+        let mut kf_gain = [0, 1].map(|i| Coefficient {
+            limbs: (0..gain_limbs[i])
+                .map(|l| (l, (l + if i == 1 { gain_limbs[0] } else { 0 }) as u16, 0))
+                .collect(),
+            bound: 0,
+            by_bw_sel: true,
+        });
+        self.coefficients = vec![0; kf.rom.len() * region as usize];
+        for (w, word) in kf.rom.iter().enumerate() {
+            for i in 0..2 {
+                kf_gain[i].bound = kf_gain[i].bound.max(word[i].unsigned_abs());
+                for l in 0..gain_limbs[i] {
+                    // Split at the format's limb count: a small word's sign fills its top limbs.
+                    let limb = limb_at(word[i], l, gain_limbs[i]);
+                    let address =
+                        w * region as usize + (l + if i == 1 { gain_limbs[0] } else { 0 }) as usize;
+                    self.coefficients[address] = limb;
+                    let slot = &mut kf_gain[i].limbs[l as usize];
+                    slot.2 = slot.2.max(u128::from(limb.unsigned_abs()));
+                }
+            }
+        }
+        (kf_gain, region.trailing_zeros())
+    }
+
+    /// Calibration of each gyro with the estimates of earlier windows, then the combined rate
+    /// (the mean of the valid ones): the KF's input `z`.
+    fn calibrate_and_combine(
+        &mut self,
+        est: &crate::estimator::Plan,
+        state: &State,
+    ) -> Result<Value, CompileError> {
+        let calibration_frac = est.input.frac.max(est.bias.frac);
+        let mut out = Vec::new();
+        for (g, bias_g) in state.bias.iter().enumerate() {
+            let (positive, negative) = if g == 0 {
+                (Cond::ModeA, Cond::NotModeA)
+            } else {
+                (Cond::ModeB, Cond::NotModeB)
+            };
+            let y_scale = self.power("calibration", calibration_frac - est.input.frac)?;
+            let b_shift = calibration_frac - est.bias.frac;
+            let b_minus = self.constant(-(1i128 << b_shift));
+            let b_plus = self.power("calibration", b_shift)?;
+            let corrected = self.materialize(
+                &[
+                    term(Source::Input(g), y_scale),
+                    when(positive, Source::Ram(*bias_g), b_minus),
+                    when(negative, Source::Ram(*bias_g), b_plus),
+                ],
+                calibration_frac,
+            );
+            let o = self.value(est.calibrated.width, est.calibrated.frac);
+            self.quantize(
+                "calibration",
+                corrected,
+                est.calibrated,
+                o.address,
+                RamIndex::None,
+            )?;
+            self.ram_top = o.address as usize + o.limbs as usize;
+            out.push(o);
+        }
+        let z = self.value(est.calibrated.width, est.calibrated.frac);
+        self.cond = Cond::AnyValid;
+        let one = self.constant(1);
+        let two = self.constant(2);
+        let pair = self.materialize(
+            &[
+                when(Cond::BothValid, Source::Ram(out[0]), one.clone()),
+                when(Cond::BothValid, Source::Ram(out[1]), one.clone()),
+                when(Cond::OnlyA, Source::Ram(out[0]), two.clone()),
+                when(Cond::OnlyB, Source::Ram(out[1]), two),
+            ],
+            est.calibrated.frac + 1,
+        );
+        self.quantize("combined", pair, est.calibrated, z.address, RamIndex::None)?;
+        Ok(z)
+    }
+
+    /// The KF on `z`: e = z − x1 − x2; x_i = Q(x_i · 2^s_i + g_i · e); rate = Q(x1), sent
+    /// out.
+    fn kf_step(
+        &mut self,
+        kf: &crate::kf::Plan,
+        state: &State,
+        z: Value,
+        kf_gain: &[Coefficient; 2],
+    ) -> Result<(), CompileError> {
+        let x = state.x;
+        let z_scale = self.power("kf.e", kf.state.frac - kf.input.frac)?;
+        let minus_one = self.constant(-1);
+        let e = self.materialize(
+            &[
+                term(Source::Ram(z), z_scale),
+                term(Source::Ram(x[0]), minus_one.clone()),
+                term(Source::Ram(x[1]), minus_one),
+            ],
+            kf.state.frac,
+        );
+        for i in 0..2 {
+            let mark = self.ram_top;
+            let frac = kf.product[i].frac;
+            let x_scale =
+                self.power(if i == 0 { "kf.x1" } else { "kf.x2" }, frac - kf.state.frac)?;
+            let sum = self.materialize(
+                &[
+                    term(Source::Ram(x[i]), x_scale),
+                    term(Source::Ram(e), kf_gain[i].clone()),
+                ],
+                frac,
+            );
+            self.quantize("kf.state", sum, kf.state, x[i].address, RamIndex::None)?;
+            self.ram_top = mark;
+        }
+        let rate = self.value(kf.output.width, kf.output.frac);
+        self.quantize("kf.output", x[0], kf.output, rate.address, RamIndex::None)?;
+        for l in 0..rate.limbs {
+            self.push(Op::Out, rate.address + l as u16, OUTPUT_RATE);
+        }
+        self.ram_top = state.state_words;
+        Ok(())
+    }
+
+    /// Each valid sample into its gyro's interval sum; at an interval's end its mean, stored
+    /// at the interval's index, and the sum cleared.
+    fn interval_means(
+        &mut self,
+        est: &crate::estimator::Plan,
+        state: &State,
+    ) -> Result<(), CompileError> {
+        let reciprocal = self.constant(est.reciprocal_code);
+        for g in 0..2 {
+            let accumulator = state.accumulator[g];
+            self.cond = if g == 0 { Cond::ValidA } else { Cond::ValidB };
+            let one = self.constant(1);
+            self.materialize_into(
+                &[
+                    term(Source::Ram(accumulator), one.clone()),
+                    term(Source::Input(g), one),
+                ],
+                accumulator,
+            );
+            self.cond = if g == 0 { Cond::DoneA } else { Cond::DoneB };
+            let scaled = self.materialize(
+                &[term(Source::Ram(accumulator), reciprocal.clone())],
+                est.input.frac + est.reciprocal.frac,
+            );
+            let index = if g == 0 {
+                RamIndex::IntervalA
+            } else {
+                RamIndex::IntervalB
+            };
+            self.quantize("estimator.mean", scaled, est.mean, state.means[g], index)?;
+            self.zero_into(accumulator);
+            self.ram_top = state.state_words;
+        }
+        Ok(())
+    }
+
+    /// At a window's end: each bias b_new = Q(G m), smoothed after the first window, then the
+    /// estimated flag.
+    fn window(&mut self, est: &crate::estimator::Plan, state: &State) -> Result<(), CompileError> {
+        self.cond = Cond::Window;
+        for (g, &bias_g) in state.bias.iter().enumerate() {
+            let mut terms = Vec::new();
+            for (j, &gain) in est.rom[g].iter().enumerate() {
+                if gain != 0 {
+                    let coefficient = self.constant(gain);
+                    terms.push(term(
+                        Source::Ram(state.mean(j % 2, (j / 2) as u32, est.mean)),
+                        coefficient,
+                    ));
+                }
+            }
+            let dot = self.materialize(&terms, est.dot.frac);
+            if est.smoothing_shift == 0 {
+                self.quantize(
+                    "estimator.bias",
+                    dot,
+                    est.bias,
+                    bias_g.address,
+                    RamIndex::None,
+                )?;
+            } else {
+                self.smoothed_bias(est, dot, bias_g)?;
+            }
+            self.ram_top = state.state_words;
+        }
+        self.push(Op::SetEstimated, 0, 0);
+        Ok(())
+    }
+
+    /// The smoothed bias: the first window takes the new estimate Q(dot), later ones
+    /// Q((2^s − 1)·b + new) at s more fraction bits.
+    fn smoothed_bias(
+        &mut self,
+        est: &crate::estimator::Plan,
+        dot: Value,
+        bias_g: Value,
+    ) -> Result<(), CompileError> {
+        let s = est.smoothing_shift;
+        let new = self.value(est.bias.width, est.bias.frac);
+        self.quantize("estimator.bias", dot, est.bias, new.address, RamIndex::None)?;
+        let keep = self.constant((1i128 << s) - 1);
+        let one = self.constant(1);
+        let smoothed = self.materialize(
+            &[
+                term(Source::Ram(bias_g), keep),
+                term(Source::Ram(new), one.clone()),
+            ],
+            est.bias.frac + s as i32,
+        );
+        let t = self.value(est.bias.width, est.bias.frac);
+        self.quantize(
+            "estimator.smoothing",
+            smoothed,
+            est.bias,
+            t.address,
+            RamIndex::None,
+        )?;
+        self.materialize_into(&[term(Source::Ram(new), one.clone())], bias_g);
+        self.cond = Cond::WindowEstimated;
+        self.materialize_into(&[term(Source::Ram(t), one)], bias_g);
+        self.cond = Cond::Window;
+        Ok(())
+    }
+
+    /// The bias registers out at every sample, then the end of the program.
+    fn outputs(&mut self, state: &State) {
+        self.cond = Cond::Always;
+        for (g, output) in [OUTPUT_BIAS_A, OUTPUT_BIAS_B].into_iter().enumerate() {
+            for l in 0..state.bias[g].limbs {
+                self.push(Op::Out, state.bias[g].address + l as u16, output);
+            }
+        }
+        self.push(Op::End, 0, 0);
+    }
 }
 
 /// Limb `l` of `value` split into exactly `limbs` limbs.
