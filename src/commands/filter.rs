@@ -151,35 +151,111 @@ pub fn run(args: Args) -> Result<ExitCode> {
     } = args;
     check_rates(fs, bandwidth)?;
     let output = output.as_path();
-    let inputs = [
-        ("--input", Some(csv.input.as_path())),
-        ("--config", config.as_deref()),
-    ];
+    check_outputs(&csv, config.as_deref(), output, vectors.as_deref())?;
+    let mut staged = stage(output)?;
+    let (config, bandwidth_hz, plan) = configured(config.as_deref(), fs, bandwidth)?;
+    // The vectors' folder is checked, and their files opened, before the work.
+    let mut kf_vectors = match &vectors {
+        Some(folder) => {
+            let job = gyrofx_codegen::blocks::checked_job(config)?;
+            let provenance = filter_provenance(&job, &csv, fs, bandwidth);
+            let package =
+                FilterPackage::create(folder, &job, &provenance, super::options::replace(force))?;
+            Some((job, provenance, package))
+        }
+        None => None,
+    };
+    let values = csv.read()?;
+    let package = kf_vectors.as_mut().map(|(_, _, package)| package);
+    let counts = filter(&values, &plan, staged.as_file_mut(), package)
+        .map_err(|e| anyhow::anyhow!("output {}: {e}", output.display()))??;
+    if let Some(message) = counts.warning(&plan) {
+        if strict {
+            // The staged file is removed when it drops: nothing is written.
+            anyhow::bail!("--strict: {message}; no output written (choose wider formats in --config, or drop --strict to keep the saturated result)");
+        }
+        eprintln!("warning: {message} (--strict makes this an error)");
+    }
+    // The vectors first: when they fail, the staged CSV is removed as it drops, and neither
+    // output is left.
+    if let (Some((job, provenance, package)), Some(folder)) = (kf_vectors, &vectors) {
+        let recording = serde_json::json!({
+            "input": csv.input.display().to_string(),
+            "column": csv.column,
+            "sha256": gyrofx_job::hash::file_sha256(&csv.input)?,
+            "samples": values.len(),
+            "fs_hz": fs,
+            "bandwidth_hz": bandwidth_hz,
+            "quantization": format!("nearest, saturate into {}", plan.input),
+        });
+        let files = package.finish(&job, &provenance, recording)?;
+        println!(
+            "wrote the KF's vectors of the record ({} files) -> {}; run them with make -C {} iverilog-kf",
+            files.len(),
+            folder.display(),
+            folder.display()
+        );
+    }
+    staged
+        .persist(output)
+        .with_context(|| format!("output {}: cannot move into place", output.display()))?;
+    let summary = Summary {
+        samples: values.len(),
+        fs,
+        bandwidth_hz,
+        output,
+        counts,
+    };
+    println!("{summary}");
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Refuses, before any work, an `--output` or `--vectors` that would overwrite an input or
+/// each other.
+fn check_outputs(
+    csv: &CsvColumn,
+    config: Option<&Path>,
+    output: &Path,
+    vectors: Option<&Path>,
+) -> Result<()> {
+    let inputs = [("--input", Some(csv.input.as_path())), ("--config", config)];
     check_output("--output", output, false, &inputs)?;
-    if let Some(folder) = &vectors {
+    if let Some(folder) = vectors {
         let mut inputs = inputs.to_vec();
         inputs.push(("--output", Some(output)));
         check_output("--vectors", folder, true, &inputs)?;
     }
-    // The output's folder is checked before the work: the file is staged there first.
+    Ok(())
+}
+
+/// The staged output file, beside `output` (which is checked before the work this way: the
+/// file is moved into place at the end).
+fn stage(output: &Path) -> Result<tempfile::NamedTempFile> {
     let folder = match output.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
-    let mut staged =
-        output_folder::staged_file(folder, ".gyrofx-filter-", ".csv").map_err(|e| {
-            // The OS's reason, without the temporary file's name that tempfile adds.
-            let reason = e.to_string();
-            let reason = reason.split(" at path ").next().unwrap_or_default();
-            anyhow::anyhow!(
-                "--output {}: cannot create a file in {}: {reason}",
-                output.display(),
-                folder.display()
-            )
-        })?;
-    // filter takes no --preset: its config is the embedded default, or the file over it.
-    let mut config = match config {
-        Some(path) => Config::from_file(&path)?,
+    output_folder::staged_file(folder, ".gyrofx-filter-", ".csv").map_err(|e| {
+        // The OS's reason, without the temporary file's name that tempfile adds.
+        let reason = e.to_string();
+        let reason = reason.split(" at path ").next().unwrap_or_default();
+        anyhow::anyhow!(
+            "--output {}: cannot create a file in {}: {reason}",
+            output.display(),
+            folder.display()
+        )
+    })
+}
+
+/// The config (the embedded default, or the file over it: filter takes no --preset) with
+/// `--fs` and `--bandwidth` set, the bandwidth the KF runs at (Hz) and its plan.
+fn configured(
+    path: Option<&Path>,
+    fs: f64,
+    bandwidth: Option<f64>,
+) -> Result<(Config, f64, gyrofx_model::kf::Plan)> {
+    let mut config = match path {
+        Some(path) => Config::from_file(path)?,
         None => Config::embedded(),
     };
     config.stimulus.fs_hz = fs;
@@ -208,28 +284,45 @@ pub fn run(args: Args) -> Result<ExitCode> {
         ))
     })?;
     let plan = plan_for(&settings, &designs)?;
-    // The vectors' folder is checked, and their files opened, before the work.
-    let mut kf_vectors = match &vectors {
-        Some(folder) => {
-            let job = gyrofx_codegen::blocks::checked_job(config.clone())?;
-            let provenance = filter_provenance(&job, &csv, fs, bandwidth);
-            let package =
-                FilterPackage::create(folder, &job, &provenance, super::options::replace(force))?;
-            Some((job, provenance, package))
-        }
-        None => None,
-    };
-    let values = csv.read()?;
-    let mut fixed = FixedKf::new(&plan);
+    Ok((config, settings.bandwidths_hz[0], plan))
+}
+
+/// What the KF met on the record: input saturations and its quantizers' overflows.
+struct Counts {
+    saturated: u64,
+    overflows: gyrofx_model::kf::OverflowCounts,
+}
+
+impl Counts {
+    /// The warning (or, with --strict, the error) when anything saturated or overflowed.
+    fn warning(&self, plan: &gyrofx_model::kf::Plan) -> Option<String> {
+        let o = &self.overflows;
+        (self.saturated + o.x1 + o.x2 + o.rate_hat > 0).then(|| {
+            format!(
+                "the input saturated the KF's input format {} {} times, the KF's quantizers overflowed x1 {} x2 {} rate_hat {}",
+                plan.input, self.saturated, o.x1, o.x2, o.rate_hat
+            )
+        })
+    }
+}
+
+/// `values` (°/s) through the fixed-point KF and its float model into `file` as CSV rows, and
+/// into `package` when the KF's vectors are written too. The KF runs in batches; each batch's
+/// rows are formatted (itoa/ryu, shortest round-trip reals: formatting is most of filter's
+/// time) on every core, and a writer thread writes the formatted parts in order while the
+/// next batch runs. The outer error is the file's, the inner one the input's.
+fn filter(
+    values: &[f64],
+    plan: &gyrofx_model::kf::Plan,
+    file: &mut std::fs::File,
+    mut package: Option<&mut FilterPackage>,
+) -> std::io::Result<Result<Counts>> {
+    let mut fixed = FixedKf::new(plan);
     let mut float = FloatKf::new(plan.gains.clone());
-    let write_error = |e: std::io::Error| anyhow::anyhow!("output {}: {e}", output.display());
-    // The KF runs in batches; each batch's rows are formatted (itoa/ryu, shortest round-trip
-    // reals: formatting is most of filter's time) on every core, and a writer thread writes
-    // the formatted parts in order while the next batch runs.
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get().min(8));
     let mut saturated = 0u64;
-    let file = staged.as_file_mut();
-    std::thread::scope(|scope| -> Result<()> {
+    let mut input_error = None;
+    std::thread::scope(|scope| -> std::io::Result<()> {
         let (send, receive) = std::sync::mpsc::sync_channel::<Vec<u8>>(2 * cores);
         // The parts are large: written as they are, not copied through a buffer.
         let writer = scope.spawn(move || -> std::io::Result<()> {
@@ -240,14 +333,20 @@ pub fn run(args: Args) -> Result<ExitCode> {
             file.flush()
         });
         let mut rows = Vec::with_capacity(FILTER_BATCH.min(values.len()));
-        for (batch, chunk) in values.chunks(FILTER_BATCH).enumerate() {
+        'batches: for (batch, chunk) in values.chunks(FILTER_BATCH).enumerate() {
             rows.clear();
             for value in chunk {
-                let q = from_f64(*value, plan.input, Rounding::Nearest, Overflow::Saturate)?;
+                let q = match from_f64(*value, plan.input, Rounding::Nearest, Overflow::Saturate) {
+                    Ok(q) => q,
+                    Err(e) => {
+                        input_error = Some(e);
+                        break 'batches;
+                    }
+                };
                 saturated += u64::from(q.overflowed);
                 let z = q.code as i64;
                 let rate = fixed.step(z, 0);
-                if let Some((_, _, package)) = kf_vectors.as_mut() {
+                if let Some(package) = package.as_mut() {
                     package.push(z, rate);
                 }
                 rows.push(Row {
@@ -256,80 +355,71 @@ pub fn run(args: Args) -> Result<ExitCode> {
                     reference: float.step(*value, 0),
                 });
             }
-            let first = batch * FILTER_BATCH;
-            let part_rows = rows.len().div_ceil(cores).max(1);
-            let parts: Vec<Vec<u8>> = std::thread::scope(|formatters| {
-                let handles: Vec<_> = rows
-                    .chunks(part_rows)
-                    .enumerate()
-                    .map(|(p, part)| {
-                        let plan = &plan;
-                        formatters.spawn(move || format_rows(part, first + p * part_rows, plan))
-                    })
-                    .collect();
-                handles
-                    .into_iter()
-                    .map(|h| h.join().expect("formatting does not panic"))
-                    .collect()
-            });
-            for part in parts {
+            for part in format_in_parts(&rows, batch * FILTER_BATCH, cores, plan) {
                 if send.send(part).is_err() {
-                    break; // the writer failed: its error is reported below
+                    break 'batches; // the writer failed: its error is reported below
                 }
             }
         }
         drop(send);
-        writer
-            .join()
-            .expect("the writer does not panic")
-            .map_err(write_error)
+        writer.join().expect("the writer does not panic")
     })?;
-    let o = fixed.overflow_counts();
-    let overflows = o.x1 + o.x2 + o.rate_hat;
-    if saturated + overflows > 0 {
-        let counts = format!(
-            "the input saturated the KF's input format {} {saturated} times, the KF's quantizers overflowed x1 {} x2 {} rate_hat {}",
-            plan.input, o.x1, o.x2, o.rate_hat
-        );
-        if strict {
-            // The staged file is removed when it drops: nothing is written.
-            anyhow::bail!("--strict: {counts}; no output written (choose wider formats in --config, or drop --strict to keep the saturated result)");
-        }
-        eprintln!("warning: {counts} (--strict makes this an error)");
+    Ok(match input_error {
+        Some(e) => Err(e.into()),
+        None => Ok(Counts {
+            saturated,
+            overflows: fixed.overflow_counts(),
+        }),
+    })
+}
+
+/// The CSV text of `rows` (the first being sample `first`) in `cores` parts formatted at once,
+/// in order.
+fn format_in_parts(
+    rows: &[Row],
+    first: usize,
+    cores: usize,
+    plan: &gyrofx_model::kf::Plan,
+) -> Vec<Vec<u8>> {
+    let part_rows = rows.len().div_ceil(cores).max(1);
+    std::thread::scope(|formatters| {
+        let handles: Vec<_> = rows
+            .chunks(part_rows)
+            .enumerate()
+            .map(|(p, part)| {
+                formatters.spawn(move || format_rows(part, first + p * part_rows, plan))
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("formatting does not panic"))
+            .collect()
+    })
+}
+
+/// The line `filter` prints at the end.
+struct Summary<'a> {
+    samples: usize,
+    fs: f64,
+    bandwidth_hz: f64,
+    output: &'a Path,
+    counts: Counts,
+}
+
+impl std::fmt::Display for Summary<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        let o = &self.counts.overflows;
+        write!(
+            f,
+            "filtered {} samples at {} Hz, bandwidth {} Hz -> {}; ADC saturations {}, overflows x1 {} x2 {} rate_hat {}",
+            self.samples,
+            self.fs,
+            self.bandwidth_hz,
+            self.output.display(),
+            self.counts.saturated,
+            o.x1,
+            o.x2,
+            o.rate_hat
+        )
     }
-    // The vectors first: when they fail, the staged CSV is removed as it drops, and neither
-    // output is left.
-    if let (Some((job, provenance, package)), Some(folder)) = (kf_vectors, &vectors) {
-        let recording = serde_json::json!({
-            "input": csv.input.display().to_string(),
-            "column": csv.column,
-            "sha256": gyrofx_job::hash::file_sha256(&csv.input)?,
-            "samples": values.len(),
-            "fs_hz": fs,
-            "bandwidth_hz": settings.bandwidths_hz[0],
-            "quantization": format!("nearest, saturate into {}", plan.input),
-        });
-        let files = package.finish(&job, &provenance, recording)?;
-        println!(
-            "wrote the KF's vectors of the record ({} files) -> {}; run them with make -C {} iverilog-kf",
-            files.len(),
-            folder.display(),
-            folder.display()
-        );
-    }
-    staged
-        .persist(output)
-        .with_context(|| format!("output {}: cannot move into place", output.display()))?;
-    println!(
-        "filtered {} samples at {} Hz, bandwidth {} Hz -> {}; ADC saturations {}, overflows x1 {} x2 {} rate_hat {}",
-        values.len(),
-        fs,
-        settings.bandwidths_hz[0],
-        output.display(),
-        saturated,
-        o.x1,
-        o.x2,
-        o.rate_hat
-    );
-    Ok(ExitCode::SUCCESS)
 }
