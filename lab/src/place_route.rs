@@ -19,6 +19,7 @@ use serde::Serialize;
 use gyrofx_codegen::block::Block;
 use gyrofx_codegen::blocks::{self, RomImages};
 use gyrofx_codegen::design;
+use gyrofx_codegen::output_folder;
 use gyrofx_codegen::package::Package;
 use gyrofx_codegen::text::fill;
 use gyrofx_job::error::{Error, Result};
@@ -661,7 +662,9 @@ fn refuse_over_capacity(
 fn place(dir: &Path, block: &Block, target: Target) -> Result<Placement> {
     let device = target.device();
     let folder = dir.join(target.name());
-    std::fs::create_dir_all(&folder).map_err(|e| Error::io(&folder, e))?;
+    // Below `dir` only: after a signal has removed the work folder, this fails instead of
+    // bringing it back to be left behind.
+    output_folder::create_below(dir, &folder).map_err(|e| Error::io(&folder, e))?;
     for (name, text) in [
         ("synth.ys", yosys_script(block, target)),
         ("run.sh", run_script(target)),
@@ -846,7 +849,7 @@ pub fn place_and_route(
     let mut design_files = Vec::new();
     for block in &designs {
         let dir = work.join(FOLDER).join(block.name);
-        std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+        output_folder::create_below(work, &dir).map_err(|e| Error::io(&dir, e))?;
         let mut files = design::design_files(block);
         files.push((HARNESS_FILE.into(), harness(block)));
         for (name, text) in &files {

@@ -414,10 +414,12 @@ fn inputs(top: &Block) -> Vec<(String, String)> {
     inputs
 }
 
-/// Writes `inputs` into `dir` and runs both flows there.
-fn run_in(dir: &Path, inputs: &[(String, String)]) -> Result<Resources> {
+/// Writes `inputs` into `dir` (`work`, or a folder below it) and runs both flows there.
+fn run_in(work: &Path, dir: &Path, inputs: &[(String, String)]) -> Result<Resources> {
     let netlists = dir.join(NETLIST_FOLDER);
-    std::fs::create_dir_all(&netlists).map_err(|e| Error::io(&netlists, e))?;
+    // Below the work folder only, never the work folder itself: after a signal has removed
+    // it, this fails instead of bringing it back to be left behind.
+    output_folder::create_below(work, &netlists).map_err(|e| Error::io(&netlists, e))?;
     for (name, text) in inputs {
         let path = dir.join(name);
         std::fs::write(&path, text).map_err(|e| Error::io(&path, e))?;
@@ -483,8 +485,8 @@ pub fn synthesize(
     let loop_work = work.path().join(LOOP_FOLDER);
     // The two designs are independent: synthesize them side by side.
     let (chain, looped) = std::thread::scope(|scope| {
-        let looped = scope.spawn(|| run_in(&loop_work, &loop_inputs));
-        let chain = run_in(work.path(), &chain_inputs);
+        let looped = scope.spawn(|| run_in(work.path(), &loop_work, &loop_inputs));
+        let chain = run_in(work.path(), work.path(), &chain_inputs);
         (chain, looped.join().expect("synthesis does not panic"))
     });
     let mut synthesis = Synthesis {
@@ -622,5 +624,19 @@ fn yosys_version() -> String {
 pub fn cost(inputs: &[(String, String)]) -> Result<Resources> {
     let work = output_folder::WorkFolder::new()
         .map_err(|e| Error::io(Path::new("temporary folder"), e))?;
-    run_in(work.path(), inputs)
+    run_in(work.path(), work.path(), inputs)
+}
+
+#[cfg(test)]
+mod tests {
+    /// A flow that starts after a signal has removed the work folder fails, and does not bring
+    /// the folder back to be left behind.
+    #[test]
+    fn a_removed_work_folder_is_not_recreated() {
+        let dir = tempfile::tempdir().unwrap();
+        let work = dir.path().join("work");
+        let error = super::run_in(&work, &work.join(super::LOOP_FOLDER), &[]).unwrap_err();
+        assert!(error.to_string().contains("netlist"), "{error}");
+        assert!(!work.exists(), "the work folder came back");
+    }
 }
