@@ -301,17 +301,6 @@ impl Run {
 /// When two builders report statistics or facts under the same key (a programming error).
 pub fn run<'a>(
     job: &Job,
-    builders: Vec<Box<dyn VectorBuilder + 'a>>,
-    progress: &Progress,
-) -> Result<Run> {
-    run_with(job, builders, progress)
-}
-
-/// Chain samples the gyros are simulated ahead of the chain, a batch at a time.
-const GYRO_BATCH: usize = 2048;
-
-fn run_with<'a>(
-    job: &Job,
     mut builders: Vec<Box<dyn VectorBuilder + 'a>>,
     progress: &Progress,
 ) -> Result<Run> {
@@ -417,31 +406,12 @@ fn run_with<'a>(
             }
         }
     }
-    let mut stats = BTreeMap::new();
-    let mut facts = BTreeMap::new();
-    let mut directed = BTreeMap::new();
-    let mut blocks = Vec::with_capacity(builders.len());
-    for builder in builders {
-        let mut results = BlockResults::default();
-        let mut block = builder.finish(&mut results);
-        block.finish_rows()?;
-        let twice = |what: &str, key: &str| panic!("two blocks report the {what} `{key}`");
-        for (name, value) in results.stats {
-            if stats.insert(name, value).is_some() {
-                twice("statistics", name);
-            }
-        }
-        for (key, value) in results.overflows {
-            if directed.insert(key, value).is_some() {
-                twice("overflow counts", key);
-            }
-        }
-        for (key, value) in results.facts {
-            facts.insert((block.name, key), value);
-        }
-        blocks.push(block);
-    }
-
+    let Gathered {
+        blocks,
+        stats,
+        facts,
+        directed,
+    } = gather(builders)?;
     Ok(Run {
         blocks,
         stats,
@@ -457,6 +427,51 @@ fn run_with<'a>(
         samples: n,
     })
 }
+
+/// What the builders returned and reported, gathered by key ([`gather`]).
+struct Gathered {
+    blocks: Vec<Block>,
+    stats: BTreeMap<&'static str, ErrorStats>,
+    facts: BTreeMap<(&'static str, &'static str), serde_json::Value>,
+    directed: BTreeMap<&'static str, serde_json::Value>,
+}
+
+/// Finishes every builder (its directed segments, its files) and gathers what each reported.
+///
+/// # Panics
+/// When two builders report statistics or overflow counts under the same key.
+fn gather<'a>(builders: Vec<Box<dyn VectorBuilder + 'a>>) -> Result<Gathered> {
+    let mut gathered = Gathered {
+        blocks: Vec::with_capacity(builders.len()),
+        stats: BTreeMap::new(),
+        facts: BTreeMap::new(),
+        directed: BTreeMap::new(),
+    };
+    for builder in builders {
+        let mut results = BlockResults::default();
+        let mut block = builder.finish(&mut results);
+        block.finish_rows()?;
+        let twice = |what: &str, key: &str| panic!("two blocks report the {what} `{key}`");
+        for (name, value) in results.stats {
+            if gathered.stats.insert(name, value).is_some() {
+                twice("statistics", name);
+            }
+        }
+        for (key, value) in results.overflows {
+            if gathered.directed.insert(key, value).is_some() {
+                twice("overflow counts", key);
+            }
+        }
+        for (key, value) in results.facts {
+            gathered.facts.insert((block.name, key), value);
+        }
+        gathered.blocks.push(block);
+    }
+    Ok(gathered)
+}
+
+/// Chain samples the gyros are simulated ahead of the chain, a batch at a time.
+const GYRO_BATCH: usize = 2048;
 
 /// One batch of chain samples: the true rates and the sequencer's modes in, the gyros'
 /// ADC codes (chain input format) and the unreversed gyros' outputs (°/s) out.
