@@ -298,7 +298,8 @@ impl Run {
 /// Stimulus errors (a bad CSV file); a builder's write errors.
 ///
 /// # Panics
-/// When two builders report statistics or facts under the same key (a programming error).
+/// When two builders report statistics or overflow counts under the same key (a programming
+/// error; facts are kept per block).
 pub fn run<'a>(
     job: &Job,
     mut builders: Vec<Box<dyn VectorBuilder + 'a>>,

@@ -176,11 +176,18 @@ pub fn run(args: Args) -> Result<ExitCode> {
     }
     let o = &run.overflows;
     let loops = loop_overflows(&job, o);
-    let directed = &o.directed["kf_directed"];
+    // The KF's directed segment, as the KF's builder reported it (every package has a KF).
+    let directed = match o.directed.get("kf_directed") {
+        Some(d) => format!(
+            " (directed segment: x1 {} x2 {} rate_hat {})",
+            d["x1"], d["x2"], d["rate_hat"]
+        ),
+        None => String::new(),
+    };
     println!(
-        "overflows: ADC {:?}, means {:?}, biases {:?}, calibrated {:?}, combined {}, KF x1 {} x2 {} rate_hat {} (directed segment: x1 {} x2 {} rate_hat {}){loops}",
+        "overflows: ADC {:?}, means {:?}, biases {:?}, calibrated {:?}, combined {}, KF x1 {} x2 {} rate_hat {}{directed}{loops}",
         o.adc, o.estimator.mean, o.estimator.bias, o.estimator.calibrated, o.estimator.combined,
-        o.kf_chain.x1, o.kf_chain.x2, o.kf_chain.rate_hat, directed["x1"], directed["x2"], directed["rate_hat"]
+        o.kf_chain.x1, o.kf_chain.x2, o.kf_chain.rate_hat
     );
     println!(
         "report ({} s):",
