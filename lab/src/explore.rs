@@ -339,53 +339,18 @@ pub fn explore(
     costs: &Costs,
     progress: &Progress,
 ) -> Result<Exploration> {
-    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-    use std::sync::Mutex;
-    let n = plan.candidates.len();
-    progress.plan(n as u64);
+    progress.plan(plan.candidates.len() as u64);
     progress.set_phase("simulating the gyros");
     let shared = match plan.reference {
         Reference::Chain => Some(measure::stimulus(&plan.job, false)?),
         Reference::System => None,
     };
     progress.set_phase("simulating and synthesizing candidates");
-    let next = AtomicUsize::new(0);
-    let stop = AtomicBool::new(false);
-    let rows: Mutex<Vec<Option<Row>>> = Mutex::new(vec![None; n]);
-    let failure: Mutex<Option<(usize, Error)>> = Mutex::new(None);
-    std::thread::scope(|scope| {
-        for _ in 0..jobs.clamp(1, n.max(1)) {
-            scope.spawn(|| loop {
-                if stop.load(Ordering::Relaxed) {
-                    break;
-                }
-                let i = next.fetch_add(1, Ordering::Relaxed);
-                let Some(candidate) = plan.candidates.get(i) else {
-                    break;
-                };
-                match run_candidate(plan, candidate, shared.as_ref(), costs) {
-                    Ok(row) => rows.lock().unwrap_or_else(|e| e.into_inner())[i] = Some(row),
-                    Err(e) => {
-                        stop.store(true, Ordering::Relaxed);
-                        let mut failure = failure.lock().unwrap_or_else(|e| e.into_inner());
-                        if failure.as_ref().is_none_or(|(j, _)| i < *j) {
-                            *failure = Some((i, e));
-                        }
-                    }
-                }
-                progress.advance(1);
-            });
-        }
-    });
-    if let Some((_, e)) = failure.into_inner().unwrap_or_else(|e| e.into_inner()) {
-        return Err(e);
-    }
-    let rows: Vec<Row> = rows
-        .into_inner()
-        .unwrap_or_else(|e| e.into_inner())
-        .into_iter()
-        .map(|r| r.expect("every candidate ran"))
-        .collect();
+    let rows = crate::pool::try_map(&plan.candidates, jobs, |candidate| {
+        let row = run_candidate(plan, candidate, shared.as_ref(), costs);
+        progress.advance(1);
+        row
+    })?;
     let best = rows
         .iter()
         .filter_map(|r| {

@@ -2,8 +2,10 @@
 //! verification package, a design's files) and runs it: the simulators on a package
 //! ([`simulate`], with [`junit`] summaries), yosys on the chain and the loop ([`synth`]),
 //! yosys and nextpnr per block ([`place_route`]), word-length sweeps costed in yosys
-//! ([`explore`]), the papers' figures ([`reproduce`]) and the plots ([`plot`]). Every child
-//! process starts through [`processes`], which ends them all when a signal ends gyrofx.
+//! ([`explore`]), the papers' figures ([`reproduce`]) and the plots ([`plot`]). Every external
+//! program is found, versioned and run through [`toolchain`] (its children tracked by
+//! [`processes`], which ends them all when a signal ends gyrofx), and work runs side by side in
+//! one [`pool`].
 //!
 //! It stands on codegen, the job and the model, and nothing below it knows it exists: the CLI
 //! is its only user.
@@ -13,7 +15,9 @@ pub mod explore;
 pub mod junit;
 pub mod place_route;
 pub mod plot;
+pub mod pool;
 pub mod processes;
 pub mod reproduce;
 pub mod simulate;
 pub mod synth;
+pub mod toolchain;

@@ -12,7 +12,6 @@
 //! a few percent of the device).
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use serde::Serialize;
 
@@ -23,6 +22,8 @@ use gyrofx_codegen::output_folder;
 use gyrofx_codegen::package::Package;
 use gyrofx_codegen::text::fill;
 use gyrofx_job::error::{Error, Result};
+
+use crate::toolchain::{self, Ran, Tool};
 use gyrofx_job::job::Job;
 
 /// Which blocks `synth` also places and routes, on which targets.
@@ -168,11 +169,12 @@ pub fn check_tools(targets: &[Target]) -> Result<()> {
     let Some(ice40) = targets.iter().find(|t| **t != Target::Xilinx) else {
         return Ok(());
     };
-    match crate::processes::output(Command::new("nextpnr-ice40").arg("--version")) {
-        Ok(output) if output.status.success() => Ok(()),
-        _ => Err(Error::Synthesis(format!(
-            "--target {} needs nextpnr-ice40, which does not run here (install the Debian package nextpnr-ice40)",
-            ice40.name()
+    match Tool::NextpnrIce40.version() {
+        Some(_) => Ok(()),
+        None => Err(Error::Synthesis(format!(
+            "--target {} needs nextpnr-ice40, which does not run here ({})",
+            ice40.name(),
+            Tool::NextpnrIce40.install_hint()
         ))),
     }
 }
@@ -489,19 +491,6 @@ fn sum(cells: &[(String, u64)], keep: impl Fn(&str) -> bool) -> u64 {
     cells.iter().filter(|(k, _)| keep(k)).map(|(_, n)| n).sum()
 }
 
-/// Runs `program` with `args` in `dir`; `Ok(None)` when it succeeded, else what it printed.
-fn run_tool(dir: &Path, program: &str, args: &[String]) -> Result<Option<String>> {
-    let output = crate::processes::output(Command::new(program).args(args).current_dir(dir))
-        .map_err(|e| Error::Synthesis(format!("cannot run {program} (is it installed?): {e}")))?;
-    Ok((!output.status.success()).then(|| {
-        format!(
-            "{}{}",
-            String::from_utf8_lossy(&output.stdout),
-            String::from_utf8_lossy(&output.stderr)
-        )
-    }))
-}
-
 /// How long nextpnr may take on one block before it counts as not routing: a design near the
 /// device's capacity can keep the router going round (seen: router1 on 83 % of an HX8K, 2.8
 /// million iterations without progress).
@@ -509,7 +498,8 @@ pub const NEXTPNR_LIMIT: std::time::Duration = std::time::Duration::from_secs(60
 
 /// What a run of nextpnr came to.
 enum Routed {
-    /// It finished (placed and routed, or refused the design).
+    /// It finished (placed and routed, or refused the design): what it printed on stderr when
+    /// it failed.
     Finished(Option<String>),
     /// Still running at [`NEXTPNR_LIMIT`]: stopped.
     OutOfTime,
@@ -517,38 +507,16 @@ enum Routed {
 
 /// Runs nextpnr in `dir` for at most [`NEXTPNR_LIMIT`].
 fn run_nextpnr(dir: &Path, args: &[String]) -> Result<Routed> {
-    let mut child = crate::processes::spawn(
-        Command::new("nextpnr-ice40")
-            .args(args)
-            .current_dir(dir)
-            .stdin(std::process::Stdio::null())
-            .stdout(std::process::Stdio::null())
-            .stderr(std::process::Stdio::piped()),
-    )
-    .map_err(|e| Error::Synthesis(format!("cannot run nextpnr-ice40 (is it installed?): {e}")))?;
-    let start = std::time::Instant::now();
-    loop {
-        match child.try_wait() {
-            Ok(Some(status)) => {
-                crate::processes::forget(&child);
-                let mut printed = String::new();
-                if let Some(mut stderr) = child.stderr.take() {
-                    let _ = std::io::Read::read_to_string(&mut stderr, &mut printed);
-                }
-                return Ok(Routed::Finished((!status.success()).then_some(printed)));
-            }
-            Ok(None) if start.elapsed() >= NEXTPNR_LIMIT => {
-                let _ = child.kill();
-                let _ = child.wait();
-                crate::processes::forget(&child);
-                return Ok(Routed::OutOfTime);
-            }
-            Ok(None) => std::thread::sleep(std::time::Duration::from_millis(200)),
-            Err(e) => {
-                crate::processes::forget(&child);
-                return Err(Error::Synthesis(format!("waiting for nextpnr-ice40: {e}")));
-            }
-        }
+    let mut command = Tool::NextpnrIce40.command();
+    command.args(args).current_dir(dir);
+    match toolchain::run_limited(&mut command, NEXTPNR_LIMIT) {
+        Ok(Ran::Finished(finished)) => Ok(Routed::Finished(
+            (!finished.success).then_some(finished.stderr),
+        )),
+        Ok(Ran::OutOfTime) => Ok(Routed::OutOfTime),
+        Err(e) => Err(Error::Synthesis(format!(
+            "cannot run nextpnr-ice40 (is it installed?): {e}"
+        ))),
     }
 }
 
@@ -673,20 +641,18 @@ fn place(dir: &Path, block: &Block, target: Target) -> Result<Placement> {
         std::fs::write(&path, text).map_err(|e| Error::io(&path, e))?;
     }
     let yosys_log = PathBuf::from(target.name()).join("yosys.log");
-    let yosys_args: Vec<String> = [
-        "-q".to_string(),
-        "-l".into(),
-        yosys_log.display().to_string(),
-        "-s".into(),
-        format!("{}/synth.ys", target.name()),
-    ]
-    .to_vec();
-    if let Some(printed) = run_tool(dir, "yosys", &yosys_args)? {
+    let script = format!("{}/synth.ys", target.name());
+    let log_arg = yosys_log.display().to_string();
+    let yosys = Tool::Yosys
+        .run_in(dir, &["-q", "-l", &log_arg, "-s", &script])
+        .map_err(|e| Error::Synthesis(format!("cannot run yosys (is it installed?): {e}")))?;
+    if !yosys.success {
         return Err(Error::Synthesis(format!(
-            "yosys failed on {} for {}:\n{}\n{printed}",
+            "yosys failed on {} for {}:\n{}\n{}",
             block.name,
             target.name(),
-            log_tail(&dir.join(&yosys_log))
+            log_tail(&dir.join(&yosys_log)),
+            yosys.printed()
         )));
     }
     let cells = module_cells(
@@ -812,113 +778,137 @@ fn sample_rate(rate: f64) -> String {
     }
 }
 
-/// Places the blocks `request` names (from [`placed_blocks`]) of `job` on its targets in `work`, its
-/// `jobs` at a time, and adds every block's design files, scripts, statistics, reports and logs
-/// to `package` under [`FOLDER`]. Results in target order, then block order.
-///
-/// # Errors
-/// A yosys or nextpnr failure other than not fitting ([`Error::Synthesis`]), or an I/O error.
-pub fn place_and_route(
-    job: &Job,
-    roms: &RomImages,
-    provenance: &gyrofx_codegen::text::Provenance,
-    request: &PlaceRequest,
-    work: &Path,
-    package: &mut Package,
-) -> Result<Vec<Placement>> {
-    let (names, targets, jobs) = (&request.blocks, &request.targets, request.jobs);
-    let mut designs: Vec<Block> = Vec::new();
-    let mut serial: Option<(Job, RomImages)> = None;
-    for name in names {
-        let (registered, is_serial) =
-            blocks::placed(name).unwrap_or_else(|| panic!("{name} is not a placed block"));
-        if is_serial {
-            if serial.is_none() {
-                let job = job.serial_variant()?;
-                let roms = RomImages::new(&job, provenance);
-                serial = Some((job, roms));
-            }
-            let (serial_job, serial_roms) = serial.as_ref().expect("set above");
-            let mut block = registered.block(serial_job, serial_roms);
-            block.name = name;
-            designs.push(block);
-        } else {
-            designs.push(registered.block(job, roms));
-        }
-    }
-    let mut design_files = Vec::new();
-    for block in &designs {
-        let dir = work.join(FOLDER).join(block.name);
-        output_folder::create_below(work, &dir).map_err(|e| Error::io(&dir, e))?;
-        let mut files = design::design_files(block);
-        files.push((HARNESS_FILE.into(), harness(block)));
-        for (name, text) in &files {
-            let path = dir.join(name);
-            std::fs::write(&path, text).map_err(|e| Error::io(&path, e))?;
-        }
-        design_files.push(files);
-    }
-    let tasks: Vec<(usize, Target)> = targets
-        .iter()
-        .flat_map(|&t| (0..designs.len()).map(move |b| (b, t)))
-        .collect();
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let results: std::sync::Mutex<Vec<Option<Result<Placement>>>> =
-        std::sync::Mutex::new((0..tasks.len()).map(|_| None).collect());
-    std::thread::scope(|scope| {
-        for _ in 0..jobs.clamp(1, tasks.len().max(1)) {
-            scope.spawn(|| loop {
-                let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                let Some(&(b, target)) = tasks.get(i) else {
-                    break;
-                };
-                let block = &designs[b];
-                let result = place(&work.join(FOLDER).join(block.name), block, target);
-                results.lock().expect("no panic holds the lock")[i] = Some(result);
-            });
-        }
-    });
-    let mut placements = Vec::new();
-    for result in results.into_inner().expect("no panic holds the lock") {
-        placements.push(result.expect("every task ran")?);
-    }
-    for (block, files) in designs.iter().zip(&design_files) {
-        let prefix = format!("{FOLDER}/{}", block.name);
-        for (name, text) in files {
-            package.add(format!("{prefix}/{name}"), text.as_str());
-        }
-        for target in targets {
-            let dir = work.join(FOLDER).join(block.name).join(target.name());
-            // yosys's log is left out (6 MB for the gyro loop): `run.sh` writes it again.
-            for name in [
-                "synth.ys",
-                "run.sh",
-                "stat.json",
-                "report.json",
-                "nextpnr.log",
-            ] {
-                let path = dir.join(name);
-                if !path.exists() {
-                    continue;
+/// The blocks a [`PlaceRequest`] names, their design files written into the work folder and
+/// ready to be placed ([`Prepared::place`], one task at a time, in any order or side by side),
+/// then added to the package ([`Prepared::add_to`]).
+pub struct Prepared {
+    designs: Vec<Block>,
+    design_files: Vec<Vec<(String, String)>>,
+    targets: Vec<Target>,
+    work: PathBuf,
+}
+
+/// One block on one target: an index into [`Prepared::tasks`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Task {
+    block: usize,
+    target: Target,
+}
+
+impl Prepared {
+    /// Writes the design files of the blocks `request` names (from [`placed_blocks`]) of `job`
+    /// below `work`.
+    ///
+    /// # Errors
+    /// A config the serial variant refuses, or an I/O error.
+    pub fn new(
+        job: &Job,
+        roms: &RomImages,
+        provenance: &gyrofx_codegen::text::Provenance,
+        request: &PlaceRequest,
+        work: &Path,
+    ) -> Result<Prepared> {
+        let mut designs: Vec<Block> = Vec::new();
+        let mut serial: Option<(Job, RomImages)> = None;
+        for name in &request.blocks {
+            let (registered, is_serial) =
+                blocks::placed(name).unwrap_or_else(|| panic!("{name} is not a placed block"));
+            if is_serial {
+                if serial.is_none() {
+                    let job = job.serial_variant()?;
+                    let roms = RomImages::new(&job, provenance);
+                    serial = Some((job, roms));
                 }
-                let data = std::fs::read(&path).map_err(|e| Error::io(&path, e))?;
-                // nextpnr warns once per port whose share of a failing clock is negative:
-                // thousands of lines the report's critical path sums up.
-                let data = if name == "nextpnr.log" {
-                    String::from_utf8_lossy(&data)
-                        .lines()
-                        .filter(|l| !l.contains("negative timing budget"))
-                        .map(|l| format!("{l}\n"))
-                        .collect::<String>()
-                        .into_bytes()
-                } else {
-                    data
-                };
-                package.add(format!("{prefix}/{}/{name}", target.name()), data);
+                let (serial_job, serial_roms) = serial.as_ref().expect("set above");
+                let mut block = registered.block(serial_job, serial_roms);
+                block.name = name;
+                designs.push(block);
+            } else {
+                designs.push(registered.block(job, roms));
             }
         }
+        let mut design_files = Vec::new();
+        for block in &designs {
+            let dir = work.join(FOLDER).join(block.name);
+            output_folder::create_below(work, &dir).map_err(|e| Error::io(&dir, e))?;
+            let mut files = design::design_files(block);
+            files.push((HARNESS_FILE.into(), harness(block)));
+            for (name, text) in &files {
+                let path = dir.join(name);
+                std::fs::write(&path, text).map_err(|e| Error::io(&path, e))?;
+            }
+            design_files.push(files);
+        }
+        Ok(Prepared {
+            designs,
+            design_files,
+            targets: request.targets.clone(),
+            work: work.to_path_buf(),
+        })
     }
-    Ok(placements)
+
+    /// Every block on every target, in target order, then block order.
+    pub fn tasks(&self) -> Vec<Task> {
+        self.targets
+            .iter()
+            .flat_map(|&target| (0..self.designs.len()).map(move |block| Task { block, target }))
+            .collect()
+    }
+
+    /// Synthesizes, places and routes one task's block for its target.
+    ///
+    /// # Errors
+    /// A yosys or nextpnr failure other than not fitting ([`Error::Synthesis`]), or an I/O
+    /// error.
+    pub fn place(&self, task: Task) -> Result<Placement> {
+        let block = &self.designs[task.block];
+        place(&self.work.join(FOLDER).join(block.name), block, task.target)
+    }
+
+    /// Adds every block's design files, scripts, statistics, reports and logs to `package`
+    /// under [`FOLDER`].
+    ///
+    /// # Errors
+    /// An I/O error reading them.
+    pub fn add_to(&self, package: &mut Package) -> Result<()> {
+        for (block, files) in self.designs.iter().zip(&self.design_files) {
+            let prefix = format!("{FOLDER}/{}", block.name);
+            for (name, text) in files {
+                package.add(format!("{prefix}/{name}"), text.as_str());
+            }
+            for target in &self.targets {
+                let dir = self.work.join(FOLDER).join(block.name).join(target.name());
+                // yosys's log is left out (6 MB for the gyro loop): `run.sh` writes it again.
+                for name in [
+                    "synth.ys",
+                    "run.sh",
+                    "stat.json",
+                    "report.json",
+                    "nextpnr.log",
+                ] {
+                    let path = dir.join(name);
+                    if !path.exists() {
+                        continue;
+                    }
+                    let data = std::fs::read(&path).map_err(|e| Error::io(&path, e))?;
+                    // nextpnr warns once per port whose share of a failing clock is negative:
+                    // thousands of lines the report's critical path sums up.
+                    let data = if name == "nextpnr.log" {
+                        String::from_utf8_lossy(&data)
+                            .lines()
+                            .filter(|l| !l.contains("negative timing budget"))
+                            .map(|l| format!("{l}\n"))
+                            .collect::<String>()
+                            .into_bytes()
+                    } else {
+                        data
+                    };
+                    package.add(format!("{prefix}/{}/{name}", target.name()), data);
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 /// The place-and-route table in Markdown: one row per block and target.

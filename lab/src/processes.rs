@@ -7,7 +7,7 @@
 //! reaches them all. Their own group also keeps a terminal's Ctrl-C from reaching them before
 //! gyrofx has decided what to do; [`end_all`] passes it on.
 
-use std::process::{Child, Command, Output};
+use std::process::{Child, Command};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
@@ -48,23 +48,16 @@ pub fn forget(child: &Child) {
     groups.retain(|g| *g != child.id());
 }
 
-/// Runs `command` to its end as [`Command::output`] does (stdin empty, stdout and stderr
-/// captured), tracked while it runs.
-///
-/// # Errors
-/// Those of [`spawn`] and of waiting for it.
-pub fn output(command: &mut Command) -> std::io::Result<Output> {
-    use std::process::Stdio;
-    command
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped());
-    let child = spawn(command)?;
-    let id = child.id();
-    let result = child.wait_with_output();
-    let mut groups = GROUPS.lock().unwrap_or_else(|e| e.into_inner());
-    groups.retain(|g| *g != id);
-    result
+/// Ends `child`'s process group at once (SIGKILL): for a child past its time limit, which
+/// gets no grace. It is still to be waited for and forgotten.
+pub fn end_group(child: &Child) {
+    #[cfg(unix)]
+    // SAFETY: kill has no memory effects; a negative pid names a process group.
+    unsafe {
+        libc::kill(-(child.id() as libc::pid_t), libc::SIGKILL);
+    }
+    #[cfg(not(unix))]
+    let _ = child;
 }
 
 /// Ends every tracked child's process group: SIGTERM, then SIGKILL to the groups that still

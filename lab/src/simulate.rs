@@ -3,10 +3,11 @@
 //! user runs without gyrofx).
 
 use std::path::Path;
-use std::process::Command;
 use std::time::Instant;
 
 use gyrofx_job::error::{Error, Result};
+
+use crate::toolchain::{self, Tool};
 
 /// A supported simulator.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -41,13 +42,18 @@ impl Simulator {
     }
 
     /// Programs it needs on PATH.
-    fn programs(self) -> &'static [&'static str] {
+    fn tools(self) -> &'static [Tool] {
         match self {
-            Simulator::Icarus => &["iverilog", "vvp", "make"],
-            Simulator::Verilator => &["verilator", "make"],
-            Simulator::Ghdl => &["ghdl", "make"],
-            Simulator::Cocotb => &["iverilog", "vvp", "make", "cocotb-config", "python3"],
-            Simulator::Dpi => &["verilator", "make"],
+            Simulator::Icarus => &[Tool::Iverilog, Tool::Vvp, Tool::Make],
+            Simulator::Verilator | Simulator::Dpi => &[Tool::Verilator, Tool::Make],
+            Simulator::Ghdl => &[Tool::Ghdl, Tool::Make],
+            Simulator::Cocotb => &[
+                Tool::Iverilog,
+                Tool::Vvp,
+                Tool::Make,
+                Tool::CocotbConfig,
+                Tool::Python3,
+            ],
         }
     }
 }
@@ -138,12 +144,6 @@ impl Outcome {
     }
 }
 
-fn on_path(program: &str) -> bool {
-    std::env::var_os("PATH")
-        .map(|paths| std::env::split_paths(&paths).any(|dir| dir.join(program).is_file()))
-        .unwrap_or(false)
-}
-
 /// The blocks the package's Makefile runs under `simulator` (its `sim-<simulator>:` line).
 fn blocks(out: &Path, simulator: Simulator) -> Result<Vec<String>> {
     let makefile = std::fs::read_to_string(out.join("Makefile")).map_err(|e| {
@@ -225,17 +225,13 @@ pub fn run_reporting(
     done: &mut dyn FnMut(&BlockOutcome),
 ) -> Result<Outcome> {
     let names = block_names(out, simulator, options)?;
-    for program in simulator.programs() {
-        if !on_path(program) {
-            let how = match (simulator, *program) {
-                (Simulator::Cocotb, "cocotb-config" | "python3") => {
-                    "pip install cocotb and <gyrofx>/python into a virtualenv and put its bin/ on PATH; scripts/test.sh does"
-                }
-                _ => "scripts/test.sh installs it with apt-get",
-            };
+    for tool in simulator.tools() {
+        if !tool.on_path() {
             return Err(Error::Simulation(format!(
-                "{program} is not on PATH: {} needs it ({how})",
-                simulator.name()
+                "{} is not on PATH: {} needs it ({})",
+                tool.program(),
+                simulator.name(),
+                tool.install_hint()
             )));
         }
     }
@@ -259,7 +255,7 @@ pub fn run_reporting(
     let mut blocks = Vec::with_capacity(names.len());
     for block in names {
         let start = Instant::now();
-        let mut make = Command::new("make");
+        let mut make = Tool::Make.command();
         make.env("TMPDIR", temp.path());
         if let Some(netlists) = &netlists {
             make.args(netlists.make_variables(&block, simulator));
@@ -272,17 +268,16 @@ pub fn run_reporting(
             .arg(format!("MAX_REPORTED={}", options.max_reported))
             .arg(format!("MAX_MISMATCHES={}", options.max_mismatches))
             .arg(format!("WAVES={}", u8::from(options.waves)));
-        let output = crate::processes::output(&mut make)
+        let finished = toolchain::run_to_end(&mut make)
             .map_err(|e| Error::Simulation(format!("cannot run make: {e}")))?;
         let seconds = start.elapsed().as_secs_f64();
-        let mut log = String::from_utf8_lossy(&output.stdout).into_owned();
-        log.push_str(&String::from_utf8_lossy(&output.stderr));
+        let log = finished.printed();
         let report: Vec<String> = log
             .lines()
             .filter(|l| l.starts_with("PASS") || l.starts_with("FAIL") || l.starts_with("MISMATCH"))
             .map(str::to_string)
             .collect();
-        let passed = output.status.success() && report.iter().any(|l| l.starts_with("PASS "));
+        let passed = finished.success && report.iter().any(|l| l.starts_with("PASS "));
         let outcome = BlockOutcome {
             block,
             passed,

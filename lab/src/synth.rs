@@ -7,8 +7,8 @@
 //! flip-flops and multipliers (counted before they are merged into `$macc` cells), and the
 //! `synth_xilinx` mapping's LUTs, flip-flops, DSP48E1s and block RAMs.
 
+use crate::toolchain::Tool;
 use std::path::Path;
-use std::process::Command;
 
 use serde::{Deserialize, Serialize};
 
@@ -262,23 +262,39 @@ fn count(by_type: &[(String, u64)], keep: impl Fn(&str) -> bool) -> u64 {
 }
 
 fn yosys(dir: &Path, script: &str, log: &str) -> Result<()> {
-    let output = crate::processes::output(
-        Command::new("yosys")
-            .args(["-q", "-l", log, "-s", script])
-            .current_dir(dir),
-    )
-    .map_err(|e| Error::Synthesis(format!("cannot run yosys (is it installed?): {e}")))?;
-    if !output.status.success() {
+    let finished = Tool::Yosys
+        .run_in(dir, &["-q", "-l", log, "-s", script])
+        .map_err(|e| Error::Synthesis(format!("cannot run yosys (is it installed?): {e}")))?;
+    if !finished.success {
         let text = std::fs::read_to_string(dir.join(log)).unwrap_or_default();
         let tail: Vec<&str> = text.lines().rev().take(20).collect();
         let tail: Vec<&str> = tail.into_iter().rev().collect();
         return Err(Error::Synthesis(format!(
             "synthesis check failed ({script}):\n{}\n{}",
             tail.join("\n"),
-            String::from_utf8_lossy(&output.stderr)
+            finished.stderr
         )));
     }
     Ok(())
+}
+
+/// One of the two yosys flows every design goes through.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Flow {
+    /// yosys's generic `synth`: cells, flip-flops, multipliers.
+    Generic,
+    /// `synth_xilinx`: LUTs, flip-flops, DSP48s, block RAMs, carries.
+    Xilinx,
+}
+
+impl Flow {
+    /// Runs the flow in `dir`, which must hold the RTL, the ROM images and the scripts.
+    fn run(self, dir: &Path) -> Result<()> {
+        match self {
+            Flow::Generic => yosys(dir, "generic.ys", "generic.log"),
+            Flow::Xilinx => yosys(dir, "xilinx.ys", "xilinx.log"),
+        }
+    }
 }
 
 /// Runs both flows in `dir`, which must hold the RTL, the ROM images and the scripts.
@@ -286,8 +302,13 @@ fn yosys(dir: &Path, script: &str, log: &str) -> Result<()> {
 /// # Errors
 /// [`Error::Synthesis`] when yosys is missing or a check fails (with the log's tail).
 pub fn measure(dir: &Path) -> Result<Resources> {
-    yosys(dir, "generic.ys", "generic.log")?;
-    yosys(dir, "xilinx.ys", "xilinx.log")?;
+    Flow::Generic.run(dir)?;
+    Flow::Xilinx.run(dir)?;
+    resources(dir)
+}
+
+/// What both flows measured in `dir`, from their statistics files.
+fn resources(dir: &Path) -> Result<Resources> {
     let (_, coarse) = cell_counts(dir, "coarse.json")?;
     let (cells, generic) = cell_counts(dir, "generic.json")?;
     let (_, xilinx) = cell_counts(dir, "xilinx.json")?;
@@ -414,8 +435,8 @@ fn inputs(top: &Block) -> Vec<(String, String)> {
     inputs
 }
 
-/// Writes `inputs` into `dir` (`work`, or a folder below it) and runs both flows there.
-fn run_in(work: &Path, dir: &Path, inputs: &[(String, String)]) -> Result<Resources> {
+/// Writes `inputs` into `dir` (`work`, or a folder below it).
+fn write_inputs(work: &Path, dir: &Path, inputs: &[(String, String)]) -> Result<()> {
     let netlists = dir.join(NETLIST_FOLDER);
     // Below the work folder only, never the work folder itself: after a signal has removed
     // it, this fails instead of bringing it back to be left behind.
@@ -424,6 +445,21 @@ fn run_in(work: &Path, dir: &Path, inputs: &[(String, String)]) -> Result<Resour
         let path = dir.join(name);
         std::fs::write(&path, text).map_err(|e| Error::io(&path, e))?;
     }
+    Ok(())
+}
+
+/// One piece of `synth`'s work; all of them run side by side in one pool.
+#[derive(Clone, Copy, Debug)]
+enum Task<'a> {
+    /// A yosys flow on the design whose inputs are in this folder.
+    Flow(&'a Path, Flow),
+    /// One block on one target.
+    Place(place_route::Task),
+}
+
+/// Runs `inputs` through both flows in `dir` (`work`, or a folder below it).
+fn run_in(work: &Path, dir: &Path, inputs: &[(String, String)]) -> Result<Resources> {
+    write_inputs(work, dir, inputs)?;
     measure(dir)
 }
 
@@ -483,23 +519,46 @@ pub fn synthesize(
     let work = output_folder::WorkFolder::new()
         .map_err(|e| Error::io(Path::new("temporary folder"), e))?;
     let loop_work = work.path().join(LOOP_FOLDER);
-    // The two designs are independent: synthesize them side by side.
-    let (chain, looped) = std::thread::scope(|scope| {
-        let looped = scope.spawn(|| run_in(work.path(), &loop_work, &loop_inputs));
-        let chain = run_in(work.path(), work.path(), &chain_inputs);
-        (chain, looped.join().expect("synthesis does not panic"))
-    });
-    let mut synthesis = Synthesis {
+    write_inputs(work.path(), &loop_work, &loop_inputs)?;
+    write_inputs(work.path(), work.path(), &chain_inputs)?;
+    let placing = if place.targets.is_empty() {
+        None
+    } else {
+        Some(place_route::Prepared::new(
+            job,
+            &roms,
+            provenance,
+            place,
+            work.path(),
+        )?)
+    };
+    // The longest first (the loop's flows, over a minute each at the defaults), so that none
+    // runs alone at the end.
+    let mut tasks = vec![
+        Task::Flow(&loop_work, Flow::Generic),
+        Task::Flow(&loop_work, Flow::Xilinx),
+        Task::Flow(work.path(), Flow::Generic),
+        Task::Flow(work.path(), Flow::Xilinx),
+    ];
+    tasks.extend(placing.iter().flat_map(|p| p.tasks()).map(Task::Place));
+    let placed = crate::pool::try_map(&tasks, place.jobs, |task| match *task {
+        Task::Flow(dir, flow) => flow.run(dir).map(|()| None),
+        Task::Place(task) => placing
+            .as_ref()
+            .expect("only placing has place tasks")
+            .place(task)
+            .map(Some),
+    })?;
+    let synthesis = Synthesis {
         chain_module: top.module,
-        chain: chain?,
-        gyro_loop: looped?,
-        placements: Vec::new(),
+        chain: resources(work.path())?,
+        gyro_loop: resources(&loop_work)?,
+        placements: placed.into_iter().flatten().collect(),
     };
 
     let mut package = Package::new(Kind::Synth, Vec::new());
-    if !place.targets.is_empty() {
-        synthesis.placements =
-            place_route::place_and_route(job, &roms, provenance, place, work.path(), &mut package)?;
+    if let Some(placing) = &placing {
+        placing.add_to(&mut package)?;
     }
     package.add(
         "report.md",
@@ -608,11 +667,7 @@ pub fn cache_key(inputs: &[(String, String)]) -> String {
 fn yosys_version() -> String {
     static VERSION: std::sync::OnceLock<String> = std::sync::OnceLock::new();
     VERSION
-        .get_or_init(|| {
-            crate::processes::output(Command::new("yosys").arg("-V"))
-                .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
-                .unwrap_or_default()
-        })
+        .get_or_init(|| Tool::Yosys.version().unwrap_or_default())
         .clone()
 }
 

@@ -140,7 +140,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
         gyrofx_codegen::output_folder::Kind::Explore,
         args.out.replace(),
     )?;
-    if gyrofx_lab::processes::output(std::process::Command::new("yosys").arg("-V")).is_err() {
+    if gyrofx_lab::toolchain::Tool::Yosys.version().is_none() {
         anyhow::bail!("gyrofx explore synthesizes every candidate with yosys, which is not installed (or not on PATH)");
     }
     let costs = Costs::open(&cache).with_context(|| format!("--cache {}", cache.display()))?;

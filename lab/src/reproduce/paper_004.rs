@@ -61,34 +61,19 @@ pub struct ResonatorBias {
 /// Both gyros of `config` at resonator level: each closed loop characterized (noise off).
 fn resonator_biases(config: &gyrofx_job::config::Config) -> Result<Vec<ResonatorBias>> {
     let loops = config.gyro_loops()?;
-    std::thread::scope(|scope| {
-        let handles: Vec<_> = loops
-            .iter()
-            .map(|gyro| {
-                scope.spawn(move || {
-                    characterize::<FixedHarness>(
-                        &gyro.plan,
-                        &gyro.params,
-                        &gyro.front_end,
-                        &Procedure::default(),
-                    )
-                    .map(|figures| ResonatorBias {
-                        gyro: gyro.name,
-                        figures,
-                        modes: [Mode::Normal, Mode::Reverse]
-                            .map(|m| ModeFigures::new(&gyro.params, m)),
-                    })
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| {
-                h.join()
-                    .expect("the loop simulation does not panic")
-                    .map_err(|e| Error::Simulation(format!("gu2019's resonator: {e}")))
-            })
-            .collect()
+    crate::pool::try_map(&loops, loops.len(), |gyro| {
+        characterize::<FixedHarness>(
+            &gyro.plan,
+            &gyro.params,
+            &gyro.front_end,
+            &Procedure::default(),
+        )
+        .map(|figures| ResonatorBias {
+            gyro: gyro.name,
+            figures,
+            modes: [Mode::Normal, Mode::Reverse].map(|m| ModeFigures::new(&gyro.params, m)),
+        })
+        .map_err(|e| Error::Simulation(format!("gu2019's resonator: {e}")))
     })
 }
 
