@@ -37,7 +37,15 @@ fn copy_tree(from: &Path, to: &Path) {
 /// widths keep `P2_I + 1` integer bits of x2's update, P2_I = P2_W − P2_F < 0, and x2 = (g2/S)·y
 /// must pass 2^P2_I. A 0.2 Hz entry (g2 in s18.31, P2_I = −1, g2/S = 6·10⁻³) at 300 °/s does;
 /// the default (P2_I = −8, g2/S ≈ 10⁻⁶) never does at any rate in range.
-const SLOW: &str = "[stimulus]\nrate_dps = 300.0\n[kf]\nbandwidths_hz = [0.2, 10.0, 20.0]\n";
+///
+/// The loop's NCO sine, gains and taps at 12 bits instead of 18, its demodulator's products
+/// and outputs at 32 and 24 bits instead of 36 and 32: a netlist of 57 000 cells instead of
+/// 80 000, whose synthesis and Verilator build take a quarter less (the check is the same:
+/// the netlist against the model's vectors for these formats).
+const SLOW: &str = "[stimulus]\nrate_dps = 300.0\n\
+    [loop]\nnco_sine_width = 12\ndemod_product_format = \"s32.30\"\ndemod_output_format = \"s24.22\"\n\
+    pll_gain_width = 12\nagc_gain_width = 12\ncic_tap_width = 12\nscale_coefficient_width = 16\n\
+    [kf]\nbandwidths_hz = [0.2, 10.0, 20.0]\n";
 
 /// One `synth` run serves every check of this module: the gyro loop's synthesis alone is
 /// over 100 s of yosys, and two tests each paid it. The loop netlist's 40 000 samples in
@@ -382,7 +390,8 @@ fn flip_flops(generic_json: &Path) -> u64 {
         .sum()
 }
 
-/// The loop's netlist (80 000 cells) in Verilator: 40 000 closed-loop samples, bit-exact.
+/// The loop's netlist (57 000 cells at [`SLOW`]'s formats) in Verilator: 40 000 closed-loop
+/// samples, bit-exact.
 fn the_loop_netlist_passes_the_vectors(dir: &Path, config: &str, synth: &Path) {
     let package = dir.join("loop-package");
     ok(&[
@@ -409,7 +418,7 @@ fn the_loop_netlist_passes_the_vectors(dir: &Path, config: &str, synth: &Path) {
     assert!(log.contains("PASS n=40000"), "{log}");
 }
 
-/// The synthesized chain runs the package's testbench bit-exact in Icarus and Verilator; the
+/// The synthesized chain runs the package's testbench bit-exact in Icarus; the
 /// `chparam` script on RTL whose parameters and width localparams are untyped (what `synth` did
 /// before) gives a netlist that fails it.
 fn netlists_pass_the_vectors_and_chparam_on_untyped_localparams_fails_them(
@@ -431,6 +440,8 @@ fn netlists_pass_the_vectors_and_chparam_on_untyped_localparams_fails_them(
         config,
     ]);
     let (pkg, syn) = (package.to_str().unwrap(), synth.to_str().unwrap());
+    // In Icarus: the loop's netlist runs in Verilator (the_loop_netlist_passes_the_vectors),
+    // and each netlist build there is a minute of C++.
     let log = ok(&[
         "verify",
         "--out",
@@ -438,12 +449,12 @@ fn netlists_pass_the_vectors_and_chparam_on_untyped_localparams_fails_them(
         "--netlist",
         syn,
         "--sim",
-        "iverilog,verilator",
+        "iverilog",
         "--blocks",
         "top",
         "--quiet",
     ]);
-    assert_eq!(log.matches("PASS n=3001").count(), 2, "{log}");
+    assert_eq!(log.matches("PASS n=3001").count(), 1, "{log}");
     // GHDL has no netlist to run.
     let error = fails(&["verify", "--out", pkg, "--netlist", syn, "--sim", "ghdl"]);
     assert!(error.contains("--sim ghdl is not allowed"), "{error}");
@@ -506,10 +517,12 @@ fn netlists_pass_the_vectors_and_chparam_on_untyped_localparams_fails_them(
         "--netlist",
         old.to_str().unwrap(),
         "--sim",
-        "verilator",
+        "iverilog",
         "--blocks",
         "top",
+        "--max-mismatches",
+        "1",
         "--quiet",
     ]);
-    assert!(error.contains("FAIL mismatches="), "{error}");
+    assert!(error.contains("FAIL mismatches=1"), "{error}");
 }
