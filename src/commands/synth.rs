@@ -33,7 +33,8 @@ pub struct Args {
     /// architecture).
     #[arg(long, value_name = "LIST", requires = "target")]
     blocks: Option<String>,
-    /// yosys and nextpnr runs at a time for --target, 1..=256 (default: the available cores).
+    /// yosys and nextpnr runs at a time with --target, the chain's and loop's flows among
+    /// them, 1..=256 (default: the available cores).
     #[arg(long, value_parser = super::options::jobs, requires = "target")]
     jobs: Option<usize>,
     /// No progress spinner (it shows only on a terminal).
