@@ -7,10 +7,11 @@
 # ghdl, yosys, nextpnr-ice40, make, cbindgen for the C header's test, and the DejaVu font the
 # plots use), FuseSoC with pip in a virtualenv, and
 # maturin, numpy, pytest and pytest-xdist in another (for the Python package in python/):
-# a missing simulator is a failure, never a skipped test. Then: rustfmt,
-# clippy, Verilator lint of the RTL, and the whole test suite with cargo-nextest (unit, property,
-# end-to-end in every simulator, golden vectors, doc tests), then the Python package's wheel and pytest suite. Benchmarks are compiled (clippy --all-targets) but
-# not run: run them with `cargo bench`.
+# a missing simulator is a failure, never a skipped test. Then: rustfmt, Verilator and GHDL lint
+# of the RTL, and the whole test suite with cargo-nextest (unit, property, end-to-end in every
+# simulator, golden vectors, doc tests), its build linted by clippy (-D warnings) as it
+# compiles, then the Python package's wheel (linted the same way) and pytest suite. Benchmarks
+# are compiled and linted but not run: run them with `cargo bench`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # cargo probes rustc with `rustc -`, whose program comes from /dev/null: on a machine where
@@ -82,8 +83,16 @@ command -v fusesoc >/dev/null 2>&1 || { echo "FAIL: fusesoc is still missing" >&
 echo "== tools: $(iverilog -V 2>&1 | head -1); $(verilator --version); $(ghdl --version | head -1) ($(ghdl --version | grep -i 'code generator' | sed 's/^ *//')); $(yosys -V); $(nextpnr-ice40 --version 2>&1 | head -1); fusesoc $(fusesoc --version)"
 echo "== cargo fmt --check"
 cargo fmt --all -- --check
-echo "== cargo clippy --all-targets -D warnings"
-cargo clippy --workspace --all-targets --quiet -- -D warnings
+# Clippy lints while the test build compiles: clippy-driver as the compiler of the workspace's
+# own crates (what `cargo clippy` runs, but there in check mode, which compiled every
+# dependency a second time: 180 s of a fresh run). The same lints as
+# `cargo clippy --workspace --all-targets -- -D warnings`: the test build compiles every
+# library, binary and test target, and the benches are compiled below.
+clippy_driver="$(dirname "$(rustup which cargo 2>/dev/null || command -v cargo)")/clippy-driver"
+[ -x "$clippy_driver" ] || clippy_driver="$(command -v clippy-driver || true)"
+[ -x "$clippy_driver" ] || { echo "FAIL: clippy-driver not found (rustup component add clippy)" >&2; exit 1; }
+export RUSTC_WORKSPACE_WRAPPER="$clippy_driver"
+export CLIPPY_ARGS="-D__CLIPPY_HACKERY__warnings__CLIPPY_HACKERY__"
 echo "== verilator --lint-only -Wall (hdl/)"
 verilator --lint-only -Wall --top-module gyrofx_top hdl/*.v
 for module in gyrofx_mean_filter gyrofx_mean_filter_serial gyrofx_nco gyrofx_demodulator gyrofx_pi gyrofx_cic; do
@@ -103,7 +112,7 @@ ghdl -a --std=08 -Werror -Wunused -Wbinding -Wbody -Wspecs --workdir="$ghdl_work
     hdl/gyrofx_cic.vhd hdl/gyrofx_gyro_loop.vhd hdl/gyrofx_system.vhd hdl/gyrofx_serial_engine.vhd \
     hdl/gyrofx_top_serial.vhd hdl/gyrofx_testbench_pkg.vhd
 rm -rf "$ghdl_work"
-echo "== cargo nextest run (every test binary of the workspace), then the doc tests"
+echo "== cargo nextest run (every test binary of the workspace, linted by clippy as it compiles), then the benches' build and the doc tests"
 # cargo-nextest runs the tests: a process per test, one pool over every binary, the longest
 # first (.config/nextest.toml), where `cargo test` ran one binary at a time in name order and
 # left its last long test alone on one core. Rust toolchains here come with it; where one does
@@ -113,6 +122,8 @@ if ! cargo nextest --version >/dev/null 2>&1; then
     cargo install --locked --quiet cargo-nextest
 fi
 cargo nextest run --workspace --no-tests=fail
+# The benches compiled (and so linted), not run: `cargo bench` runs them.
+cargo test --workspace --benches --no-run --quiet
 # nextest does not run doc tests.
 cargo test --workspace --doc
 
@@ -136,11 +147,12 @@ cargo fmt --manifest-path python/Cargo.toml -- --check
 # its own, so Cargo sees them at another path than the workspace does (a local crate's
 # fingerprint hashes its path relative to its workspace: `model/src/lib.rs` there,
 # `/…/model/src/lib.rs` here), about 40 CPU-s.
+# The wheel's build is its clippy run too (RUSTC_WORKSPACE_WRAPPER, above): python/ has no
+# Rust test or bench target.
 export CARGO_TARGET_DIR="$PWD/target"
-cargo clippy --manifest-path python/Cargo.toml --all-targets --features workspace-features --quiet -- -D warnings
 rm -rf python/target/wheels
 "$python_venv/bin/maturin" build --profile dev --quiet -m python/Cargo.toml --features extension-module,workspace-features --out python/target/wheels
-unset CARGO_TARGET_DIR
+unset CARGO_TARGET_DIR RUSTC_WORKSPACE_WRAPPER CLIPPY_ARGS
 "$python_venv/bin/pip" install -q --force-reinstall --no-deps python/target/wheels/gyrofx-*.whl
 # One pytest worker per core (pytest-xdist): each cocotb run is one single-threaded simulator.
 GYROFX_CLI="$PWD/target/debug/gyrofx" "$python_venv/bin/python" -m pytest -q -n auto python/tests
