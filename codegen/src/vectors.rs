@@ -15,22 +15,15 @@ use std::collections::BTreeMap;
 
 use gyrofx_model::chain::{FixedChain, FloatChain, FloatSample, Sample};
 use gyrofx_model::estimator::OverflowCounts as EstimatorOverflows;
-use gyrofx_model::fx::Format;
-use gyrofx_model::gyro_loop::closed::{ClosedLoop, FixedClosedLoop, FixedHarness, LoopUnderTest};
-use gyrofx_model::gyro_loop::gyro::LoopOverflows;
 use gyrofx_model::kf::OverflowCounts;
-use gyrofx_model::plant::GyroStream;
-use gyrofx_model::resonator::Mode;
 use gyrofx_model::sequencer::Sequencer;
-use gyrofx_model::stimulus::adc;
-use gyrofx_model::system::loop_mode;
 use serde::Serialize;
 
 use crate::block::Block;
 use crate::progress::Progress;
 pub use crate::stats::ErrorStats;
-use gyrofx_job::config::GyroLoop;
-use gyrofx_job::error::{Error, Result};
+use gyrofx_job::error::Result;
+use gyrofx_job::gyros::{Batch, GyroLoopCounts, Gyros, Twins, BATCH, PROGRESS_STEP};
 use gyrofx_job::job::Job;
 
 /// Overflow counts of every quantization point.
@@ -49,18 +42,6 @@ pub struct Overflows {
     /// whose full-scale blocks may round past the range). They saturate on purpose.
     #[serde(flatten)]
     pub directed: BTreeMap<&'static str, serde_json::Value>,
-}
-
-/// One resonator-level gyro's loop saturations and wraps on the record (the start-up before
-/// it not included), node by node, split by the sequencer's blanking of the chain sample they
-/// fell in.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
-pub struct GyroLoopCounts {
-    /// In chain samples the estimator takes: they reach the chain's output.
-    pub used: LoopOverflows,
-    /// In blanked chain samples (the transient after a mode switch, which the sequencer
-    /// blanks because it may exceed the output range): not counted among the run's overflows.
-    pub blanked: LoopOverflows,
 }
 
 impl Overflows {
@@ -330,7 +311,7 @@ pub fn run<'a>(
 
     // The gyros as the sequencer drives them, and the same gyros without reversal (same
     // noise streams) for the report, simulated a batch ahead of the chain.
-    let mut gyros = Gyros::new(job, if n > 0 { rate.at(0) } else { 0.0 })?;
+    let mut gyros = Gyros::new(job, if n > 0 { rate.at(0) } else { 0.0 }, Twins::Unreversed)?;
     let mut sequencer = Sequencer::new(&est.schedule);
     let mut fixed = FixedChain::new(plan);
     let mut float = FloatChain::quantized(plan);
@@ -339,13 +320,11 @@ pub fn run<'a>(
     let fs = job.config.stimulus.fs_hz;
     let mut report = ReportStream::new(fs);
     let (mut last_combined, mut last_filtered) = (0.0, 0.0);
-    let mut batch = GyroBatch::default();
+    let mut batch = Batch::default();
 
-    for first in (0..n).step_by(GYRO_BATCH) {
-        let last = (first + GYRO_BATCH).min(n);
-        batch.rates.clear();
-        batch.modes.clear();
-        batch.blanked.clear();
+    for first in (0..n).step_by(BATCH) {
+        let last = (first + BATCH).min(n);
+        batch.clear();
         for k in first..last {
             if reset_at == Some(k) {
                 sequencer.reset();
@@ -355,7 +334,7 @@ pub fn run<'a>(
             batch.blanked.push([slot.blank_a, slot.blank_b]);
             batch.rates.push(rate.at(k));
         }
-        gyros.simulate(&mut batch, progress)?;
+        gyros.simulate(&mut batch, &|done| progress.advance(done))?;
         for (i, k) in (first..last).enumerate() {
             if k % PROGRESS_STEP == PROGRESS_STEP - 1 {
                 progress.advance(PROGRESS_STEP as u64);
@@ -469,253 +448,6 @@ fn gather<'a>(builders: Vec<Box<dyn VectorBuilder + 'a>>) -> Result<Gathered> {
         gathered.blocks.push(block);
     }
     Ok(gathered)
-}
-
-/// Chain samples the gyros are simulated ahead of the chain, a batch at a time.
-const GYRO_BATCH: usize = 2048;
-
-/// One batch of chain samples: the true rates and the sequencer's modes in, the gyros'
-/// ADC codes (chain input format) and the unreversed gyros' outputs (°/s) out.
-#[derive(Default)]
-struct GyroBatch {
-    rates: Vec<f64>,
-    modes: Vec<[i8; 2]>,
-    /// Whether the sequencer blanks A's and B's sample.
-    blanked: Vec<[bool; 2]>,
-    codes: Vec<[i64; 2]>,
-    raw: Vec<[f64; 2]>,
-}
-
-/// The four simulated gyros of a run: A and B in the sequencer's modes, and A and B always in
-/// normal mode (same seeds, so the same noise) for the report.
-enum Gyros {
-    Rate {
-        reversed: Box<[GyroStream; 2]>,
-        normal: Box<[GyroStream; 2]>,
-        input: Format,
-        saturations: [u64; 2],
-    },
-    Resonator {
-        reversed: Box<[FixedClosedLoop; 2]>,
-        normal: Box<[FixedClosedLoop; 2]>,
-        scale: f64,
-        /// The saturations of `reversed` (whose outputs feed the chain) on the record.
-        counts: Box<[GyroLoopCounts; 2]>,
-        /// `reversed`'s running counts at the last chain sample.
-        last: Box<[LoopOverflows; 2]>,
-    },
-    /// Recorded outputs (`generate --recording`): already in the sequencer's modes; the
-    /// report's "without reversal" rows show the same record.
-    Recorded {
-        rows: Box<gyrofx_job::recording::Rows>,
-        /// This batch's rates of gyro A and B, °/s.
-        rates: [Vec<f64>; 2],
-        input: Format,
-        saturations: [u64; 2],
-    },
-}
-
-/// Start-up before the record: the loops lock from rest (about 80 ms for paper 004's gyro).
-const RESONATOR_STARTUP_S: f64 = 0.5;
-
-/// Resonator-level gyro `g` of a run seeded `seed` (the seed `2·seed + g`), its loop closed
-/// (fixed or float: `L`) and run [`RESONATOR_STARTUP_S`] at the first sample's rate `rate0`
-/// (°/s) in normal mode before the record, as every run of gyrofx starts it.
-///
-/// # Errors
-/// Resonator parameters the physics refuses, named by their config section.
-pub fn started_loop<L: LoopUnderTest>(
-    gyro: &GyroLoop,
-    g: usize,
-    seed: u64,
-    rate0: f64,
-) -> Result<ClosedLoop<L>> {
-    let mut closed = ClosedLoop::<L>::new(
-        &gyro.plan,
-        &gyro.params,
-        &gyro.front_end,
-        seed.wrapping_mul(2).wrapping_add(g as u64),
-    )
-    .map_err(|e| Error::config(format!("resonator_{}", gyro.name), e, "see gyrofx init"))?;
-    let startup = (RESONATOR_STARTUP_S * gyro.plan.chain_rate_hz()).ceil() as usize;
-    for _ in 0..startup {
-        closed.step_chain(rate0, Mode::Normal);
-    }
-    Ok(closed)
-}
-
-/// Chain samples between two counts of [`Progress::advance`].
-const PROGRESS_STEP: usize = 1024;
-
-impl Gyros {
-    /// The gyros of `job`. Resonator-level gyro `g` takes the seed `2·seed + g` and runs
-    /// [`RESONATOR_STARTUP_S`] at the first sample's rate `rate0` (°/s) in normal mode before
-    /// the record; its outputs are already codes of the chain's input format (checked by the
-    /// config).
-    fn new(job: &Job, rate0: f64) -> Result<Self> {
-        let seed = job.config.seed;
-        let input = job.chain.estimator.input;
-        if let Some(recording) = &job.recording {
-            return Ok(Gyros::Recorded {
-                rows: Box::new(recording.rows()?),
-                rates: [
-                    Vec::with_capacity(GYRO_BATCH),
-                    Vec::with_capacity(GYRO_BATCH),
-                ],
-                input,
-                saturations: [0; 2],
-            });
-        }
-        Ok(match &job.settings.resonator {
-            None => {
-                let plant = &job.settings.plant;
-                let streams = || Box::new([0, 1].map(|g| plant.gyro_stream(g, seed)));
-                Gyros::Rate {
-                    reversed: streams(),
-                    normal: streams(),
-                    input,
-                    saturations: [0; 2],
-                }
-            }
-            Some(loops) => {
-                let closed = |g: usize| started_loop::<FixedHarness>(&loops[g], g, seed, rate0);
-                let reversed = Box::new([closed(0)?, closed(1)?]);
-                let normal = reversed.clone();
-                // The start-up is not the record: its saturations are left out.
-                let last = Box::new(reversed.each_ref().map(|gyro| gyro.gyro.overflows()));
-                Gyros::Resonator {
-                    reversed,
-                    normal,
-                    scale: libm::ldexp(1.0, input.frac),
-                    counts: Box::default(),
-                    last,
-                }
-            }
-        })
-    }
-
-    /// Fills `batch.codes` and `batch.raw` for its rates and modes.
-    ///
-    /// # Errors
-    /// A recording that cannot be read to the batch's end.
-    fn simulate(&mut self, batch: &mut GyroBatch, progress: &Progress) -> Result<()> {
-        let len = batch.rates.len();
-        batch.codes.clear();
-        batch.raw.clear();
-        match self {
-            Gyros::Rate {
-                reversed,
-                normal,
-                input,
-                saturations,
-            } => {
-                let mut values: [Vec<f64>; 2] = [Vec::with_capacity(len), Vec::with_capacity(len)];
-                for (omega, modes) in batch.rates.iter().zip(&batch.modes) {
-                    for g in 0..2 {
-                        values[g].push(reversed[g].step(*omega, modes[g]).0);
-                    }
-                    batch.raw.push([0, 1].map(|g| normal[g].step(*omega, 1).0));
-                }
-                let [(a, sat_a), (b, sat_b)] = values.map(|v| adc(&v, *input));
-                saturations[0] += sat_a;
-                saturations[1] += sat_b;
-                batch
-                    .codes
-                    .extend(a.into_iter().zip(b).map(|(a, b)| [a, b]));
-            }
-            Gyros::Resonator {
-                reversed,
-                normal,
-                scale,
-                counts,
-                last,
-            } => {
-                let scale = *scale;
-                let (rates, modes, blanked) = (&batch.rates, &batch.modes, &batch.blanked);
-                let run = |g: usize,
-                           reversed: &mut FixedClosedLoop,
-                           normal: &mut FixedClosedLoop,
-                           counts: &mut GyroLoopCounts,
-                           last: &mut LoopOverflows| {
-                    let mut out = Vec::with_capacity(len);
-                    for (k, (omega, mode)) in rates.iter().zip(modes).enumerate() {
-                        if k % PROGRESS_STEP == PROGRESS_STEP - 1 {
-                            progress.advance(2 * PROGRESS_STEP as u64);
-                        }
-                        let output = reversed
-                            .step_chain(*omega, loop_mode(mode[g]))
-                            .output
-                            .rate_dps;
-                        // Booked to the chain sample they fell in, so that a switch
-                        // transient's are told apart from those the chain takes in.
-                        let now = reversed.gyro.overflows();
-                        let stretch = if blanked[k][g] {
-                            &mut counts.blanked
-                        } else {
-                            &mut counts.used
-                        };
-                        stretch.add(&now.since(last));
-                        *last = now;
-                        let raw = normal.step_chain(*omega, Mode::Normal).output.rate_dps;
-                        out.push(((output * scale).round() as i64, raw));
-                    }
-                    out
-                };
-                let [reversed_a, reversed_b] = &mut **reversed;
-                let [normal_a, normal_b] = &mut **normal;
-                let [counts_a, counts_b] = &mut **counts;
-                let [last_a, last_b] = &mut **last;
-                let (a, b) = std::thread::scope(|scope| {
-                    let b = scope.spawn(|| run(1, reversed_b, normal_b, counts_b, last_b));
-                    let a = run(0, reversed_a, normal_a, counts_a, last_a);
-                    (a, b.join().expect("the loop simulation does not panic"))
-                });
-                for ((code_a, raw_a), (code_b, raw_b)) in a.into_iter().zip(b) {
-                    batch.codes.push([code_a, code_b]);
-                    batch.raw.push([raw_a, raw_b]);
-                }
-            }
-            Gyros::Recorded {
-                rows,
-                rates,
-                input,
-                saturations,
-            } => {
-                rates.iter_mut().for_each(Vec::clear);
-                rows.read_into(len, rates)?;
-                let [(a, sat_a), (b, sat_b)] = [0, 1].map(|g| adc(&rates[g], *input));
-                saturations[0] += sat_a;
-                saturations[1] += sat_b;
-                batch
-                    .codes
-                    .extend(a.into_iter().zip(b).map(|(a, b)| [a, b]));
-                batch
-                    .raw
-                    .extend(rates[0].iter().zip(&rates[1]).map(|(a, b)| [*a, *b]));
-            }
-        }
-        Ok(())
-    }
-
-    /// The resonator-level gyros' loop saturations on the record so far (zeros for the other
-    /// plants).
-    fn loop_counts(&self) -> [GyroLoopCounts; 2] {
-        match self {
-            Gyros::Resonator { counts, .. } => **counts,
-            Gyros::Rate { .. } | Gyros::Recorded { .. } => Default::default(),
-        }
-    }
-
-    /// ADC saturations of gyro A and B so far (the pick-offs' for resonator-level gyros).
-    fn saturations(&self) -> [u64; 2] {
-        match self {
-            Gyros::Rate { saturations, .. } => *saturations,
-            Gyros::Resonator { reversed, .. } => reversed
-                .each_ref()
-                .map(|gyro| gyro.resonator.adc_saturations()),
-            Gyros::Recorded { saturations, .. } => *saturations,
-        }
-    }
 }
 
 /// The signals of the report, in its order.

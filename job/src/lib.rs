@@ -13,6 +13,7 @@ pub mod config;
 pub mod error;
 pub mod formats;
 pub mod golden;
+pub mod gyros;
 pub mod hash;
 pub mod input;
 pub mod job;

@@ -34,18 +34,16 @@
 
 use gyrofx_model::analysis::allan::OverlappingStream;
 use gyrofx_model::chain::{FixedChain, FloatChain};
-use gyrofx_model::gyro_loop::closed::{FixedHarness, FloatHarness, LoopUnderTest};
+use gyrofx_model::gyro_loop::closed::FloatHarness;
 use gyrofx_model::sequencer::Sequencer;
-use gyrofx_model::stimulus::adc;
 use gyrofx_model::system::loop_mode;
 use serde::Serialize;
 
 use gyrofx_codegen::stats::Accumulator;
-use gyrofx_codegen::vectors::{
-    bw_sel_at, bw_sel_switches, started_loop, EstimatorCounts, KfCounts,
-};
+use gyrofx_codegen::vectors::{bw_sel_at, bw_sel_switches, EstimatorCounts, KfCounts};
 use gyrofx_job::config::GyroLoop;
 use gyrofx_job::error::Result;
+use gyrofx_job::gyros::{started_loop, Batch, Gyros, Twins, BATCH};
 use gyrofx_job::job::Job;
 
 /// The averaging time of the ADEV and ARW readings, s.
@@ -118,9 +116,9 @@ fn modes(job: &Job, samples: usize) -> Vec<[i8; 2]> {
         .collect()
 }
 
-/// Gyro `g`'s loop closed around its resonator and started up as every run starts it
+/// Gyro `g`'s float loop closed around its resonator and started up as every run starts it
 /// ([`started_loop`]); its chain-rate outputs (°/s) over the record.
-fn closed_loop_rates<L: LoopUnderTest>(
+fn float_loop_rates(
     gyro: &GyroLoop,
     g: usize,
     seed: u64,
@@ -128,7 +126,7 @@ fn closed_loop_rates<L: LoopUnderTest>(
     modes: &[[i8; 2]],
 ) -> Result<Vec<f64>> {
     let rate0 = rates.first().copied().unwrap_or(0.0);
-    let mut closed = started_loop::<L>(gyro, g, seed, rate0)?;
+    let mut closed = started_loop::<FloatHarness>(gyro, g, seed, rate0)?;
     Ok(rates
         .iter()
         .zip(modes)
@@ -136,9 +134,9 @@ fn closed_loop_rates<L: LoopUnderTest>(
         .collect())
 }
 
-/// Simulates the gyros of `job` over its `samples` (each gyro on its own thread) into the
-/// chain's input codes (ADC: nearest, saturating; the resonator loops' outputs are codes of
-/// the input format already), and with `float_twin` also the float loops' rates.
+/// Simulates the gyros of `job` over its `samples` ([`Gyros`], as `generate` does) into the
+/// chain's input codes, and with `float_twin` also the float loops' rates (each gyro on its
+/// own thread).
 ///
 /// # Errors
 /// A bad CSV stimulus, or resonator parameters the physics refuses.
@@ -147,50 +145,28 @@ pub fn stimulus(job: &Job, float_twin: bool) -> Result<Stimulus> {
     let rates = job.true_rate(samples)?;
     let modes = modes(job, samples);
     let seed = job.config.seed;
-    let input = job.chain.estimator.input;
-    let per_gyro = |g: usize| -> Result<(Vec<i64>, Option<Vec<f64>>)> {
-        match &job.settings.resonator {
-            None => {
-                let mut stream = job.settings.plant.gyro_stream(g as u8, seed);
-                let values: Vec<f64> = rates
-                    .iter()
-                    .zip(&modes)
-                    .map(|(omega, m)| stream.step(*omega, m[g]).0)
-                    .collect();
-                Ok((adc(&values, input).0, None))
-            }
-            Some(loops) => {
-                let scale = libm::ldexp(1.0, input.frac);
-                let fixed = closed_loop_rates::<FixedHarness>(&loops[g], g, seed, &rates, &modes)?;
-                let codes = fixed.iter().map(|r| (r * scale).round() as i64).collect();
-                let float = if float_twin {
-                    Some(closed_loop_rates::<FloatHarness>(
-                        &loops[g], g, seed, &rates, &modes,
-                    )?)
-                } else {
-                    None
-                };
-                Ok((codes, float))
-            }
+    let mut gyros = Gyros::new(job, rates.first().copied().unwrap_or(0.0), Twins::None)?;
+    let mut codes = Vec::with_capacity(samples);
+    let mut batch = Batch::default();
+    for (rates, modes) in rates.chunks(BATCH).zip(modes.chunks(BATCH)) {
+        batch.clear();
+        batch.rates.extend_from_slice(rates);
+        batch.modes.extend_from_slice(modes);
+        gyros.simulate(&mut batch, &|_| {})?;
+        codes.extend_from_slice(&batch.codes);
+    }
+    let float = match (&job.settings.resonator, float_twin) {
+        (Some(loops), true) => {
+            let (a, b) = std::thread::scope(|scope| {
+                let b = scope.spawn(|| float_loop_rates(&loops[1], 1, seed, &rates, &modes));
+                let a = float_loop_rates(&loops[0], 0, seed, &rates, &modes);
+                (a, b.join().expect("the gyro simulation does not panic"))
+            });
+            Some(a?.into_iter().zip(b?).map(|(a, b)| [a, b]).collect())
         }
+        _ => None,
     };
-    let (a, b) = std::thread::scope(|scope| {
-        let b = scope.spawn(|| per_gyro(1));
-        let a = per_gyro(0);
-        (a, b.join().expect("the gyro simulation does not panic"))
-    });
-    let ((codes_a, float_a), (codes_b, float_b)) = (a?, b?);
-    Ok(Stimulus {
-        codes: codes_a
-            .into_iter()
-            .zip(codes_b)
-            .map(|(a, b)| [a, b])
-            .collect(),
-        float: match (float_a, float_b) {
-            (Some(a), Some(b)) => Some(a.into_iter().zip(b).map(|(a, b)| [a, b]).collect()),
-            _ => None,
-        },
-    })
+    Ok(Stimulus { codes, float })
 }
 
 /// The first sample at which the chain of `job` has a bias estimate (from reset, whatever the
