@@ -4,7 +4,8 @@
 #   scripts/test.sh
 #
 # Installs the simulators and synthesis tools with apt-get where missing (iverilog, verilator,
-# ghdl, yosys, nextpnr-ice40, make, cbindgen for the C header's test, and the DejaVu font the
+# ghdl, yosys, nextpnr-ice40, make, cbindgen for the C header's test, ccache for Verilator's
+# runtime, and the DejaVu font the
 # plots use), FuseSoC with pip in a virtualenv, and
 # maturin, numpy, pytest and pytest-xdist in another (for the Python package in python/):
 # a missing simulator is a failure, never a skipped test. Then: rustfmt, Verilator and GHDL lint
@@ -33,7 +34,7 @@ export CARGO_INCREMENTAL=0
 
 font=/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf
 missing=()
-for program in iverilog vvp verilator ghdl yosys nextpnr-ice40 make sha256sum cbindgen; do
+for program in iverilog vvp verilator ghdl yosys nextpnr-ice40 make sha256sum cbindgen ccache; do
     command -v "$program" >/dev/null 2>&1 || missing+=("$program")
 done
 [ -f "$font" ] || missing+=("$font")
@@ -43,7 +44,7 @@ if [ ${#missing[@]} -gt 0 ]; then
     if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
     $sudo apt-get update -qq
     DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq \
-        iverilog verilator ghdl yosys nextpnr-ice40 make coreutils cbindgen fonts-dejavu-core >/dev/null
+        iverilog verilator ghdl yosys nextpnr-ice40 make coreutils cbindgen ccache fonts-dejavu-core >/dev/null
 fi
 # GHDL's LLVM back end runs the closed-loop testbenches about 3x faster than the default mcode
 # one (2310 us of the system testbench: 90 s against 258 s); Debian's ghdl wrapper takes it from
@@ -57,7 +58,7 @@ if [ ! -x /usr/bin/ghdl-llvm ] && command -v apt-get >/dev/null 2>&1; then
 fi
 if [ -x /usr/bin/ghdl-llvm ]; then export GHDL_BACKEND=llvm; fi
 [ -f "$font" ] || { echo "FAIL: $font is still missing after apt-get (plots need it)" >&2; exit 1; }
-for program in iverilog vvp verilator ghdl yosys nextpnr-ice40 make sha256sum cbindgen; do
+for program in iverilog vvp verilator ghdl yosys nextpnr-ice40 make sha256sum cbindgen ccache; do
     command -v "$program" >/dev/null 2>&1 || { echo "FAIL: $program is still missing after apt-get" >&2; exit 1; }
 done
 
@@ -112,6 +113,12 @@ ghdl -a --std=08 -Werror -Wunused -Wbinding -Wbody -Wspecs --workdir="$ghdl_work
     hdl/gyrofx_cic.vhd hdl/gyrofx_gyro_loop.vhd hdl/gyrofx_system.vhd hdl/gyrofx_serial_engine.vhd \
     hdl/gyrofx_top_serial.vhd hdl/gyrofx_testbench_pkg.vhd
 rm -rf "$ghdl_work"
+# Every Verilator build compiles Verilator's runtime (verilated.cpp and two more: 8.7 of a
+# small testbench's 11 CPU-s) with the same flags: through ccache (verilated.mk's OBJCACHE),
+# the suite's 40-odd builds compile it once per flag set. The default package's seven
+# Verilator testbenches: 83 CPU-s without, 33 with. The cache lives in target/, so a fresh
+# clone starts without one; the objects it gives are those the compiler gives.
+export OBJCACHE=ccache CCACHE_DIR="$PWD/target/verilator-ccache" CCACHE_NOHASHDIR=1
 echo "== cargo nextest run (every test binary of the workspace, linted by clippy as it compiles), then the benches' build and the doc tests"
 # cargo-nextest runs the tests: a process per test, one pool over every binary, the longest
 # first (.config/nextest.toml), where `cargo test` ran one binary at a time in name order and
