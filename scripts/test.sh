@@ -84,16 +84,6 @@ command -v fusesoc >/dev/null 2>&1 || { echo "FAIL: fusesoc is still missing" >&
 echo "== tools: $(iverilog -V 2>&1 | head -1); $(verilator --version); $(ghdl --version | head -1) ($(ghdl --version | grep -i 'code generator' | sed 's/^ *//')); $(yosys -V); $(nextpnr-ice40 --version 2>&1 | head -1); fusesoc $(fusesoc --version)"
 echo "== cargo fmt --check"
 cargo fmt --all -- --check
-# Clippy lints while the test build compiles: clippy-driver as the compiler of the workspace's
-# own crates (what `cargo clippy` runs, but there in check mode, which compiled every
-# dependency a second time: 180 s of a fresh run). The same lints as
-# `cargo clippy --workspace --all-targets -- -D warnings`: the test build compiles every
-# library, binary and test target, and the benches are compiled below.
-clippy_driver="$(dirname "$(rustup which cargo 2>/dev/null || command -v cargo)")/clippy-driver"
-[ -x "$clippy_driver" ] || clippy_driver="$(command -v clippy-driver || true)"
-[ -x "$clippy_driver" ] || { echo "FAIL: clippy-driver not found (rustup component add clippy)" >&2; exit 1; }
-export RUSTC_WORKSPACE_WRAPPER="$clippy_driver"
-export CLIPPY_ARGS="-D__CLIPPY_HACKERY__warnings__CLIPPY_HACKERY__"
 echo "== verilator --lint-only -Wall (hdl/)"
 verilator --lint-only -Wall --top-module gyrofx_top hdl/*.v
 for module in gyrofx_mean_filter gyrofx_mean_filter_serial gyrofx_nco gyrofx_demodulator gyrofx_pi gyrofx_cic; do
@@ -128,6 +118,17 @@ if ! cargo nextest --version >/dev/null 2>&1; then
     echo "== installing cargo-nextest from crates.io"
     cargo install --locked --quiet cargo-nextest
 fi
+# Clippy lints while the test build compiles: clippy-driver as the compiler of the workspace's
+# own crates (what `cargo clippy` runs, but there in check mode, which compiled every
+# dependency a second time: 180 s of a fresh run). The same lints as
+# `cargo clippy --workspace --all-targets -- -D warnings`: the test build compiles every
+# library, binary and test target, and the benches are compiled below. Set after
+# cargo-nextest's install above, which it must not lint.
+clippy_driver="$(dirname "$(rustup which cargo 2>/dev/null || command -v cargo)")/clippy-driver"
+[ -x "$clippy_driver" ] || clippy_driver="$(command -v clippy-driver || true)"
+[ -x "$clippy_driver" ] || { echo "FAIL: clippy-driver not found (rustup component add clippy)" >&2; exit 1; }
+export RUSTC_WORKSPACE_WRAPPER="$clippy_driver"
+export CLIPPY_ARGS="-D__CLIPPY_HACKERY__warnings__CLIPPY_HACKERY__"
 cargo nextest run --workspace --no-tests=fail
 # The benches compiled (and so linted), not run: `cargo bench` runs them.
 cargo test --workspace --benches --no-run --quiet
