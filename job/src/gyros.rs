@@ -374,14 +374,5 @@ mod tests {
         assert!(job.settings.resonator.is_some());
         let one = codes(&job, 300, 300, Twins::None);
         assert_eq!(one, codes(&job, 300, 64, Twins::Unreversed));
-        let mut gyros = Gyros::new(&job, 10.0, Twins::None).unwrap();
-        assert_eq!(gyros.loop_counts(), [GyroLoopCounts::default(); 2]);
-        let mut batch = Batch {
-            rates: vec![10.0; 10],
-            modes: vec![[1, -1]; 10],
-            ..Batch::default()
-        };
-        gyros.simulate(&mut batch, &|_| {}).unwrap();
-        assert!(batch.raw.is_empty());
     }
 }

@@ -163,27 +163,8 @@ fn run(command: &mut Command, limit: Option<Duration>) -> std::io::Result<Ran> {
     let mut child = crate::processes::spawn(command)?;
     // Both pipes are drained while the child runs: a child that fills one would otherwise
     // wait for us while we wait for it.
-    let drain = |pipe: Option<Box<dyn Read + Send>>| {
-        std::thread::spawn(move || {
-            let mut bytes = Vec::new();
-            if let Some(mut pipe) = pipe {
-                let _ = pipe.read_to_end(&mut bytes);
-            }
-            String::from_utf8_lossy(&bytes).into_owned()
-        })
-    };
-    let stdout = drain(
-        child
-            .stdout
-            .take()
-            .map(|p| Box::new(p) as Box<dyn Read + Send>),
-    );
-    let stderr = drain(
-        child
-            .stderr
-            .take()
-            .map(|p| Box::new(p) as Box<dyn Read + Send>),
-    );
+    let stdout = drain(child.stdout.take());
+    let stderr = drain(child.stderr.take());
     let start = Instant::now();
     let status = loop {
         let waited = match limit {
@@ -216,6 +197,17 @@ fn run(command: &mut Command, limit: Option<Duration>) -> std::io::Result<Ran> {
             stderr,
         }),
         None => Ran::OutOfTime,
+    })
+}
+
+/// Reads `pipe` to its end on a thread of its own, as (lossy) UTF-8.
+fn drain<R: Read + Send + 'static>(pipe: Option<R>) -> std::thread::JoinHandle<String> {
+    std::thread::spawn(move || {
+        let mut bytes = Vec::new();
+        if let Some(mut pipe) = pipe {
+            let _ = pipe.read_to_end(&mut bytes);
+        }
+        String::from_utf8_lossy(&bytes).into_owned()
     })
 }
 
