@@ -22,9 +22,9 @@ use gyrofx_codegen::output_folder;
 use gyrofx_codegen::package::Package;
 use gyrofx_codegen::text::fill;
 use gyrofx_job::error::{Error, Result};
+use gyrofx_job::job::Job;
 
 use crate::toolchain::{self, Ran, Tool};
-use gyrofx_job::job::Job;
 
 /// Which blocks `synth` also places and routes, on which targets.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -496,28 +496,12 @@ fn sum(cells: &[(String, u64)], keep: impl Fn(&str) -> bool) -> u64 {
 /// million iterations without progress).
 pub const NEXTPNR_LIMIT: std::time::Duration = std::time::Duration::from_secs(600);
 
-/// What a run of nextpnr came to.
-enum Routed {
-    /// It finished (placed and routed, or refused the design): what it printed on stderr when
-    /// it failed.
-    Finished(Option<String>),
-    /// Still running at [`NEXTPNR_LIMIT`]: stopped.
-    OutOfTime,
-}
-
 /// Runs nextpnr in `dir` for at most [`NEXTPNR_LIMIT`].
-fn run_nextpnr(dir: &Path, args: &[String]) -> Result<Routed> {
+fn run_nextpnr(dir: &Path, args: &[String]) -> Result<Ran> {
     let mut command = Tool::NextpnrIce40.command();
     command.args(args).current_dir(dir);
-    match toolchain::run_limited(&mut command, NEXTPNR_LIMIT) {
-        Ok(Ran::Finished(finished)) => Ok(Routed::Finished(
-            (!finished.success).then_some(finished.stderr),
-        )),
-        Ok(Ran::OutOfTime) => Ok(Routed::OutOfTime),
-        Err(e) => Err(Error::Synthesis(format!(
-            "cannot run nextpnr-ice40 (is it installed?): {e}"
-        ))),
-    }
+    toolchain::run_limited(&mut command, NEXTPNR_LIMIT)
+        .map_err(|e| Error::Synthesis(format!("cannot run nextpnr-ice40 (is it installed?): {e}")))
 }
 
 /// The last lines of a log, for an error message.
@@ -712,9 +696,10 @@ fn place(dir: &Path, block: &Block, target: Target) -> Result<Placement> {
         return Ok(placement);
     }
     let log = PathBuf::from(target.name()).join("nextpnr.log");
+    // What nextpnr printed on stderr when it failed.
     let printed = match run_nextpnr(dir, &nextpnr_args(target))? {
-        Routed::Finished(printed) => printed,
-        Routed::OutOfTime => {
+        Ran::Finished(finished) => (!finished.success).then_some(finished.stderr),
+        Ran::OutOfTime => {
             placement.fits = false;
             placement.limit = Some(format!(
                 "nextpnr-ice40 did not finish placing and routing it in {} s (too congested: {} LUT4, {} flip-flops, {} carries in the block alone)",

@@ -7,7 +7,6 @@
 //! flip-flops and multipliers (counted before they are merged into `$macc` cells), and the
 //! `synth_xilinx` mapping's LUTs, flip-flops, DSP48E1s and block RAMs.
 
-use crate::toolchain::Tool;
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
@@ -17,6 +16,7 @@ use gyrofx_codegen::blocks::{self, RomImages};
 
 use crate::place_route;
 use crate::place_route::PlaceRequest;
+use crate::toolchain::Tool;
 use gyrofx_codegen::design::{
     configured_name, connections, design_files, sources, CONFIGURED_FILE, LOOP_TOP,
 };

@@ -135,8 +135,8 @@ fn float_loop_rates(
 }
 
 /// Simulates the gyros of `job` over its `samples` ([`Gyros`], as `generate` does) into the
-/// chain's input codes, and with `float_twin` also the float loops' rates (each gyro on its
-/// own thread).
+/// chain's input codes, and with `float_twin` also the float loops' rates (the two gyros side
+/// by side in the lab's pool).
 ///
 /// # Errors
 /// A bad CSV stimulus, or resonator parameters the physics refuses.
@@ -157,12 +157,12 @@ pub fn stimulus(job: &Job, float_twin: bool) -> Result<Stimulus> {
     }
     let float = match (&job.settings.resonator, float_twin) {
         (Some(loops), true) => {
-            let (a, b) = std::thread::scope(|scope| {
-                let b = scope.spawn(|| float_loop_rates(&loops[1], 1, seed, &rates, &modes));
-                let a = float_loop_rates(&loops[0], 0, seed, &rates, &modes);
-                (a, b.join().expect("the gyro simulation does not panic"))
-            });
-            Some(a?.into_iter().zip(b?).map(|(a, b)| [a, b]).collect())
+            let [a, b]: [Vec<f64>; 2] = crate::pool::try_map(&[0, 1], 2, |&g| {
+                float_loop_rates(&loops[g], g, seed, &rates, &modes)
+            })?
+            .try_into()
+            .expect("two gyros");
+            Some(a.into_iter().zip(b).map(|(a, b)| [a, b]).collect())
         }
         _ => None,
     };
