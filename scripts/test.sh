@@ -5,9 +5,8 @@
 #
 # Installs the simulators and synthesis tools with apt-get where missing (iverilog, verilator,
 # ghdl, yosys, nextpnr-ice40, make, cbindgen for the C header's test, ccache for Verilator's
-# runtime, and the DejaVu font the
-# plots use), FuseSoC with pip in a virtualenv, and
-# maturin, numpy, pytest and pytest-xdist in another (for the Python package in python/):
+# runtime, and the DejaVu font the plots use), FuseSoC with pip in a virtualenv, and maturin,
+# numpy, pytest and pytest-xdist in another (for the Python package in python/):
 # a missing simulator is a failure, never a skipped test. Then: rustfmt, Verilator and GHDL lint
 # of the RTL, and the whole test suite with cargo-nextest (unit, property, end-to-end in every
 # simulator, golden vectors, doc tests), its build linted by clippy (-D warnings) as it
@@ -138,7 +137,7 @@ cargo test --workspace --doc
 # The Python package (python/): pyo3 + numpy, built by maturin as an abi3 wheel into a
 # virtualenv from PyPI (reused across runs), then its pytest suite: the model against the CLI's
 # vectors, and the package's cocotb tests in Icarus (python/tests/test_cocotb.py).
-echo "== python: cargo fmt, clippy, maturin wheel, pytest"
+echo "== python: cargo fmt, maturin wheel (linted by clippy), pytest"
 python_venv="${XDG_CACHE_HOME:-$HOME/.cache}/gyrofx/python-venv"
 if [ ! -x "$python_venv/bin/maturin" ] || ! "$python_venv/bin/python" -c "import numpy, pytest, xdist, cocotb" >/dev/null 2>&1; then
     echo "== installing maturin, numpy, pytest, pytest-xdist, cocotb into $python_venv"
@@ -150,8 +149,8 @@ cargo fmt --manifest-path python/Cargo.toml -- --check
 # the workspace's build compiled with the same version, features and dependencies is not
 # compiled again. python/Cargo.lock keeps the workspace's versions, and the feature
 # `workspace-features` (with the root Cargo.toml's side) the workspace's features below the
-# model and the job. Fresh: clippy 52 s, the wheel 73 s (107 and 121 s without the aligned
-# features). The model and the job themselves are compiled once more: python/ is a workspace of
+# model and the job. Fresh: the wheel 93 s, linted as it builds (the separate clippy run and the
+# wheel took 52 + 73 s, and 107 + 121 s before the features were aligned). The model and the job themselves are compiled once more: python/ is a workspace of
 # its own, so Cargo sees them at another path than the workspace does (a local crate's
 # fingerprint hashes its path relative to its workspace: `model/src/lib.rs` there,
 # `/…/model/src/lib.rs` here), about 40 CPU-s.
