@@ -247,7 +247,7 @@ mod tests {
     }
 
     #[test]
-    fn a_missing_program_has_no_version_and_is_not_on_path() {
+    fn make_is_found_with_its_version_and_a_missing_program_does_not_start() {
         // make is installed wherever the tests run (scripts/test.sh checks it).
         assert!(Tool::Make.on_path());
         assert!(Tool::Make.version().is_some_and(|v| v.contains("Make")));
