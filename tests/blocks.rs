@@ -82,9 +82,12 @@ fn doc_ports(page: &str) -> Vec<Port> {
 
 /// Names and directions of a Verilog module's ports, in order (ANSI header, one per line).
 fn verilog_ports(source: &str) -> Vec<(String, String)> {
+    // The module's port list ends at the first `);`: functions after it declare inputs too.
     source
         .lines()
         .map(str::trim)
+        .skip_while(|l| !l.starts_with("module "))
+        .take_while(|l| !l.starts_with(");"))
         .filter_map(|l| {
             let direction = if l.starts_with("input ") {
                 "in"

@@ -16,7 +16,7 @@ mod fuzz_parsers;
 mod golden;
 mod gyro_loop;
 mod layers;
-mod loop_blocks_rtl;
+mod loop_blocks;
 mod memory;
 mod output_folder;
 mod random_configs;

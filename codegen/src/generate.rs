@@ -105,6 +105,34 @@ pub(crate) fn block_files(block: &Block, provenance: &Provenance) -> Vec<BlockFi
     files
 }
 
+/// A package of `blocks` alone, built outside a job with their rows kept (a leaf module of the
+/// gyro loop at a plan of its own: [`crate::blocks::nco::block`] and its `push_vectors`): each
+/// block's folder as [`build_package`] writes it, the HDL sources and the Makefile, so that
+/// `gyrofx verify` and `make` run them as they run a generated package's.
+///
+/// # Panics
+/// When a block's rows were streamed rather than kept.
+pub fn blocks_package(blocks: &[Block], provenance: &Provenance) -> Package {
+    let mut package = Package::new(Kind::Generate, writers::build_outputs(blocks));
+    package.add("Makefile", writers::makefile(blocks, provenance));
+    for (name, source) in hdl::RTL_SOURCES.iter().chain(&hdl::VHDL_SOURCES) {
+        package.add(format!("hdl/{name}"), *source);
+    }
+    for block in blocks {
+        let (stimulus, expected) = writers::vector_hex(block, provenance);
+        for (what, text) in [("stimulus.hex", stimulus), ("expected.hex", expected)] {
+            package.add(format!("{}/{}", block.name, block.file(what)), text);
+        }
+        for file in block_files(block, provenance) {
+            match file {
+                BlockFile::Text(path, text) => package.add(path, text),
+                BlockFile::Written(entry) => package.add_written(entry),
+            }
+        }
+    }
+    package
+}
+
 pub(crate) fn block_manifest(block: &Block) -> serde_json::Value {
     let fields = |signals: Vec<(&str, String)>| -> Vec<serde_json::Value> {
         signals

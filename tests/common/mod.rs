@@ -148,7 +148,8 @@ pub fn reseal(package: &Path) {
 }
 
 /// Like [`flip_expected_bit`], at the first sample from `from` where the last output is
-/// compared: where the manifest gates it by a strobe (`only_where`), a line with the strobe 1.
+/// compared: where the manifest gates it by a strobe (`only_where`), a line with the strobe 1;
+/// where it gates others itself, a line where it is 1.
 /// Returns the field flipped and the sample.
 pub fn flip_checked_bit(package: &Path, block: &str, from: usize) -> (String, usize) {
     let manifest: serde_json::Value =
@@ -160,12 +161,21 @@ pub fn flip_checked_bit(package: &Path, block: &str, from: usize) -> (String, us
     let strobe_name = fields.last().unwrap()["only_where"]
         .as_str()
         .map(|gate| gate.trim_end_matches(" = 1").to_string());
-    let strobe = strobe_name.map(|name| {
+    let mut strobe = strobe_name.map(|name| {
         fields
             .iter()
             .position(|f| f["name"] == name.as_str())
             .expect("the strobe among the outputs")
     });
+    // A last output that gates others (a decimator's `y_valid`) is flipped where it is 1: at a
+    // 0, the flip would also expose the outputs it gates.
+    let last = fields.last().unwrap()["name"].as_str().unwrap().to_string();
+    if fields
+        .iter()
+        .any(|f| f["only_where"].as_str() == Some(&format!("{last} = 1")))
+    {
+        strobe = Some(fields.len() - 1);
+    }
     let path = package.join(block).join(format!("{block}_expected.hex"));
     let content = std::fs::read_to_string(&path).unwrap();
     let lines: Vec<&str> = content.lines().collect();
@@ -176,12 +186,16 @@ pub fn flip_checked_bit(package: &Path, block: &str, from: usize) -> (String, us
 }
 
 /// The blocks of a resonator-plant package (the default's), in Makefile order.
-pub const BLOCKS: [&str; 7] = [
+pub const BLOCKS: [&str; 11] = [
     "sequencer",
     "estimator",
     "kf",
     "top",
     "mean_filter",
+    "nco",
+    "demodulator",
+    "pi",
+    "cic",
     "gyro_loop",
     "system",
 ];

@@ -13,10 +13,14 @@
 //! and one line in [`REGISTRY`].
 
 pub mod calibration;
+pub mod cic;
+pub mod demodulator;
 pub mod estimator;
 pub mod gyro_loop;
 pub mod kf;
 pub mod mean_filter;
+pub mod nco;
+pub mod pi;
 pub mod sequencer;
 pub mod system;
 pub mod top;
@@ -24,7 +28,8 @@ pub mod top;
 #[cfg(test)]
 mod tests;
 
-use gyrofx_model::fx::{Overflow, Rounding};
+use gyrofx_model::fx::{Format, Overflow, Rounding};
+use gyrofx_model::gyro_loop::RtlParameter;
 
 use crate::block::{Block, Param};
 use crate::rom::{self, Rom, RomFormat};
@@ -141,6 +146,10 @@ pub static REGISTRY: &[&dyn RtlBlock] = &[
     &kf::Kf,
     &top::Top,
     &mean_filter::MeanFilter,
+    &nco::Nco,
+    &demodulator::Demodulator,
+    &pi::Pi,
+    &cic::Cic,
     &gyro_loop::GyroLoop,
     &system::System,
 ];
@@ -278,6 +287,132 @@ pub fn mode_params(rounding: Rounding, overflow: Overflow) -> [Param; 2] {
         Param::integer("ROUNDING", rounding.rtl_code().into(), rounding.name()),
         Param::integer("SATURATE", overflow.rtl_code().into(), overflow.name()),
     ]
+}
+
+/// A parameter holding a signed code of `width` bits (a Verilog `[width-1:0]` literal, a
+/// VHDL bit string), e.g. a PI's gain.
+pub(crate) fn signed(name: &str, width: u32, code: i128, comment: impl Into<String>) -> Param {
+    let mask = if width >= 128 {
+        u128::MAX
+    } else {
+        (1u128 << width) - 1
+    };
+    Param::bits(name, width, (code as u128) & mask, comment)
+}
+
+/// The parameters of one of the gyro loop's leaf modules from its plan's `rtl_parameters`
+/// (in the RTL's order, each under its own name): `KP`, `KI`, `INT_MIN` and `INT_MAX` as codes
+/// of the widths `KP_W`, `KI_W` and `INT_W` the list also gives, `ROUNDING` and `SATURATE`
+/// from `modes`, every other an integer; then `ROM_FILE` when the module reads a ROM image.
+pub(crate) fn leaf_params(
+    all: &[RtlParameter],
+    modes: Option<(Rounding, Overflow)>,
+    rom_file: Option<&str>,
+    what: &str,
+) -> Vec<Param> {
+    let width_of = |name: &str| {
+        all.iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, w)| *w as u32)
+            .unwrap_or_else(|| panic!("{what}: no {name} among the RTL parameters"))
+    };
+    // `X_W` and `X_F` describe one format: both say it.
+    let format_of = |prefix: &str| {
+        let fraction = all.iter().find(|(n, _)| *n == format!("{prefix}_F"))?.1;
+        Some(format!("s{}.{fraction}", width_of(&format!("{prefix}_W"))))
+    };
+    let mut params: Vec<Param> = all
+        .iter()
+        .filter(|(name, _)| !matches!(*name, "ROUNDING" | "SATURATE"))
+        .map(|&(name, value)| {
+            let coded = match name {
+                "KP" | "KI" => Some(name),
+                "INT_MIN" | "INT_MAX" => Some("INT"),
+                _ => None,
+            };
+            let pair = name
+                .strip_suffix("_W")
+                .or_else(|| name.strip_suffix("_F"))
+                .and_then(|prefix| Some((prefix, format_of(prefix)?)));
+            match (coded, pair) {
+                (Some(prefix), _) => {
+                    let format: Format = format_of(prefix)
+                        .and_then(|f| f.parse().ok())
+                        .unwrap_or_else(|| panic!("{what}: {prefix} has no format"));
+                    let comment = format!("{what}: {name} = {:e} ({format})", format.to_f64(value));
+                    signed(name, format.width, value, comment)
+                }
+                (None, Some((prefix, format))) => {
+                    Param::integer(name, value as i64, format!("{what}: {prefix} {format}"))
+                }
+                (None, None) => Param::integer(name, value as i64, format!("{what}: {name}")),
+            }
+        })
+        .collect();
+    if let Some((rounding, overflow)) = modes {
+        params.extend(mode_params(rounding, overflow));
+    }
+    if let Some(file) = rom_file {
+        params.push(Param::string("ROM_FILE", file, format!("{what} ROM image")));
+    }
+    params
+}
+
+/// A deterministic stream of pseudo-random words (SplitMix64): the same codes on every
+/// platform for one seed.
+pub(crate) struct Words(u64);
+
+impl Words {
+    /// The stream of `seed`.
+    pub(crate) fn new(seed: u64) -> Self {
+        Words(seed)
+    }
+
+    /// The next word.
+    pub(crate) fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    /// A code of `format` (up to 64 bits wide), uniform over its range.
+    pub(crate) fn code(&mut self, format: Format) -> i128 {
+        format.from_bits(u128::from(self.next()))
+    }
+}
+
+/// The vector builder of a block that drives its own stimulus (the gyro loop's leaf modules):
+/// the chain's samples are not used; `fill` pushes every row when the run ends.
+pub(crate) struct OwnStimulus<'a> {
+    block: Block,
+    fill: Box<dyn FnOnce(&mut Block) + 'a>,
+}
+
+impl<'a> OwnStimulus<'a> {
+    /// `block`'s builder, whose rows `fill` pushes.
+    pub(crate) fn boxed(
+        block: Block,
+        fill: impl FnOnce(&mut Block) + 'a,
+    ) -> Box<dyn VectorBuilder + 'a> {
+        Box::new(OwnStimulus {
+            block,
+            fill: Box::new(fill),
+        })
+    }
+}
+
+impl VectorBuilder for OwnStimulus<'_> {
+    fn reset(&mut self) {}
+
+    fn sample(&mut self, _sample: &crate::vectors::ChainSample) {}
+
+    fn finish(self: Box<Self>, _results: &mut crate::vectors::BlockResults) -> Block {
+        let OwnStimulus { mut block, fill } = *self;
+        fill(&mut block);
+        block
+    }
 }
 
 /// A flag's code.

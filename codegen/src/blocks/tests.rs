@@ -30,6 +30,14 @@ fn run_embedded(edit: impl FnOnce(&mut Config)) -> (Job, Run) {
     (job, run)
 }
 
+/// The run's block called `name`.
+fn named<'a>(run: &'a Run, name: &str) -> &'a crate::block::Block {
+    run.blocks
+        .iter()
+        .find(|b| b.name == name)
+        .unwrap_or_else(|| panic!("no {name} block in the run"))
+}
+
 /// Streamed rows give the bytes the kept rows give (one formatter), the entries name
 /// the files' real SHA-256 and size, a left-out block writes nothing, and without the CSV
 /// only the hex files are written.
@@ -92,6 +100,10 @@ fn the_default_run_fills_every_block_and_stays_within_the_bounds() {
             "kf",
             "top",
             "mean_filter",
+            "nco",
+            "demodulator",
+            "pi",
+            "cic",
             "gyro_loop",
             "system"
         ]
@@ -99,7 +111,7 @@ fn the_default_run_fills_every_block_and_stays_within_the_bounds() {
     // The system's run: both loops lock during the start-up, the chain then steps once
     // per decimated output, both gyros switch, and the estimator produces estimates.
     let system = super::system::recorded(&run).expect("a resonator package records the system");
-    assert_eq!(run.blocks[6].len(), system.samples);
+    assert_eq!(named(&run, "system").len(), system.samples);
     let lock = system.first_lock_sample.expect("both loops lock");
     assert!(lock < system.startup_samples, "{system:?}");
     assert_eq!(
@@ -119,9 +131,9 @@ fn the_default_run_fills_every_block_and_stays_within_the_bounds() {
     assert!(normal < record.switch_sample && reverse > record.switch_sample);
     assert!(reverse < record.samples);
     assert_eq!(record.outputs, record.samples / 1000);
-    assert_eq!(run.blocks[5].len(), record.samples);
+    assert_eq!(named(&run, "gyro_loop").len(), record.samples);
     // One row per sample plus the reset, in every chain block.
-    for b in [&run.blocks[0], &run.blocks[1], &run.blocks[3]] {
+    for b in ["sequencer", "estimator", "top"].map(|name| named(&run, name)) {
         assert_eq!(b.len(), 4001, "{}", b.name);
     }
     for name in ["kf", "chain", "bias"] {
@@ -135,9 +147,8 @@ fn the_default_run_fills_every_block_and_stays_within_the_bounds() {
         assert!(kf.ties(tie.rate_hat.expect("output tie"), tie.bw_sel)[2]);
     }
     // Every bw_sel value occurs in the top vectors.
-    let sels: std::collections::BTreeSet<i64> = (0..run.blocks[3].len())
-        .map(|k| run.blocks[3].row(k)[1])
-        .collect();
+    let top = named(&run, "top");
+    let sels: std::collections::BTreeSet<i64> = (0..top.len()).map(|k| top.row(k)[1]).collect();
     assert_eq!(sels.len(), 3);
 }
 
@@ -147,7 +158,7 @@ fn the_default_run_fills_every_block_and_stays_within_the_bounds() {
 fn the_mean_filter_vectors_cover_every_case_within_the_bound() {
     // r = 3 °/s, about 2.6 sigma of the default gyro: only the gross errors (8 r) go.
     let (_, run) = run_embedded(|config| config.mean_filter.threshold_dps = 3.0);
-    let block = &run.blocks[4];
+    let block = named(&run, "mean_filter");
     // rst, x, y_valid, y, kept
     let outputs: Vec<&[i64]> = (0..block.len())
         .map(|k| block.row(k))

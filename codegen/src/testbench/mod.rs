@@ -6,7 +6,9 @@
 //! the testbench's own), drive one sample per `ce` with an idle clock after every fourth, and
 //! compare: combinational outputs before the clock edge (not on reset samples), registered
 //! outputs 1 clock after it (gated ones only where their gate is expected 1), and on idle
-//! clocks pulses low and other registered outputs held. Both print the same lines:
+//! clocks pulses low and other registered outputs held. Inputs keep their values through the
+//! settle and idle clocks: a strobe that acts without `ce` (the PI's `preset`) acts there too,
+//! and the expected outputs say so ([`idle_clock_after`]). Both print the same lines:
 //!
 //! - `MISMATCH sample <k> signal <name> expected <hex> (<real>) actual <hex> (<real>)` for the
 //!   first mismatches,
@@ -29,6 +31,14 @@ use crate::block::Signal;
 
 pub mod verilog;
 pub mod vhdl;
+
+/// The testbenches add an idle clock (`ce` low) after every `IDLE_EVERY`-th sample.
+pub const IDLE_EVERY: usize = 4;
+
+/// Whether the testbenches add an idle clock after sample `index` (0-based).
+pub fn idle_clock_after(index: usize) -> bool {
+    index % IDLE_EVERY == IDLE_EVERY - 1
+}
 
 /// Mismatches printed unless the run says otherwise.
 pub const MAX_REPORTED: u32 = 10;

@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use super::{header, MAX_REPORTED};
+use super::{header, IDLE_EVERY, MAX_REPORTED};
 use crate::block::{Block, Output, Signal, Timing};
 use crate::text::{fill, Provenance};
 
@@ -251,7 +251,8 @@ fn sample_checks(block: &Block) -> String {
     // Idle clock: pulses low, other ungated registered outputs held.
     let _ = writeln!(
         out,
-        "        if (index % 4 == 3) begin\n            @(negedge clk);"
+        "        if (index % {IDLE_EVERY} == {}) begin\n            @(negedge clk);",
+        IDLE_EVERY - 1
     );
     for o in block
         .outputs

@@ -5,7 +5,7 @@
 
 use std::fmt::Write as _;
 
-use super::{header, timeout_clocks, MAX_REPORTED};
+use super::{header, timeout_clocks, IDLE_EVERY, MAX_REPORTED};
 use crate::block::{Block, Output, Signal, Timing};
 use crate::text::{fill, Provenance};
 
@@ -247,8 +247,9 @@ fn sample_checks(block: &Block) -> String {
     let _ = writeln!(
         out,
         "            end if;
-            if index mod 4 = 3 then
-                wait until falling_edge(clk);"
+            if index mod {IDLE_EVERY} = {} then
+                wait until falling_edge(clk);",
+        IDLE_EVERY - 1
     );
     let held: Vec<&Output> = block
         .outputs

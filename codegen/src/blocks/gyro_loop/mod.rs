@@ -16,7 +16,7 @@ use gyrofx_model::gyro_loop::gyro::Plan;
 use gyrofx_model::resonator::Mode;
 use serde_json::json;
 
-use super::{flag, mode_params, RomImages, RtlBlock};
+use super::{flag, mode_params, signed, RomImages, RtlBlock};
 use crate::block::{Block, Output, Param, Signal};
 use crate::block::{DpiParts, DpiStream};
 use crate::rom::Rom;
@@ -45,16 +45,6 @@ const RECORDED: &str = "recorded";
 /// Clocks from the `ce` of a sample to its registered outputs, less the one the testbench
 /// always allows (the RTL's four register stages).
 const SETTLE_CLOCKS: u32 = 3;
-
-/// A parameter holding a signed code of `width` bits.
-fn signed(name: &str, width: u32, code: i128, comment: impl Into<String>) -> Param {
-    let mask = if width >= 128 {
-        u128::MAX
-    } else {
-        (1u128 << width) - 1
-    };
-    Param::bits(name, width, (code as u128) & mask, comment)
-}
 
 /// Sub-block parameters under the top's prefix, except the rounding and overflow (the top's)
 /// and the PIs' codes ([`pi_codes`]).
