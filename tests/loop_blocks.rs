@@ -5,7 +5,7 @@
 //! block's own `push_vectors` drives it at small, wrapping and saturating formats, odd
 //! gains, a 63-bit accumulator, 74-bit CIC registers; `blocks_package` writes the block's
 //! folder as `generate` does, and the package's Makefile runs its generated testbenches in
-//! Icarus and GHDL. The Verilog also lints clean under `verilator -Wall` for several parameter
+//! Icarus and GHDL; so are the modules' own defaults (their RTL parameters' defaults). The Verilog also lints clean under `verilator -Wall` for several parameter
 //! sets and synthesizes in yosys without latches, and the RTL's defaults are the model's.
 
 use std::path::{Path, PathBuf};
@@ -76,6 +76,7 @@ fn rom_entry(rom: &Rom) -> (String, String) {
 fn the_nco_passes_at_other_widths() {
     let dir = tempfile::tempdir().unwrap();
     for (name, spec, seed) in [
+        ("default", nco_model::Spec::default(), 1),
         // A small ROM and a short accumulator.
         (
             "small",
@@ -162,6 +163,11 @@ fn the_demodulator_passes_where_it_wraps_and_saturates() {
         assert!(overflows > 0, "{name} exercises no overflow");
         assert_passes(dir.path(), name, block);
     }
+    // The module's own defaults (the RTL's parameter defaults), which no loop plan has.
+    let plan = demodulator_model::Plan::new(&demodulator_model::Spec::default()).unwrap();
+    let mut block = demodulator::block(&plan);
+    demodulator::push_vectors(&mut block, &plan, 5);
+    assert_passes(dir.path(), "default", block);
 }
 
 #[test]
@@ -242,6 +248,11 @@ fn the_pi_passes_with_other_gains_limits_and_formats() {
         assert!(overflows > 0, "{name} exercises no clamp or overflow");
         assert_passes(dir.path(), name, block);
     }
+    // The module's own defaults (the RTL's parameter defaults), which no loop plan has.
+    let plan = pi_model::Plan::new(&pi_model::Spec::default()).unwrap();
+    let mut block = pi::block(&plan);
+    pi::push_vectors(&mut block, &plan, 11);
+    assert_passes(dir.path(), "default", block);
 }
 
 #[test]
@@ -356,6 +367,11 @@ fn the_cic_passes_at_other_orders_rates_and_formats() {
         assert!(overflows > 0, "{name} exercises no overflow");
         assert_passes(dir.path(), name, block);
     }
+    // The module's own defaults (the RTL's parameter defaults).
+    let plan = cic_model::Plan::new(&cic_model::Spec::default()).unwrap();
+    let mut block = cic::block(&plan, rom_entry(&Rom::gyro_loop_cic(&plan)));
+    cic::push_vectors(&mut block, &plan, 12_000, 17);
+    assert_passes(dir.path(), "default", block);
 }
 
 #[test]
