@@ -1,6 +1,7 @@
 //! [`Block`]: one RTL module's verification vectors and everything its testbench needs to
 //! know — the DUT, its parameters and ROMs, the signals and when each is checked.
 
+use gyrofx_job::pipeline::Pipeline;
 use gyrofx_model::fx::Format;
 
 /// When an output is compared.
@@ -243,17 +244,12 @@ pub struct Block {
     count: usize,
     /// The files the rows were streamed to, after [`Block::finish_rows`].
     written: Vec<crate::package::FileEntry>,
-    /// Clocks the testbench waits after the one that follows `ce` before it compares the
-    /// registered outputs (0: they are valid 1 clock after `ce`): a pipelined block's extra
-    /// latency. `ce` stays low meanwhile, so samples come every `2 + settle_clocks` clocks at
-    /// most.
-    pub settle_clocks: u32,
+    /// Its pipeline ([`gyrofx_job::pipeline`]): when the registered outputs show a sample (the
+    /// testbench waits `settle_clocks` with `ce` low after the clock that follows `ce`) and how
+    /// soon the next sample may come.
+    pub pipeline: Pipeline,
     /// Whether the module has `clk`, `rst` and `ce` ports (a combinational block has none).
     pub clocked: bool,
-    /// The fewest clocks from one sample's `ce` to the next one's where the pipeline frees its
-    /// first stage before its outputs show (the KF: 3 with 4 clocks of latency); `None`:
-    /// `1 + settle_clocks` ([`Block::clocks_per_sample`]).
-    pub sample_spacing: Option<u32>,
     /// What its DPI-C testbench takes from it (`None`: it has no golden model to call).
     pub dpi: Option<DpiParts>,
     /// Its cocotb test module (`None`: it has no golden model to check against): the block's
@@ -317,7 +313,13 @@ impl Block {
 
     /// The fewest clocks from one sample's `ce` to the next one's.
     pub fn clocks_per_sample(&self) -> u32 {
-        self.sample_spacing.unwrap_or(1 + self.settle_clocks)
+        self.pipeline.min_clocks_per_sample
+    }
+
+    /// Clocks the testbench waits, `ce` low, after the clock that follows `ce` before it
+    /// compares the registered outputs.
+    pub fn settle_clocks(&self) -> u32 {
+        self.pipeline.settle_clocks()
     }
 
     /// `clk`, `rst`, `ce`, or none for a combinational block.
@@ -352,9 +354,8 @@ impl Block {
             },
             count: 0,
             written: Vec::new(),
-            settle_clocks: 0,
+            pipeline: gyrofx_job::pipeline::ONE_CLOCK,
             clocked: true,
-            sample_spacing: None,
             dpi: None,
             cocotb_test: None,
         }

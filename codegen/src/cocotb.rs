@@ -61,7 +61,7 @@ fn with_pipeline(test: &str, block: &Block) -> String {
         .lines()
         .map(|line| {
             if line.starts_with("OUTPUT_CLOCKS = ") {
-                format!("OUTPUT_CLOCKS = {}", block.settle_clocks)
+                format!("OUTPUT_CLOCKS = {}", block.settle_clocks())
             } else if line.starts_with("PIPELINE_CLOCKS = ") {
                 format!("PIPELINE_CLOCKS = {}", block.clocks_per_sample() - 1)
             } else {

@@ -151,8 +151,8 @@ pub(crate) fn block_manifest(block: &Block) -> serde_json::Value {
                 "format": o.signal.format.to_string(),
                 "checked": match o.timing {
                     Timing::Combinational => "before the clock edge that takes the sample (not on resets)".to_string(),
-                    Timing::Registered if block.settle_clocks == 0 => "1 clock after the sample's ce".to_string(),
-                    Timing::Registered => format!("{} clocks after the sample's ce (a pipeline of {} settle clocks)", 1 + block.settle_clocks, block.settle_clocks),
+                    Timing::Registered if block.settle_clocks() == 0 => "1 clock after the sample's ce".to_string(),
+                    Timing::Registered => format!("{} clocks after the sample's ce (a pipeline of {} settle clocks)", 1 + block.settle_clocks(), block.settle_clocks()),
                 },
                 "only_where": o.gate.map(|g| format!("{g} = 1")),
                 "pulse": o.pulse,

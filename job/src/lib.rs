@@ -17,5 +17,6 @@ pub mod gyros;
 pub mod hash;
 pub mod input;
 pub mod job;
+pub mod pipeline;
 pub mod recording;
 pub mod system;

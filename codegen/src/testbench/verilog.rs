@@ -133,7 +133,7 @@ pub fn testbench(block: &Block, provenance: &Provenance) -> String {
             ("params", &block.file("params.vh")),
             (
                 "timeout_clocks",
-                &super::timeout_clocks(block.len(), block.settle_clocks).to_string(),
+                &super::timeout_clocks(block.len(), block.settle_clocks()).to_string(),
             ),
             ("ports", &ports),
             ("instance", &instance(block)),
@@ -223,11 +223,11 @@ fn sample_checks(block: &Block) -> String {
         out,
         "        @(negedge clk);\n        rst = 1'b0;\n        ce = 1'b0;"
     );
-    if block.settle_clocks > 0 {
+    if block.settle_clocks() > 0 {
         let _ = writeln!(
             out,
             "        // The pipeline's latency: registered outputs settle these clocks later.\n        repeat ({}) @(negedge clk);",
-            block.settle_clocks
+            block.settle_clocks()
         );
     }
     for o in block

@@ -162,7 +162,7 @@ pub fn testbench(block: &Block, provenance: &Provenance) -> String {
             ("count", &block.len().to_string()),
             (
                 "timeout",
-                &timeout_clocks(block.len(), block.settle_clocks).to_string(),
+                &timeout_clocks(block.len(), block.settle_clocks()).to_string(),
             ),
             ("signals", &lines(signals)),
             ("generics", &generics.join(",\n")),
@@ -214,14 +214,14 @@ fn sample_checks(block: &Block) -> String {
             rst <= '0';
             ce <= '0';"
     );
-    if block.settle_clocks > 0 {
+    if block.settle_clocks() > 0 {
         let _ = writeln!(
             out,
             "            -- The pipeline's latency: registered outputs settle these clocks later.
             for settle in 1 to {} loop
                 wait until falling_edge(clk);
             end loop;",
-            block.settle_clocks
+            block.settle_clocks()
         );
     }
     let _ = writeln!(out, "            if not masked then");

@@ -14,6 +14,7 @@ use super::{flag, leaf_params, OwnStimulus, RomImages, RtlBlock, Words};
 use crate::block::{Block, Output, Signal};
 use crate::vectors::VectorBuilder;
 use gyrofx_job::job::Job;
+use gyrofx_job::pipeline;
 
 /// The CIC block.
 pub struct Cic;
@@ -68,6 +69,7 @@ pub fn block(plan: &Plan, rom: (String, String)) -> Block {
             Output::pulse(Signal::flag("y_valid")),
         ],
     );
+    block.pipeline = pipeline::ONE_CLOCK;
     block.params = leaf_params(
         &plan.rtl_parameters(),
         Some((plan.output.rounding, plan.output.overflow)),

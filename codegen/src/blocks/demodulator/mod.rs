@@ -16,6 +16,7 @@ use super::{flag, leaf_params, OwnStimulus, RomImages, RtlBlock, Words};
 use crate::block::{Block, Output, Signal};
 use crate::vectors::VectorBuilder;
 use gyrofx_job::job::Job;
+use gyrofx_job::pipeline;
 
 /// The demodulator block.
 pub struct Demodulator;
@@ -80,6 +81,7 @@ pub fn block(plan: &Plan) -> Block {
             Output::pulse(Signal::flag("out_valid")),
         ],
     );
+    block.pipeline = pipeline::ONE_CLOCK;
     block.params = leaf_params(
         &plan.rtl_parameters(),
         Some((plan.output.rounding, plan.output.overflow)),

@@ -12,15 +12,10 @@ use crate::stats::Accumulator;
 use crate::text::fill;
 use crate::vectors::{BlockResults, ChainSample, Run, VectorBuilder};
 use gyrofx_job::job::Job;
+use gyrofx_job::pipeline;
 
 /// The estimator block.
 pub struct Estimator;
-
-/// Clocks after the one that follows `ce` before the estimates show a window's end: the
-/// estimator's pipeline (sums, products by 1/(L − M), means, gain products, dot products;
-/// `hdl/gyrofx_bias_estimator.v`). A sample's calibration reads the estimates, so samples come
-/// at most every `SETTLE_CLOCKS + 1` clocks.
-pub const SETTLE_CLOCKS: u32 = 5;
 
 /// Name of its gain ROM.
 pub const ROM: &str = "estimator_gains";
@@ -105,7 +100,7 @@ impl RtlBlock for Estimator {
             .params
             .push(Param::string("ROM_FILE", &rom.0, "gain ROM"));
         block.roms.push(rom);
-        block.settle_clocks = SETTLE_CLOCKS;
+        block.pipeline = pipeline::ESTIMATOR;
         block
     }
 
@@ -137,8 +132,8 @@ impl RtlBlock for Estimator {
                     "stagger": est.schedule.stagger,
                 },
                 "rate_order": est.rate_order,
-                "latency_clocks": SETTLE_CLOCKS + 1,
-                "min_clocks_per_sample": SETTLE_CLOCKS + 1,
+                "latency_clocks": pipeline::ESTIMATOR.latency_clocks,
+                "min_clocks_per_sample": pipeline::ESTIMATOR.min_clocks_per_sample,
                 "formats": {
                     "input": est.input.to_string(),
                     "accumulator": est.accumulator.to_string(),
@@ -230,9 +225,9 @@ const DPI: DpiParts = DpiParts {
 };
 
 /// One sample of the DPI-C testbench's stimulus loop.
-fn dpi_step(_block: &Block) -> String {
+fn dpi_step(block: &Block) -> String {
     fill(
         include_str!("dpi_step.sv").trim_end(),
-        &[("settle", &SETTLE_CLOCKS.to_string())],
+        &[("settle", &block.settle_clocks().to_string())],
     )
 }

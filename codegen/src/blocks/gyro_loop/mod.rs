@@ -23,6 +23,7 @@ use crate::rom::Rom;
 use crate::vectors::{BlockResults, ChainSample, Run, VectorBuilder};
 use gyrofx_job::config::GyroLoop as LoopConfig;
 use gyrofx_job::job::Job;
+use gyrofx_job::pipeline;
 
 /// The gyro-loop block.
 pub struct GyroLoop;
@@ -41,10 +42,6 @@ pub const RATE_DPS: f64 = 10.0;
 
 /// Key of what the recorded run covered ([`RecordSummary`]) among the block's manifest facts.
 const RECORDED: &str = "recorded";
-
-/// Clocks from the `ce` of a sample to its registered outputs, less the one the testbench
-/// always allows (the RTL's four register stages).
-const SETTLE_CLOCKS: u32 = 3;
 
 /// Sub-block parameters under the top's prefix, except the rounding and overflow (the top's)
 /// and the PIs' codes ([`pi_codes`]).
@@ -280,7 +277,7 @@ impl RtlBlock for GyroLoop {
         );
         block.dpi = Some(DPI);
         block.cocotb_test = Some(include_str!("cocotb_test.py"));
-        block.settle_clocks = SETTLE_CLOCKS;
+        block.pipeline = pipeline::GYRO_LOOP;
         block.params = parameters(plan, &roms.entry(SINE_ROM).0, &roms.entry(TAPS_ROM).0);
         block.roms.push(roms.entry(SINE_ROM));
         block.roms.push(roms.entry(TAPS_ROM));
@@ -309,8 +306,8 @@ impl RtlBlock for GyroLoop {
                 "adc_rate_hz": plan.adc_rate_hz,
                 "decimation": plan.cic.decimation,
                 "latency_samples": plan.latency,
-                "latency_clocks": SETTLE_CLOCKS + 1,
-                "min_clocks_per_sample": SETTLE_CLOCKS + 1,
+                "latency_clocks": pipeline::GYRO_LOOP.latency_clocks,
+                "min_clocks_per_sample": pipeline::GYRO_LOOP.min_clocks_per_sample,
                 "formats": {
                     "adc": plan.adc.to_string(),
                     "nco": plan.nco.output.to_string(),

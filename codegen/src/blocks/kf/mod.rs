@@ -16,13 +16,10 @@ use crate::stats::Accumulator;
 use crate::text::fill;
 use crate::vectors::{BlockResults, ChainSample, KfCounts, Run, VectorBuilder};
 use gyrofx_job::job::Job;
+use gyrofx_job::pipeline;
 
 /// The KF block.
 pub struct Kf;
-
-/// Clocks after the one that follows `ce` before `rate_out` and `out_valid` show the sample:
-/// the KF's pipeline (e, products, states, output rounding; `hdl/gyrofx_kf.v`).
-pub const SETTLE_CLOCKS: u32 = 3;
 
 /// Name of its coefficient ROM.
 pub const ROM: &str = "kf_coefficients";
@@ -109,9 +106,8 @@ impl RtlBlock for Kf {
         );
         block.dpi = Some(DPI);
         block.cocotb_test = Some(include_str!("cocotb_test.py"));
-        block.settle_clocks = SETTLE_CLOCKS;
+        block.pipeline = pipeline::KF;
         // The next sample's `e` needs only the new states, not the rounded output.
-        block.sample_spacing = Some(SETTLE_CLOCKS);
         block.params = params(kf);
         block.params.extend(mode_params(kf.rounding, kf.overflow));
         let rom = roms.entry(ROM);
@@ -160,8 +156,8 @@ impl RtlBlock for Kf {
                     "sum_x2": kf.sum[1].to_string(),
                 },
                 "guard_bits": kf.guard_bits(),
-                "latency_clocks": SETTLE_CLOCKS + 1,
-                "min_clocks_per_sample": SETTLE_CLOCKS,
+                "latency_clocks": pipeline::KF.latency_clocks,
+                "min_clocks_per_sample": pipeline::KF.min_clocks_per_sample,
                 "designs": report::designs(&job.designs, kf),
                 "coefficients": report::coefficients(kf),
                 "rom": {"file": RomFormat::Mem.file_name(&rom.rom.name), "depth": kf.rom.len(), "word_bits": rom.rom.width(), "all_formats": ROM_FOLDER,
@@ -303,7 +299,7 @@ fn directed_segment(plan: &Plan, ties: &[TieCases], block: &mut Block) -> Overfl
     kf.overflow_counts()
 }
 
-/// The DPI-C testbench's parts ([`DpiParts`]): one sample every `SETTLE_CLOCKS` clocks, the rate
+/// The DPI-C testbench's parts ([`DpiParts`]): one sample every `pipeline::KF.min_clocks_per_sample` clocks, the rate
 /// against the model as a stream.
 const DPI: DpiParts = DpiParts {
     imports: include_str!("dpi_imports.svh"),
@@ -318,12 +314,13 @@ const DPI: DpiParts = DpiParts {
 };
 
 /// One sample of the DPI-C testbench's stimulus loop.
-fn dpi_step(_block: &Block) -> String {
+fn dpi_step(block: &Block) -> String {
+    let every = block.clocks_per_sample();
     fill(
         include_str!("dpi_step.sv").trim_end(),
         &[
-            ("idle", &(SETTLE_CLOCKS - 1).to_string()),
-            ("every", &SETTLE_CLOCKS.to_string()),
+            ("idle", &(every - 1).to_string()),
+            ("every", &every.to_string()),
         ],
     )
 }

@@ -13,6 +13,7 @@ use crate::stats::Accumulator;
 use crate::vectors::{BlockResults, ChainSample, Run, VectorBuilder};
 use gyrofx_job::config::Architecture;
 use gyrofx_job::job::Job;
+use gyrofx_job::pipeline;
 
 /// The mean-filter block.
 pub struct MeanFilter;
@@ -67,6 +68,7 @@ impl RtlBlock for MeanFilter {
         );
         block.dpi = Some(DPI);
         block.cocotb_test = Some(include_str!("cocotb_test.py"));
+        block.pipeline = pipeline::mean_filter(job);
         block
             .params
             .extend(Param::format("IN", plan.input, "input x"));
@@ -97,8 +99,6 @@ impl RtlBlock for MeanFilter {
                 plan.threshold_code as u128,
                 format!("r in input LSB ({} °/s)", plan.threshold_dps()),
             ));
-            // The registered outputs show a block's mean this many clocks after its last ce.
-            block.settle_clocks = serial::latency_clocks(plan) - 1;
         } else {
             block.params.push(Param::integer(
                 "DEV_W",
@@ -151,22 +151,15 @@ impl RtlBlock for MeanFilter {
         // Parallel: a sample every clock, the mean 1 clock after a block's last, every sample
         // compared by its deviation L·x − sum. Serial: the next ce or rst no sooner than the
         // mean, the samples compared with a kept range.
-        let (architecture, module, latency, min_spacing, (compared, compared_format)) =
-            match job.settings.architecture {
-                Architecture::Parallel => {
-                    ("parallel", self.module(), 1, 1, ("deviation", mf.deviation))
-                }
-                Architecture::Serial => {
-                    let latency = serial::latency_clocks(mf);
-                    (
-                        "serial",
-                        SERIAL_MODULE,
-                        latency,
-                        latency,
-                        ("kept_range", serial::kept_range_format(mf)),
-                    )
-                }
-            };
+        let (architecture, module, (compared, compared_format)) = match job.settings.architecture {
+            Architecture::Parallel => ("parallel", self.module(), ("deviation", mf.deviation)),
+            Architecture::Serial => (
+                "serial",
+                SERIAL_MODULE,
+                ("kept_range", serial::kept_range_format(mf)),
+            ),
+        };
+        let timing = pipeline::mean_filter(job);
         let section = json!({
                 "window": mf.window,
                 "threshold_dps": job.config.mean_filter.threshold_dps,
@@ -185,8 +178,8 @@ impl RtlBlock for MeanFilter {
                 "stimulus": "gyro A's ADC samples with a gross error of 8 r every 53rd sample, the chain's reset, then directed blocks (samples at exactly r, at r + 1 LSB, all rejected, full scale, a full-scale spike)",
                 "architecture": architecture,
                 "module": module,
-                "latency_clocks": latency,
-                "min_clocks_per_sample": min_spacing,
+                "latency_clocks": timing.latency_clocks,
+                "min_clocks_per_sample": timing.min_clocks_per_sample,
                 "fixed_vs_float": run.stats("mean_filter"),
         });
         Some(("mean_filter", section))
@@ -325,11 +318,11 @@ const DPI: DpiParts = DpiParts {
 /// One sample of the DPI-C testbench's stimulus loop.
 fn dpi_step(block: &Block) -> String {
     let mut step = include_str!("dpi_step.sv").trim_end().to_string();
-    if block.settle_clocks > 0 {
+    if block.settle_clocks() > 0 {
         // The sequential filter: the next sample once a block's mean is out.
         step.push_str(&format!(
             "\n            @(negedge clk);\n            ce = 1'b0;\n            repeat ({}) @(posedge clk);",
-            block.settle_clocks
+            block.settle_clocks()
         ));
     }
     step

@@ -15,6 +15,7 @@ use super::{flag, leaf_params, OwnStimulus, RomImages, RtlBlock, Words};
 use crate::block::{Block, Output, Signal};
 use crate::vectors::VectorBuilder;
 use gyrofx_job::job::Job;
+use gyrofx_job::pipeline;
 
 /// The NCO block.
 pub struct Nco;
@@ -78,6 +79,7 @@ pub fn block(plan: &Plan, rom: (String, String)) -> Block {
             Output::pulse(Signal::flag("out_valid")),
         ],
     );
+    block.pipeline = pipeline::ONE_CLOCK;
     block.params = leaf_params(&plan.rtl_parameters(), None, Some(&rom.0), "NCO");
     block.roms.push(rom);
     block

@@ -16,6 +16,7 @@ use crate::block::{Block, Output, Signal};
 use crate::testbench::idle_clock_after;
 use crate::vectors::VectorBuilder;
 use gyrofx_job::job::Job;
+use gyrofx_job::pipeline;
 
 /// The PI block.
 pub struct Pi;
@@ -77,6 +78,7 @@ pub fn block(plan: &Plan) -> Block {
             Output::pulse(Signal::flag("out_valid")),
         ],
     );
+    block.pipeline = pipeline::ONE_CLOCK;
     block.params = leaf_params(
         &plan.rtl_parameters(),
         Some((plan.output.rounding, plan.output.overflow)),

@@ -9,6 +9,7 @@ use crate::block::DpiParts;
 use crate::block::{Block, Output, Param, Signal};
 use crate::vectors::{BlockResults, ChainSample, VectorBuilder};
 use gyrofx_job::job::Job;
+use gyrofx_job::pipeline;
 
 /// The sequencer block.
 pub struct Sequencer;
@@ -106,6 +107,7 @@ impl RtlBlock for Sequencer {
             ],
         );
         block.dpi = Some(DPI);
+        block.pipeline = pipeline::SEQUENCER;
         block.cocotb_test = Some(include_str!("cocotb_test.py"));
         block.params = params(schedule);
         block

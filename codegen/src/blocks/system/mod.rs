@@ -28,6 +28,7 @@ use crate::vectors::{BlockResults, ChainSample, Run, VectorBuilder};
 use gyrofx_job::config::GyroLoop as LoopConfig;
 use gyrofx_job::error::{Error, Result};
 use gyrofx_job::job::Job;
+use gyrofx_job::pipeline;
 
 use crate::block::{DpiParts, DpiStream};
 use crate::text::fill;
@@ -49,11 +50,6 @@ pub const STARTUP_S: f64 = 0.1;
 const RECORDED: &str = "recorded";
 /// Input rate of the recorded run, °/s.
 pub const RATE_DPS: f64 = 10.0;
-
-/// Clocks from the `ce` of an ADC sample to the chain's registered outputs, less the one the
-/// testbench always allows: the loop's four stages, then the chain's six
-/// ([`super::top::SETTLE_CLOCKS`] + 1).
-pub const SETTLE_CLOCKS: u32 = 4 + super::top::SETTLE_CLOCKS;
 
 /// Whether loop parameter `name` differs between the gyros (each loop gets its own, `A_` or
 /// `B_` prefixed): the per-mode values and everything designed from the gyro's physics.
@@ -215,7 +211,7 @@ impl RtlBlock for System {
         );
         block.dpi = Some(DPI);
         block.cocotb_test = Some(include_str!("cocotb_test.py"));
-        block.settle_clocks = SETTLE_CLOCKS;
+        block.pipeline = pipeline::SYSTEM;
         let gains = roms.entry(GAINS_ROM);
         let coefficients = roms.entry(kf::ROM);
         block.params = top::chain_params(plan, &gains.0, &coefficients.0);
@@ -259,8 +255,8 @@ impl RtlBlock for System {
             json!({
                 "adc_rate_hz": lp.adc_rate_hz,
                 "decimation": lp.cic.decimation,
-                "latency_clocks": SETTLE_CLOCKS + 1,
-                "min_clocks_per_sample": SETTLE_CLOCKS + 1,
+                "latency_clocks": pipeline::SYSTEM.latency_clocks,
+                "min_clocks_per_sample": pipeline::SYSTEM.min_clocks_per_sample,
                 "schedule": {
                     "interval_length": schedule.interval_length,
                     "intervals": schedule.intervals,
@@ -431,10 +427,10 @@ const DPI: DpiParts = DpiParts {
 };
 
 /// One sample of the DPI-C testbench's stimulus loop.
-fn dpi_step(_block: &Block) -> String {
+fn dpi_step(block: &Block) -> String {
     fill(
         include_str!("dpi_step.sv").trim_end(),
-        &[("settle", &SETTLE_CLOCKS.to_string())],
+        &[("settle", &block.settle_clocks().to_string())],
     )
 }
 

@@ -15,14 +15,10 @@ use crate::stats::Accumulator;
 use crate::text::fill;
 use crate::vectors::{BlockResults, ChainSample, Run, VectorBuilder};
 use gyrofx_job::job::Job;
+use gyrofx_job::pipeline;
 
 /// The top block.
 pub struct Top;
-
-/// Clocks after the one that follows `ce` before the chain's registered outputs show the
-/// sample: the estimator's pipeline ([`super::estimator::SETTLE_CLOCKS`]); the rate comes as
-/// late (calibration register, the KF's pipeline, one output register).
-pub const SETTLE_CLOCKS: u32 = super::estimator::SETTLE_CLOCKS;
 
 /// `gyrofx_top`'s parameters for `plan`, its ROMs read from `gain_rom_file` and
 /// `kf_rom_file`: the submodules' parameters, each once — the sequencer's schedule, the
@@ -182,13 +178,13 @@ impl RtlBlock for Top {
         block.dpi = Some(DPI);
         block.cocotb_test = Some(include_str!("cocotb_test.py"));
         block.extra = vec!["float_rate_dps", "ideal_rate_dps", "true_rate_dps"];
+        block.pipeline = pipeline::top(job);
         if let Some(program) = &job.serial {
             let code = roms.entry(SERIAL_PROGRAM_ROM);
             let limbs = roms.entry(SERIAL_COEFFICIENT_ROM);
             block.module = "gyrofx_top_serial";
             block.title = "the whole mode-reversal chain, time-multiplexed";
             block.params = serial_params(&job.chain, program, &code.0, &limbs.0);
-            block.settle_clocks = program.settle_clocks();
             block.roms.push(code);
             block.roms.push(limbs);
             return block;
@@ -196,7 +192,6 @@ impl RtlBlock for Top {
         let gains = roms.entry(estimator::ROM);
         let coefficients = roms.entry(kf::ROM);
         block.params = chain_params(&job.chain, &gains.0, &coefficients.0);
-        block.settle_clocks = SETTLE_CLOCKS;
         block.roms.push(gains);
         block.roms.push(coefficients);
         block
@@ -221,16 +216,18 @@ impl RtlBlock for Top {
         run: &Run,
     ) -> Option<(&'static str, serde_json::Value)> {
         let est = &job.chain.estimator;
-        let (architecture, settle) = match &job.serial {
-            Some(program) => ("serial", program.settle_clocks()),
-            None => ("parallel", SETTLE_CLOCKS),
+        let architecture = if job.serial.is_some() {
+            "serial"
+        } else {
+            "parallel"
         };
+        let timing = pipeline::top(job);
         let mut chain = json!({
             "rounding": est.rounding.name(),
             "overflow": est.overflow.name(),
             "architecture": architecture,
-            "latency_clocks": settle + 1,
-            "min_clocks_per_sample": settle + 1,
+            "latency_clocks": timing.latency_clocks,
+            "min_clocks_per_sample": timing.min_clocks_per_sample,
             "fixed_vs_float": run.stats("chain"),
         });
         if let Some(program) = &job.serial {
@@ -335,6 +332,6 @@ const DPI: DpiParts = DpiParts {
 fn dpi_step(block: &Block) -> String {
     fill(
         include_str!("dpi_step.sv").trim_end(),
-        &[("settle", &block.settle_clocks.to_string())],
+        &[("settle", &block.settle_clocks().to_string())],
     )
 }
