@@ -74,11 +74,13 @@ class Plan:
         """The simulated resonator; seed defaults to generate's (2·seed, 2·seed + 1)."""
 
 class Kf:
-    """The bit-accurate steady-state KF (gyrofx_kf); rate_out follows z by one clock in the RTL."""
+    """The bit-accurate steady-state KF (gyrofx_kf); the RTL shows rate_out latency_clocks after
+    the sample's ce and takes a sample at most every min_clocks_per_sample clocks."""
 
     input_format: str
     output_format: str
     latency_clocks: int
+    min_clocks_per_sample: int
     def reset(self) -> None: ...
     def step(self, z: int, bw_sel: int = 0) -> int:
         """One step: ``z`` (input-format code) -> ``rate_out`` (output-format code)."""
@@ -98,6 +100,8 @@ class KfFloat:
 class Sequencer:
     """The mode-reversal sequencer (gyrofx_sequencer): combinational slot outputs per clock."""
 
+    latency_clocks: int
+    min_clocks_per_sample: int
     def reset(self) -> None: ...
     def step(self) -> Dict[str, int]:
         """mode_a, mode_b, blank_a, blank_b, interval_a, interval_b, done_a, done_b,
@@ -107,6 +111,8 @@ class Sequencer:
 class Estimator:
     """The least-squares bias estimator (gyrofx_bias_estimator)."""
 
+    latency_clocks: int
+    min_clocks_per_sample: int
     input_format: str
     bias_format: str
     def reset(self) -> None: ...
@@ -156,6 +162,8 @@ class EstimatorFloat:
 class MeanFilter:
     """The mean filter with gross-error rejection (gyrofx_mean_filter)."""
 
+    latency_clocks: int
+    min_clocks_per_sample: int
     window: int
     input_format: str
     output_format: str
@@ -174,6 +182,8 @@ class MeanFilterFloat:
 class Chain:
     """The whole chain (gyrofx_top): sequencer, estimator, calibration and KF."""
 
+    latency_clocks: int
+    min_clocks_per_sample: int
     def reset(self) -> None: ...
     def next_modes(self) -> Tuple[int, int]:
         """The modes the next step runs in (what a plant needs first)."""
@@ -197,6 +207,8 @@ class GyroLoop:
     axes and the mode (1 normal, 0 reverse) in; DAC codes, locked, and every decimation-th
     sample the rate and quadrature (°/s codes, held between out_valid pulses) out."""
 
+    latency_clocks: int
+    min_clocks_per_sample: int
     adc_rate_hz: float
     decimation: int
     adc_format: str
@@ -220,6 +232,8 @@ class System:
     """The whole gyro at the ADC rate (gyrofx_system): both loops and the chain, whose
     sequencer commands the loops' modes. enable 0 holds the chain (start-up)."""
 
+    latency_clocks: int
+    min_clocks_per_sample: int
     decimation: int
     window: int
     def reset(self) -> None: ...

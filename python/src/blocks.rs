@@ -13,6 +13,7 @@ use gyrofx_job::golden::{
     self, check_bw_sel, check_codes, slot_from_ports, CHAIN_OUTPUTS, ESTIMATOR_OUTPUTS,
     ESTIMATOR_SLOT_PORTS, SLOT_PORTS,
 };
+use gyrofx_job::pipeline::Pipeline;
 use gyrofx_model::chain::{self, FloatChain};
 use gyrofx_model::estimator::{self, FloatEstimator};
 use gyrofx_model::fx::Format;
@@ -96,23 +97,40 @@ impl PerSample<'_> {
     }
 }
 
-/// The bit-accurate steady-state KF (`gyrofx_kf`): one step per clock, output registered with
-/// `out_valid` one clock later in the RTL (the model returns it at once).
+/// The bit-accurate steady-state KF (`gyrofx_kf`): one step per sample; the RTL shows the
+/// output with `out_valid` `latency_clocks` after the sample's `ce` and takes a sample at most
+/// every `min_clocks_per_sample` clocks (the model returns the output at once).
 #[pyclass(module = "gyrofx")]
 pub(crate) struct Kf {
     ports: golden::Kf,
+    pipeline: Pipeline,
 }
 
 impl Kf {
-    pub(crate) fn new(plan: &kf::Plan) -> Kf {
+    pub(crate) fn new(plan: &kf::Plan, pipeline: Pipeline) -> Kf {
         Kf {
             ports: golden::Kf::new(plan),
+            pipeline,
         }
     }
 }
 
 #[pymethods]
 impl Kf {
+    /// Clocks from a sample's `ce` to its registered outputs in the RTL (`gyrofx_job::pipeline`,
+    /// as the manifest and the testbenches have it).
+    #[getter]
+    fn latency_clocks(&self) -> u32 {
+        self.pipeline.latency_clocks
+    }
+
+    /// The fewest clocks from one sample's `ce` to the next one's in the RTL (its simulation
+    /// stops on a faster stream).
+    #[getter]
+    fn min_clocks_per_sample(&self) -> u32 {
+        self.pipeline.min_clocks_per_sample
+    }
+
     /// Clears the state (the RTL's synchronous reset).
     fn reset(&mut self) {
         self.ports.reset();
@@ -188,12 +206,6 @@ impl Kf {
     #[getter]
     fn output_format(&self) -> String {
         self.ports.plan().output.to_string()
-    }
-
-    /// Clocks from `z` to `rate_out` in the reference RTL.
-    #[getter]
-    fn latency_clocks(&self) -> u32 {
-        1
     }
 }
 
@@ -271,18 +283,34 @@ pub(crate) fn port_dict<'py, const N: usize>(
 #[pyclass(module = "gyrofx")]
 pub(crate) struct Sequencer {
     ports: golden::Sequencer,
+    pipeline: Pipeline,
 }
 
 impl Sequencer {
-    pub(crate) fn new(schedule: &Schedule) -> Sequencer {
+    pub(crate) fn new(schedule: &Schedule, pipeline: Pipeline) -> Sequencer {
         Sequencer {
             ports: golden::Sequencer::new(schedule),
+            pipeline,
         }
     }
 }
 
 #[pymethods]
 impl Sequencer {
+    /// Clocks from a sample's `ce` to its registered outputs in the RTL (`gyrofx_job::pipeline`,
+    /// as the manifest and the testbenches have it).
+    #[getter]
+    fn latency_clocks(&self) -> u32 {
+        self.pipeline.latency_clocks
+    }
+
+    /// The fewest clocks from one sample's `ce` to the next one's in the RTL (its simulation
+    /// stops on a faster stream).
+    #[getter]
+    fn min_clocks_per_sample(&self) -> u32 {
+        self.pipeline.min_clocks_per_sample
+    }
+
     /// Back to the first sample of the first interval.
     fn reset(&mut self) {
         self.ports.reset();
@@ -318,18 +346,34 @@ impl Sequencer {
 #[pyclass(module = "gyrofx")]
 pub(crate) struct Estimator {
     ports: golden::Estimator,
+    pipeline: Pipeline,
 }
 
 impl Estimator {
-    pub(crate) fn new(plan: &estimator::Plan) -> Estimator {
+    pub(crate) fn new(plan: &estimator::Plan, pipeline: Pipeline) -> Estimator {
         Estimator {
             ports: golden::Estimator::new(plan),
+            pipeline,
         }
     }
 }
 
 #[pymethods]
 impl Estimator {
+    /// Clocks from a sample's `ce` to its registered outputs in the RTL (`gyrofx_job::pipeline`,
+    /// as the manifest and the testbenches have it).
+    #[getter]
+    fn latency_clocks(&self) -> u32 {
+        self.pipeline.latency_clocks
+    }
+
+    /// The fewest clocks from one sample's `ce` to the next one's in the RTL (its simulation
+    /// stops on a faster stream).
+    #[getter]
+    fn min_clocks_per_sample(&self) -> u32 {
+        self.pipeline.min_clocks_per_sample
+    }
+
     /// Clears the sums and the estimates.
     fn reset(&mut self) {
         self.ports.reset();
@@ -506,18 +550,34 @@ impl EstimatorFloat {
 #[pyclass(module = "gyrofx")]
 pub(crate) struct MeanFilter {
     ports: golden::MeanFilter,
+    pipeline: Pipeline,
 }
 
 impl MeanFilter {
-    pub(crate) fn new(plan: &mean_filter::Plan) -> MeanFilter {
+    pub(crate) fn new(plan: &mean_filter::Plan, pipeline: Pipeline) -> MeanFilter {
         MeanFilter {
             ports: golden::MeanFilter::new(plan),
+            pipeline,
         }
     }
 }
 
 #[pymethods]
 impl MeanFilter {
+    /// Clocks from a sample's `ce` to its registered outputs in the RTL (`gyrofx_job::pipeline`,
+    /// as the manifest and the testbenches have it).
+    #[getter]
+    fn latency_clocks(&self) -> u32 {
+        self.pipeline.latency_clocks
+    }
+
+    /// The fewest clocks from one sample's `ce` to the next one's in the RTL (its simulation
+    /// stops on a faster stream).
+    #[getter]
+    fn min_clocks_per_sample(&self) -> u32 {
+        self.pipeline.min_clocks_per_sample
+    }
+
     /// Drops the current block's samples.
     fn reset(&mut self) {
         self.ports.reset();
@@ -604,18 +664,34 @@ impl MeanFilterFloat {
 #[pyclass(module = "gyrofx")]
 pub(crate) struct Chain {
     ports: golden::Chain,
+    pipeline: Pipeline,
 }
 
 impl Chain {
-    pub(crate) fn new(plan: &chain::Plan) -> Chain {
+    pub(crate) fn new(plan: &chain::Plan, pipeline: Pipeline) -> Chain {
         Chain {
             ports: golden::Chain::new(plan),
+            pipeline,
         }
     }
 }
 
 #[pymethods]
 impl Chain {
+    /// Clocks from a sample's `ce` to its registered outputs in the RTL (`gyrofx_job::pipeline`,
+    /// as the manifest and the testbenches have it).
+    #[getter]
+    fn latency_clocks(&self) -> u32 {
+        self.pipeline.latency_clocks
+    }
+
+    /// The fewest clocks from one sample's `ce` to the next one's in the RTL (its simulation
+    /// stops on a faster stream).
+    #[getter]
+    fn min_clocks_per_sample(&self) -> u32 {
+        self.pipeline.min_clocks_per_sample
+    }
+
     /// Clears every block.
     fn reset(&mut self) {
         self.ports.reset();

@@ -11,6 +11,7 @@ use pyo3::types::PyDict;
 
 use gyrofx_job::config::GyroLoop as LoopConfig;
 use gyrofx_job::golden::{self, check_code, GYRO_LOOP_OUTPUTS, SYSTEM_OUTPUTS};
+use gyrofx_job::pipeline::Pipeline;
 use gyrofx_model::chain;
 use gyrofx_model::gyro_loop::gyro::{FloatGyroLoop, Plan as LoopPlan};
 use gyrofx_model::resonator::{Mode, Resonator as PhysicalResonator};
@@ -24,18 +25,34 @@ use crate::refused;
 #[pyclass(module = "gyrofx")]
 pub(crate) struct GyroLoop {
     ports: golden::GyroLoop,
+    pipeline: Pipeline,
 }
 
 impl GyroLoop {
-    pub(crate) fn new(plan: &LoopPlan) -> GyroLoop {
+    pub(crate) fn new(plan: &LoopPlan, pipeline: Pipeline) -> GyroLoop {
         GyroLoop {
             ports: golden::GyroLoop::new(plan),
+            pipeline,
         }
     }
 }
 
 #[pymethods]
 impl GyroLoop {
+    /// Clocks from a sample's `ce` to its registered outputs in the RTL (`gyrofx_job::pipeline`,
+    /// as the manifest and the testbenches have it).
+    #[getter]
+    fn latency_clocks(&self) -> u32 {
+        self.pipeline.latency_clocks
+    }
+
+    /// The fewest clocks from one sample's `ce` to the next one's in the RTL (its simulation
+    /// stops on a faster stream).
+    #[getter]
+    fn min_clocks_per_sample(&self) -> u32 {
+        self.pipeline.min_clocks_per_sample
+    }
+
     /// Clears every register (the RTL's synchronous reset): normal mode, PLL preset.
     fn reset(&mut self) {
         self.ports.reset();
@@ -174,18 +191,34 @@ impl GyroLoopFloat {
 #[pyclass(module = "gyrofx")]
 pub(crate) struct System {
     ports: golden::System,
+    pipeline: Pipeline,
 }
 
 impl System {
-    pub(crate) fn new(loops: [&LoopPlan; 2], chain: &chain::Plan) -> System {
+    pub(crate) fn new(loops: [&LoopPlan; 2], chain: &chain::Plan, pipeline: Pipeline) -> System {
         System {
             ports: golden::System::new(loops, chain),
+            pipeline,
         }
     }
 }
 
 #[pymethods]
 impl System {
+    /// Clocks from a sample's `ce` to its registered outputs in the RTL (`gyrofx_job::pipeline`,
+    /// as the manifest and the testbenches have it).
+    #[getter]
+    fn latency_clocks(&self) -> u32 {
+        self.pipeline.latency_clocks
+    }
+
+    /// The fewest clocks from one sample's `ce` to the next one's in the RTL (its simulation
+    /// stops on a faster stream).
+    #[getter]
+    fn min_clocks_per_sample(&self) -> u32 {
+        self.pipeline.min_clocks_per_sample
+    }
+
     /// Clears every register.
     fn reset(&mut self) {
         self.ports.reset();

@@ -9,6 +9,7 @@ use pyo3::types::PyDict;
 
 use gyrofx_job::config::Config;
 use gyrofx_job::job::Job;
+use gyrofx_job::pipeline;
 
 use crate::blocks::{
     Chain, ChainFloat, Estimator, EstimatorFloat, Kf, KfFloat, MeanFilter, MeanFilterFloat,
@@ -94,7 +95,7 @@ impl Plan {
 
     /// The bit-accurate KF (`gyrofx_kf`).
     fn kf(&self) -> Kf {
-        Kf::new(self.job.kf())
+        Kf::new(self.job.kf(), pipeline::KF)
     }
 
     /// The KF's float twin: with the quantized gains (`ideal=False`, the fixed KF's arithmetic
@@ -106,12 +107,12 @@ impl Plan {
 
     /// The mode-reversal sequencer (`gyrofx_sequencer`).
     fn sequencer(&self) -> Sequencer {
-        Sequencer::new(&self.job.chain.estimator.schedule)
+        Sequencer::new(&self.job.chain.estimator.schedule, pipeline::SEQUENCER)
     }
 
     /// The bit-accurate bias estimator (`gyrofx_bias_estimator`).
     fn estimator(&self) -> Estimator {
-        Estimator::new(&self.job.chain.estimator)
+        Estimator::new(&self.job.chain.estimator, pipeline::ESTIMATOR)
     }
 
     /// The estimator's float twin (quantized or designed gains).
@@ -122,7 +123,7 @@ impl Plan {
 
     /// The bit-accurate mean filter with gross-error rejection (`gyrofx_mean_filter`).
     fn mean_filter(&self) -> MeanFilter {
-        MeanFilter::new(&self.job.mean_filter)
+        MeanFilter::new(&self.job.mean_filter, pipeline::mean_filter(&self.job))
     }
 
     /// The mean filter's float twin.
@@ -132,7 +133,7 @@ impl Plan {
 
     /// The whole chain: sequencer, estimator, calibration and KF (`gyrofx_top`).
     fn chain(&self) -> Chain {
-        Chain::new(&self.job.chain)
+        Chain::new(&self.job.chain, pipeline::top(&self.job))
     }
 
     /// The chain's float twin (quantized or designed coefficients).
@@ -145,7 +146,7 @@ impl Plan {
     /// parameters) or `"b"`.
     #[pyo3(signature = (gyro = "a"))]
     fn gyro_loop(&self, gyro: &str) -> PyResult<GyroLoop> {
-        Ok(GyroLoop::new(&self.gyro(gyro)?.plan))
+        Ok(GyroLoop::new(&self.gyro(gyro)?.plan, pipeline::GYRO_LOOP))
     }
 
     /// The loop's float twin, gyro `"a"` or `"b"`.
@@ -158,7 +159,7 @@ impl Plan {
     /// system's short schedule. Only resonator plants have it.
     fn system(&self) -> PyResult<System> {
         let (loops, chain) = self.system_plans()?;
-        Ok(System::new(loops, chain))
+        Ok(System::new(loops, chain, pipeline::SYSTEM))
     }
 
     /// The system's float twin (quantized coefficients).

@@ -6,6 +6,7 @@ own exact rational arithmetic, or from the CLI's own error messages.
 """
 
 import fractions
+import json
 import math
 import pathlib
 
@@ -264,3 +265,32 @@ def test_the_stubs_name_every_public_class():
     for name in gyrofx.__all__:
         if name != "__version__":
             assert name in stubs, name
+
+
+@pytest.mark.parametrize("architecture", ["parallel", "serial"])
+def test_every_block_class_has_the_manifests_latency_and_spacing(tmp_path, architecture):
+    # The manifest's figures are the testbenches' (both read gyrofx_job::pipeline): a
+    # scoreboard built on the Python values waits as long as the RTL takes.
+    config = tmp_path / "config.toml"
+    config.write_text(f'architecture = "{architecture}"\n')
+    folder = tmp_path / "out"
+    run_cli("generate", "--config", str(config), "--out", str(folder), "--samples", "400",
+            "--blocks", "kf", "--no-csv", "--quiet")
+    manifest = json.loads((folder / "manifest.json").read_text())
+    plan = gyrofx.Plan.from_package(str(folder))
+    classes = {
+        "kf": plan.kf(),
+        "estimator": plan.estimator(),
+        "chain": plan.chain(),
+        "mean_filter": plan.mean_filter(),
+        "gyro_loop": plan.gyro_loop(),
+        "system": plan.system(),
+    }
+    for section, block in classes.items():
+        expected = (manifest[section]["latency_clocks"], manifest[section]["min_clocks_per_sample"])
+        assert (block.latency_clocks, block.min_clocks_per_sample) == expected, section
+    assert (plan.kf().latency_clocks, plan.kf().min_clocks_per_sample) == (4, 3)
+    serial = architecture == "serial"
+    assert (plan.chain().latency_clocks > 1000) == serial
+    assert (plan.mean_filter().latency_clocks > 1) == serial
+    assert (plan.sequencer().latency_clocks, plan.sequencer().min_clocks_per_sample) == (1, 1)
