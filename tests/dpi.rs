@@ -9,6 +9,7 @@ use crate::common::{capi_library as library, generate_default, run_tool, text};
 use gyrofx_job::config::Config;
 use gyrofx_job::golden;
 use gyrofx_job::job::Job;
+use gyrofx_job::pipeline;
 
 /// The repository.
 fn repository() -> PathBuf {
@@ -56,6 +57,48 @@ fn a_c_program_gets_the_models_results_and_its_errors() {
         "{out}"
     );
     assert!(out.contains("null step: -1 block is NULL"), "{out}");
+    // The error text copied into the caller's buffer outlives the next failure; a short
+    // buffer gets a cut, terminated copy and the full length.
+    let refused_z = out
+        .lines()
+        .find_map(|l| l.strip_prefix("refused z: -1 "))
+        .expect("the refused z line");
+    assert!(
+        out.contains(&format!("copied {}: {refused_z}\n", refused_z.len())),
+        "{out}"
+    );
+    let refused_bw_sel = out
+        .lines()
+        .find_map(|l| l.strip_prefix("refused bw_sel: -1 "))
+        .expect("the refused bw_sel line");
+    assert!(
+        out.contains(&format!(
+            "cut {}: {}\n",
+            refused_bw_sel.len(),
+            &refused_bw_sel[..7]
+        )),
+        "{out}"
+    );
+    assert!(out.contains("copy refused: -1 -1"), "{out}");
+    // Every block's pipeline, as the package's testbenches and manifest take it.
+    let serial = Job::new(Config::from_toml("architecture = \"serial\"\n", "t").unwrap()).unwrap();
+    for (line, p) in [
+        ("kf", pipeline::KF),
+        ("gyro_loop", pipeline::GYRO_LOOP),
+        ("system", pipeline::SYSTEM),
+        ("serial chain", pipeline::top(&serial)),
+        ("serial mean_filter", pipeline::mean_filter(&serial)),
+        ("estimator", pipeline::ESTIMATOR),
+        ("sequencer", pipeline::SEQUENCER),
+    ] {
+        let want = format!(
+            "pipeline {line} {} {}\n",
+            p.latency_clocks, p.min_clocks_per_sample
+        );
+        assert!(out.contains(&want), "{want}{out}");
+    }
+    assert!(out.contains("pipeline kf 4 3\n"), "{out}");
+    assert!(out.contains("null pipeline: -1"), "{out}");
     // The same steps in Rust: the C side must see the same codes.
     let job =
         Job::new(Config::from_toml("[kf]\nbandwidths_hz = [5.0, 10.0]\n", "t").unwrap()).unwrap();

@@ -8,6 +8,7 @@
 #include "gyrofx.h"
 
 int main(void) {
+    int latency, spacing;
     printf("version %s\n", gyrofx_version());
     GyrofxPlan *bad = gyrofx_plan_from_toml("[kf]\nbandwidths_hz = [10.0, 500.0]\n");
     printf("bad plan %s: %s\n", bad == NULL ? "NULL" : "made", gyrofx_last_error());
@@ -45,8 +46,30 @@ int main(void) {
         printf("system %d %d %lld %lld %lld %lld %d %d\n", next[0], next[1], (long long)dac[0],
                (long long)dac[1], (long long)dac[2], (long long)dac[3], modes[0], modes[1]);
     }
+    if (gyrofx_gyro_loop_pipeline(loop, &latency, &spacing) != 0) return 1;
+    printf("pipeline gyro_loop %d %d\n", latency, spacing);
+    if (gyrofx_system_pipeline(system, &latency, &spacing) != 0) return 1;
+    printf("pipeline system %d %d\n", latency, spacing);
     gyrofx_gyro_loop_free(loop);
     gyrofx_system_free(system);
+    GyrofxPlan *serial = gyrofx_plan_from_toml("architecture = \"serial\"\n");
+    GyrofxChain *chain = gyrofx_chain_new(serial);
+    GyrofxMeanFilter *filter = gyrofx_mean_filter_new(serial);
+    GyrofxEstimator *estimator = gyrofx_estimator_new(serial);
+    GyrofxSequencer *sequencer = gyrofx_sequencer_new(serial);
+    if (gyrofx_chain_pipeline(chain, &latency, &spacing) != 0) return 1;
+    printf("pipeline serial chain %d %d\n", latency, spacing);
+    if (gyrofx_mean_filter_pipeline(filter, &latency, &spacing) != 0) return 1;
+    printf("pipeline serial mean_filter %d %d\n", latency, spacing);
+    if (gyrofx_estimator_pipeline(estimator, &latency, &spacing) != 0) return 1;
+    printf("pipeline estimator %d %d\n", latency, spacing);
+    if (gyrofx_sequencer_pipeline(sequencer, &latency, &spacing) != 0) return 1;
+    printf("pipeline sequencer %d %d\n", latency, spacing);
+    gyrofx_chain_free(chain);
+    gyrofx_mean_filter_free(filter);
+    gyrofx_estimator_free(estimator);
+    gyrofx_sequencer_free(sequencer);
+    gyrofx_plan_free(serial);
     GyrofxPlan *rate_plant = gyrofx_plan_from_toml("[plant]\nmodel = \"rate\"\n");
     GyrofxSystem *no_system = gyrofx_system_new(rate_plant);
     printf("no system for the rate plant, %s: %s\n", no_system == NULL ? "NULL" : "made", gyrofx_last_error());
@@ -54,15 +77,26 @@ int main(void) {
     int64_t rate = 0;
     int status = gyrofx_kf_step(kf, INT64_C(1) << 40, 0, &rate);
     printf("refused z: %d %s\n", status, gyrofx_last_error());
+    char saved[256];
+    int length = gyrofx_last_error_copy(saved, (int)sizeof saved);
     status = gyrofx_kf_step(kf, 5, 2, &rate);
     printf("refused bw_sel: %d %s\n", status, gyrofx_last_error());
+    /* The copy is the caller's: the next failure replaced the library's text, not this. */
+    printf("copied %d: %s\n", length, saved);
+    char cut[8];
+    length = gyrofx_last_error_copy(cut, (int)sizeof cut);
+    printf("cut %d: %s\n", length, cut);
+    printf("copy refused: %d %d\n", gyrofx_last_error_copy(NULL, 8), gyrofx_last_error_copy(cut, -1));
     for (int64_t k = 0; k < 50; ++k) {
         int64_t z = (k * 7919 % 20001) - 10000;
         if (gyrofx_kf_step(kf, z, (int)(k / 25), &rate) != 0) return 1;
         printf("rate %lld\n", (long long)rate);
     }
+    if (gyrofx_kf_pipeline(kf, &latency, &spacing) != 0) return 1;
+    printf("pipeline kf %d %d\n", latency, spacing);
     gyrofx_kf_free(kf);
     gyrofx_kf_free(NULL);
+    printf("null pipeline: %d\n", gyrofx_kf_pipeline(NULL, &latency, &spacing));
     status = gyrofx_kf_step(NULL, 0, 0, &rate); /* before reading the error: C leaves the
                                                   * order of a call's arguments open */
     printf("null step: %d %s\n", status, gyrofx_last_error());

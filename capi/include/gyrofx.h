@@ -36,8 +36,20 @@ typedef struct GyrofxSystem GyrofxSystem;
 extern "C" {
 #endif // __cplusplus
 
-// The message of the calling thread's last failure ("" before any).
+// The message of the calling thread's last failure ("" before any). The text belongs to the
+// library and stays valid only until the thread's next failing call, which frees it: read or
+// copy it before calling again (`gyrofx_last_error_copy` copies it into a buffer of yours).
 const char *gyrofx_last_error(void);
+
+// Copies the calling thread's last failure message into `buffer` (`size` bytes), cut to fit
+// and always NUL-terminated when `size` > 0, as `snprintf` does. Returns the message's full
+// length in bytes (without the NUL; a return >= `size` means it was cut), or -1 when `buffer`
+// is NULL with `size` > 0 or `size` < 0. The copy is the caller's: later calls leave it alone.
+//
+// # Safety
+// `buffer` is NULL or writable for `size` bytes.
+int32_t gyrofx_last_error_copy(char *buffer,
+                               int32_t size);
 
 // The library's version ("0.1.0"), static.
 const char *gyrofx_version(void);
@@ -81,6 +93,17 @@ struct GyrofxKf *gyrofx_kf_new(const struct GyrofxPlan *plan);
 // `kf` is NULL or from `gyrofx_kf_new`, not freed before.
 void gyrofx_kf_free(struct GyrofxKf *kf);
 
+// The pipeline in the RTL of the kF, as the package's manifest and
+// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
+// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
+// or -1 for a NULL handle.
+//
+// # Safety
+// `kf` is NULL or live; each output NULL or writable.
+int32_t gyrofx_kf_pipeline(const struct GyrofxKf *kf,
+                           int32_t *latency_clocks,
+                           int32_t *min_clocks_per_sample);
+
 // The synchronous reset. Returns 0, or -1 for a NULL handle.
 //
 // # Safety
@@ -108,6 +131,17 @@ struct GyrofxSequencer *gyrofx_sequencer_new(const struct GyrofxPlan *plan);
 // # Safety
 // `sequencer` is NULL or from `gyrofx_sequencer_new`, not freed before.
 void gyrofx_sequencer_free(struct GyrofxSequencer *sequencer);
+
+// The pipeline in the RTL of the sequencer, as the package's manifest and
+// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
+// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
+// or -1 for a NULL handle.
+//
+// # Safety
+// `sequencer` is NULL or live; each output NULL or writable.
+int32_t gyrofx_sequencer_pipeline(const struct GyrofxSequencer *sequencer,
+                                  int32_t *latency_clocks,
+                                  int32_t *min_clocks_per_sample);
 
 // The synchronous reset. Returns 0, or -1 for a NULL handle.
 //
@@ -142,6 +176,17 @@ struct GyrofxEstimator *gyrofx_estimator_new(const struct GyrofxPlan *plan);
 // # Safety
 // `estimator` is NULL or from `gyrofx_estimator_new`, not freed before.
 void gyrofx_estimator_free(struct GyrofxEstimator *estimator);
+
+// The pipeline in the RTL of the estimator, as the package's manifest and
+// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
+// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
+// or -1 for a NULL handle.
+//
+// # Safety
+// `estimator` is NULL or live; each output NULL or writable.
+int32_t gyrofx_estimator_pipeline(const struct GyrofxEstimator *estimator,
+                                  int32_t *latency_clocks,
+                                  int32_t *min_clocks_per_sample);
 
 // The synchronous reset. Returns 0, or -1 for a NULL handle.
 //
@@ -180,6 +225,17 @@ struct GyrofxMeanFilter *gyrofx_mean_filter_new(const struct GyrofxPlan *plan);
 // `filter` is NULL or from `gyrofx_mean_filter_new`, not freed before.
 void gyrofx_mean_filter_free(struct GyrofxMeanFilter *filter);
 
+// The pipeline in the RTL of the mean filter (as the plan's `architecture` builds it), as the package's manifest and
+// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
+// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
+// or -1 for a NULL handle.
+//
+// # Safety
+// `filter` is NULL or live; each output NULL or writable.
+int32_t gyrofx_mean_filter_pipeline(const struct GyrofxMeanFilter *filter,
+                                    int32_t *latency_clocks,
+                                    int32_t *min_clocks_per_sample);
+
 // The synchronous reset. Returns 0, or -1 for a NULL handle.
 //
 // # Safety
@@ -208,6 +264,17 @@ struct GyrofxChain *gyrofx_chain_new(const struct GyrofxPlan *plan);
 // # Safety
 // `chain` is NULL or from `gyrofx_chain_new`, not freed before.
 void gyrofx_chain_free(struct GyrofxChain *chain);
+
+// The pipeline in the RTL of the chain (`gyrofx_top`, or `gyrofx_top_serial` with `architecture = "serial"`), as the package's manifest and
+// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
+// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
+// or -1 for a NULL handle.
+//
+// # Safety
+// `chain` is NULL or live; each output NULL or writable.
+int32_t gyrofx_chain_pipeline(const struct GyrofxChain *chain,
+                              int32_t *latency_clocks,
+                              int32_t *min_clocks_per_sample);
 
 // The synchronous reset. Returns 0, or -1 for a NULL handle.
 //
@@ -254,6 +321,17 @@ struct GyrofxGyroLoop *gyrofx_gyro_loop_new(const struct GyrofxPlan *plan,
 // `gyro_loop` is NULL or from `gyrofx_gyro_loop_new`, not freed before.
 void gyrofx_gyro_loop_free(struct GyrofxGyroLoop *gyro_loop);
 
+// The pipeline in the RTL of the loop, as the package's manifest and
+// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
+// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
+// or -1 for a NULL handle.
+//
+// # Safety
+// `gyro_loop` is NULL or live; each output NULL or writable.
+int32_t gyrofx_gyro_loop_pipeline(const struct GyrofxGyroLoop *gyro_loop,
+                                  int32_t *latency_clocks,
+                                  int32_t *min_clocks_per_sample);
+
 // The synchronous reset. Returns 0, or -1 for a NULL handle.
 //
 // # Safety
@@ -289,6 +367,17 @@ struct GyrofxSystem *gyrofx_system_new(const struct GyrofxPlan *plan);
 // # Safety
 // `system` is NULL or from `gyrofx_system_new`, not freed before.
 void gyrofx_system_free(struct GyrofxSystem *system);
+
+// The pipeline in the RTL of the system, as the package's manifest and
+// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
+// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
+// or -1 for a NULL handle.
+//
+// # Safety
+// `system` is NULL or live; each output NULL or writable.
+int32_t gyrofx_system_pipeline(const struct GyrofxSystem *system,
+                               int32_t *latency_clocks,
+                               int32_t *min_clocks_per_sample);
 
 // The synchronous reset. Returns 0, or -1 for a NULL handle.
 //

@@ -23,6 +23,7 @@ use std::path::Path;
 use gyrofx_job::config::Config;
 use gyrofx_job::golden;
 use gyrofx_job::job::Job;
+use gyrofx_job::pipeline::{self, Pipeline};
 
 thread_local! {
     static LAST_ERROR: RefCell<CString> = RefCell::new(CString::default());
@@ -33,10 +34,43 @@ fn fail(message: impl std::fmt::Display) {
     LAST_ERROR.with(|e| *e.borrow_mut() = CString::new(text).unwrap_or_default());
 }
 
-/// The message of the calling thread's last failure ("" before any).
+/// The message of the calling thread's last failure ("" before any). The text belongs to the
+/// library and stays valid only until the thread's next failing call, which frees it: read or
+/// copy it before calling again (`gyrofx_last_error_copy` copies it into a buffer of yours).
 #[no_mangle]
 pub extern "C" fn gyrofx_last_error() -> *const c_char {
     LAST_ERROR.with(|e| e.borrow().as_ptr())
+}
+
+/// Copies the calling thread's last failure message into `buffer` (`size` bytes), cut to fit
+/// and always NUL-terminated when `size` > 0, as `snprintf` does. Returns the message's full
+/// length in bytes (without the NUL; a return >= `size` means it was cut), or -1 when `buffer`
+/// is NULL with `size` > 0 or `size` < 0. The copy is the caller's: later calls leave it alone.
+///
+/// # Safety
+/// `buffer` is NULL or writable for `size` bytes.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_last_error_copy(buffer: *mut c_char, size: i32) -> i32 {
+    let Ok(size) = usize::try_from(size) else {
+        return -1;
+    };
+    if buffer.is_null() && size > 0 {
+        return -1;
+    }
+    LAST_ERROR.with(|e| {
+        let message = e.borrow();
+        let bytes = message.as_bytes();
+        if size > 0 {
+            let copied = bytes.len().min(size - 1);
+            // SAFETY: `buffer` is writable for `size` > `copied` bytes, by contract; the
+            // message is the library's own allocation, so the two do not overlap.
+            unsafe {
+                std::ptr::copy_nonoverlapping(bytes.as_ptr().cast::<c_char>(), buffer, copied);
+                *buffer.add(copied) = 0;
+            }
+        }
+        i32::try_from(bytes.len()).unwrap_or(i32::MAX)
+    })
 }
 
 /// The library's version ("0.1.0"), static.
@@ -193,8 +227,37 @@ unsafe fn put<V>(out: *mut V, value: V) {
     }
 }
 
+/// Writes a live block's pipeline through the two outputs (each NULL or writable); 0, or -1
+/// for a NULL block.
+///
+/// # Safety
+/// `block` is NULL or a live block of type `T`; each output NULL or writable.
+unsafe fn pipeline_of<T>(
+    block: *const T,
+    pipeline: impl FnOnce(&T) -> Pipeline,
+    latency_clocks: *mut i32,
+    min_clocks_per_sample: *mut i32,
+) -> i32 {
+    // SAFETY: NULL or live, by contract.
+    let Some(block) = (unsafe { block.as_ref() }) else {
+        fail("block is NULL");
+        return -1;
+    };
+    let pipeline = pipeline(block);
+    let clocks = |n: u32| i32::try_from(n).unwrap_or(i32::MAX);
+    // SAFETY: forwarded contract.
+    unsafe {
+        put(latency_clocks, clocks(pipeline.latency_clocks));
+        put(
+            min_clocks_per_sample,
+            clocks(pipeline.min_clocks_per_sample),
+        );
+    }
+    0
+}
+
 /// The steady-state KF (`gyrofx_kf`).
-pub struct GyrofxKf(golden::Kf);
+pub struct GyrofxKf(golden::Kf, Pipeline);
 
 /// A KF from reset; NULL when `plan` is NULL.
 ///
@@ -203,7 +266,11 @@ pub struct GyrofxKf(golden::Kf);
 #[no_mangle]
 pub unsafe extern "C" fn gyrofx_kf_new(plan: *const GyrofxPlan) -> *mut GyrofxKf {
     // SAFETY: forwarded contract.
-    unsafe { new(plan, |job| GyrofxKf(golden::Kf::new(job.kf()))) }
+    unsafe {
+        new(plan, |job| {
+            GyrofxKf(golden::Kf::new(job.kf()), pipeline::KF)
+        })
+    }
 }
 
 /// Frees a KF.
@@ -214,6 +281,23 @@ pub unsafe extern "C" fn gyrofx_kf_new(plan: *const GyrofxPlan) -> *mut GyrofxKf
 pub unsafe extern "C" fn gyrofx_kf_free(kf: *mut GyrofxKf) {
     // SAFETY: forwarded contract.
     unsafe { free(kf) }
+}
+
+/// The pipeline in the RTL of the kF, as the package's manifest and
+/// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
+/// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
+/// or -1 for a NULL handle.
+///
+/// # Safety
+/// `kf` is NULL or live; each output NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_kf_pipeline(
+    kf: *const GyrofxKf,
+    latency_clocks: *mut i32,
+    min_clocks_per_sample: *mut i32,
+) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe { pipeline_of(kf, |b| b.1, latency_clocks, min_clocks_per_sample) }
 }
 
 /// The synchronous reset. Returns 0, or -1 for a NULL handle.
@@ -254,7 +338,7 @@ pub unsafe extern "C" fn gyrofx_kf_step(
 }
 
 /// The mode-reversal sequencer (`gyrofx_sequencer`).
-pub struct GyrofxSequencer(golden::Sequencer);
+pub struct GyrofxSequencer(golden::Sequencer, Pipeline);
 
 /// A sequencer from reset; NULL when `plan` is NULL.
 ///
@@ -265,7 +349,10 @@ pub unsafe extern "C" fn gyrofx_sequencer_new(plan: *const GyrofxPlan) -> *mut G
     // SAFETY: forwarded contract.
     unsafe {
         new(plan, |job| {
-            GyrofxSequencer(golden::Sequencer::new(&job.chain.estimator.schedule))
+            GyrofxSequencer(
+                golden::Sequencer::new(&job.chain.estimator.schedule),
+                pipeline::SEQUENCER,
+            )
         })
     }
 }
@@ -278,6 +365,23 @@ pub unsafe extern "C" fn gyrofx_sequencer_new(plan: *const GyrofxPlan) -> *mut G
 pub unsafe extern "C" fn gyrofx_sequencer_free(sequencer: *mut GyrofxSequencer) {
     // SAFETY: forwarded contract.
     unsafe { free(sequencer) }
+}
+
+/// The pipeline in the RTL of the sequencer, as the package's manifest and
+/// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
+/// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
+/// or -1 for a NULL handle.
+///
+/// # Safety
+/// `sequencer` is NULL or live; each output NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_sequencer_pipeline(
+    sequencer: *const GyrofxSequencer,
+    latency_clocks: *mut i32,
+    min_clocks_per_sample: *mut i32,
+) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe { pipeline_of(sequencer, |b| b.1, latency_clocks, min_clocks_per_sample) }
 }
 
 /// The synchronous reset. Returns 0, or -1 for a NULL handle.
@@ -337,7 +441,7 @@ pub unsafe extern "C" fn gyrofx_sequencer_step(
 }
 
 /// The least-squares bias estimator (`gyrofx_bias_estimator`).
-pub struct GyrofxEstimator(golden::Estimator);
+pub struct GyrofxEstimator(golden::Estimator, Pipeline);
 
 /// An estimator from reset; NULL when `plan` is NULL.
 ///
@@ -348,7 +452,10 @@ pub unsafe extern "C" fn gyrofx_estimator_new(plan: *const GyrofxPlan) -> *mut G
     // SAFETY: forwarded contract.
     unsafe {
         new(plan, |job| {
-            GyrofxEstimator(golden::Estimator::new(&job.chain.estimator))
+            GyrofxEstimator(
+                golden::Estimator::new(&job.chain.estimator),
+                pipeline::ESTIMATOR,
+            )
         })
     }
 }
@@ -361,6 +468,23 @@ pub unsafe extern "C" fn gyrofx_estimator_new(plan: *const GyrofxPlan) -> *mut G
 pub unsafe extern "C" fn gyrofx_estimator_free(estimator: *mut GyrofxEstimator) {
     // SAFETY: forwarded contract.
     unsafe { free(estimator) }
+}
+
+/// The pipeline in the RTL of the estimator, as the package's manifest and
+/// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
+/// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
+/// or -1 for a NULL handle.
+///
+/// # Safety
+/// `estimator` is NULL or live; each output NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_estimator_pipeline(
+    estimator: *const GyrofxEstimator,
+    latency_clocks: *mut i32,
+    min_clocks_per_sample: *mut i32,
+) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe { pipeline_of(estimator, |b| b.1, latency_clocks, min_clocks_per_sample) }
 }
 
 /// The synchronous reset. Returns 0, or -1 for a NULL handle.
@@ -423,7 +547,7 @@ pub unsafe extern "C" fn gyrofx_estimator_step(
 }
 
 /// The mean filter with gross-error rejection (`gyrofx_mean_filter`).
-pub struct GyrofxMeanFilter(golden::MeanFilter);
+pub struct GyrofxMeanFilter(golden::MeanFilter, Pipeline);
 
 /// A mean filter from reset; NULL when `plan` is NULL.
 ///
@@ -434,7 +558,10 @@ pub unsafe extern "C" fn gyrofx_mean_filter_new(plan: *const GyrofxPlan) -> *mut
     // SAFETY: forwarded contract.
     unsafe {
         new(plan, |job| {
-            GyrofxMeanFilter(golden::MeanFilter::new(&job.mean_filter))
+            GyrofxMeanFilter(
+                golden::MeanFilter::new(&job.mean_filter),
+                pipeline::mean_filter(job),
+            )
         })
     }
 }
@@ -447,6 +574,23 @@ pub unsafe extern "C" fn gyrofx_mean_filter_new(plan: *const GyrofxPlan) -> *mut
 pub unsafe extern "C" fn gyrofx_mean_filter_free(filter: *mut GyrofxMeanFilter) {
     // SAFETY: forwarded contract.
     unsafe { free(filter) }
+}
+
+/// The pipeline in the RTL of the mean filter (as the plan's `architecture` builds it), as the package's manifest and
+/// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
+/// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
+/// or -1 for a NULL handle.
+///
+/// # Safety
+/// `filter` is NULL or live; each output NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_mean_filter_pipeline(
+    filter: *const GyrofxMeanFilter,
+    latency_clocks: *mut i32,
+    min_clocks_per_sample: *mut i32,
+) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe { pipeline_of(filter, |b| b.1, latency_clocks, min_clocks_per_sample) }
 }
 
 /// The synchronous reset. Returns 0, or -1 for a NULL handle.
@@ -493,7 +637,7 @@ pub unsafe extern "C" fn gyrofx_mean_filter_step(
 }
 
 /// The whole chain (`gyrofx_top`).
-pub struct GyrofxChain(golden::Chain);
+pub struct GyrofxChain(golden::Chain, Pipeline);
 
 /// A chain from reset; NULL when `plan` is NULL.
 ///
@@ -502,7 +646,11 @@ pub struct GyrofxChain(golden::Chain);
 #[no_mangle]
 pub unsafe extern "C" fn gyrofx_chain_new(plan: *const GyrofxPlan) -> *mut GyrofxChain {
     // SAFETY: forwarded contract.
-    unsafe { new(plan, |job| GyrofxChain(golden::Chain::new(&job.chain))) }
+    unsafe {
+        new(plan, |job| {
+            GyrofxChain(golden::Chain::new(&job.chain), pipeline::top(job))
+        })
+    }
 }
 
 /// Frees a chain.
@@ -513,6 +661,23 @@ pub unsafe extern "C" fn gyrofx_chain_new(plan: *const GyrofxPlan) -> *mut Gyrof
 pub unsafe extern "C" fn gyrofx_chain_free(chain: *mut GyrofxChain) {
     // SAFETY: forwarded contract.
     unsafe { free(chain) }
+}
+
+/// The pipeline in the RTL of the chain (`gyrofx_top`, or `gyrofx_top_serial` with `architecture = "serial"`), as the package's manifest and
+/// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
+/// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
+/// or -1 for a NULL handle.
+///
+/// # Safety
+/// `chain` is NULL or live; each output NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_chain_pipeline(
+    chain: *const GyrofxChain,
+    latency_clocks: *mut i32,
+    min_clocks_per_sample: *mut i32,
+) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe { pipeline_of(chain, |b| b.1, latency_clocks, min_clocks_per_sample) }
 }
 
 /// The synchronous reset. Returns 0, or -1 for a NULL handle.
@@ -588,7 +753,7 @@ pub unsafe extern "C" fn gyrofx_chain_step(
 }
 
 /// One gyro's digital loop (`gyrofx_gyro_loop`).
-pub struct GyrofxGyroLoop(golden::GyroLoop);
+pub struct GyrofxGyroLoop(golden::GyroLoop, Pipeline);
 
 /// Gyro `gyro`'s loop (0: A, whose plan the block's vectors and RTL parameters use; 1: B) from
 /// reset; NULL when `plan` is NULL or `gyro` is neither.
@@ -607,7 +772,10 @@ pub unsafe extern "C" fn gyrofx_gyro_loop_new(
     // SAFETY: forwarded contract.
     unsafe {
         new(plan, |job| {
-            GyrofxGyroLoop(golden::GyroLoop::new(&job.gyro_loops[index].plan))
+            GyrofxGyroLoop(
+                golden::GyroLoop::new(&job.gyro_loops[index].plan),
+                pipeline::GYRO_LOOP,
+            )
         })
     }
 }
@@ -620,6 +788,23 @@ pub unsafe extern "C" fn gyrofx_gyro_loop_new(
 pub unsafe extern "C" fn gyrofx_gyro_loop_free(gyro_loop: *mut GyrofxGyroLoop) {
     // SAFETY: forwarded contract.
     unsafe { free(gyro_loop) }
+}
+
+/// The pipeline in the RTL of the loop, as the package's manifest and
+/// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
+/// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
+/// or -1 for a NULL handle.
+///
+/// # Safety
+/// `gyro_loop` is NULL or live; each output NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_gyro_loop_pipeline(
+    gyro_loop: *const GyrofxGyroLoop,
+    latency_clocks: *mut i32,
+    min_clocks_per_sample: *mut i32,
+) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe { pipeline_of(gyro_loop, |b| b.1, latency_clocks, min_clocks_per_sample) }
 }
 
 /// The synchronous reset. Returns 0, or -1 for a NULL handle.
@@ -673,7 +858,7 @@ pub unsafe extern "C" fn gyrofx_gyro_loop_step(
 }
 
 /// The whole gyro (`gyrofx_system`): both loops and the chain.
-pub struct GyrofxSystem(golden::System);
+pub struct GyrofxSystem(golden::System, Pipeline);
 
 /// The system from reset; NULL when `plan` is NULL or its plant has no system (the rate
 /// plant).
@@ -694,7 +879,10 @@ pub unsafe extern "C" fn gyrofx_system_new(plan: *const GyrofxPlan) -> *mut Gyro
         new(plan, |job| {
             let [a, b] = &job.gyro_loops;
             let chain = job.system_chain.as_ref().expect("checked above");
-            GyrofxSystem(golden::System::new([&a.plan, &b.plan], chain))
+            GyrofxSystem(
+                golden::System::new([&a.plan, &b.plan], chain),
+                pipeline::SYSTEM,
+            )
         })
     }
 }
@@ -707,6 +895,23 @@ pub unsafe extern "C" fn gyrofx_system_new(plan: *const GyrofxPlan) -> *mut Gyro
 pub unsafe extern "C" fn gyrofx_system_free(system: *mut GyrofxSystem) {
     // SAFETY: forwarded contract.
     unsafe { free(system) }
+}
+
+/// The pipeline in the RTL of the system, as the package's manifest and
+/// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
+/// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
+/// or -1 for a NULL handle.
+///
+/// # Safety
+/// `system` is NULL or live; each output NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_system_pipeline(
+    system: *const GyrofxSystem,
+    latency_clocks: *mut i32,
+    min_clocks_per_sample: *mut i32,
+) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe { pipeline_of(system, |b| b.1, latency_clocks, min_clocks_per_sample) }
 }
 
 /// The synchronous reset. Returns 0, or -1 for a NULL handle.
