@@ -172,3 +172,42 @@ fn a_drifted_doc_table_is_caught() {
     assert_ne!(drifted, page, "the kf page documents z as s24.14");
     assert_ne!(sorted(doc_ports(&drifted)), sorted(ports));
 }
+
+/// The `latency_clocks` and `min_clocks_per_sample` of a page's "**Pipeline**" line.
+fn doc_pipeline(page: &str) -> Option<(u32, u32)> {
+    let line = page.lines().find(|l| l.starts_with("**Pipeline**"))?;
+    let number = |key: &str| -> Option<u32> {
+        let rest = &line[line.find(&format!("`{key}` = "))? + key.len() + 5..];
+        rest.split(|c: char| !c.is_ascii_digit()).next()?.parse().ok()
+    };
+    Some((number("latency_clocks")?, number("min_clocks_per_sample")?))
+}
+
+/// Each clocked block's page states the pipeline its testbenches run with (the registry's,
+/// from `gyrofx_job::pipeline`) for the default config; a changed figure is caught.
+#[test]
+fn every_clocked_blocks_page_states_its_pipeline() {
+    let job = Job::new(Config::embedded()).unwrap();
+    let provenance = Provenance {
+        version: "test".into(),
+        command: "test".into(),
+        config_sha256: "0".repeat(64),
+    };
+    let roms = RomImages::new(&job, &provenance);
+    for registered in REGISTRY {
+        let block = registered.block(&job, &roms);
+        if !block.clocked {
+            continue;
+        }
+        let path = root().join(format!("docs/blocks/{}.md", block.name));
+        let page = std::fs::read_to_string(&path).unwrap();
+        let want = (
+            block.pipeline.latency_clocks,
+            block.pipeline.min_clocks_per_sample,
+        );
+        assert_eq!(doc_pipeline(&page), Some(want), "{}", path.display());
+    }
+    let kf = std::fs::read_to_string(root().join("docs/blocks/kf.md")).unwrap();
+    let drifted = kf.replace("`latency_clocks` = 4", "`latency_clocks` = 1");
+    assert_ne!(doc_pipeline(&drifted), doc_pipeline(&kf));
+}
