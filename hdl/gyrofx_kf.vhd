@@ -197,4 +197,28 @@ begin
     rate_out <= rate_reg;
     out_valid <= valid_reg;
 
+    -- pragma translate_off
+    -- Simulation only: the KF takes a sample at most every MIN_CLOCKS_PER_SAMPLE clocks
+    -- (four register stages; the state update a sample needs is written 3 clocks after its ce); a sooner ce would be lost without a trace, so the
+    -- simulation stops, naming the instance (gyrofx_job::pipeline holds the same figure).
+    spacing_check : process (clk)
+        constant MIN_CLOCKS_PER_SAMPLE : positive := 3;
+        variable clocks_since_sample : natural := MIN_CLOCKS_PER_SAMPLE;
+    begin
+        if rising_edge(clk) then
+            if rst = '1' then
+                clocks_since_sample := MIN_CLOCKS_PER_SAMPLE;
+            elsif ce = '1' then
+                assert clocks_since_sample >= MIN_CLOCKS_PER_SAMPLE
+                    report spacing_check'path_name & ": a sample " & integer'image(clocks_since_sample)
+                        & " clocks after the previous one; gyrofx_kf takes one at most every "
+                        & integer'image(MIN_CLOCKS_PER_SAMPLE) & " clocks"
+                    severity failure;
+                clocks_since_sample := 1;
+            elsif clocks_since_sample < MIN_CLOCKS_PER_SAMPLE then
+                clocks_since_sample := clocks_since_sample + 1;
+            end if;
+        end if;
+    end process;
+    -- pragma translate_on
 end architecture;

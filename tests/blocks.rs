@@ -178,7 +178,10 @@ fn doc_pipeline(page: &str) -> Option<(u32, u32)> {
     let line = page.lines().find(|l| l.starts_with("**Pipeline**"))?;
     let number = |key: &str| -> Option<u32> {
         let rest = &line[line.find(&format!("`{key}` = "))? + key.len() + 5..];
-        rest.split(|c: char| !c.is_ascii_digit()).next()?.parse().ok()
+        rest.split(|c: char| !c.is_ascii_digit())
+            .next()?
+            .parse()
+            .ok()
     };
     Some((number("latency_clocks")?, number("min_clocks_per_sample")?))
 }

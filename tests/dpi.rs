@@ -254,3 +254,95 @@ fn the_cpp_verilator_harness_checks_the_kf_against_the_c_api() {
     let (passed, out) = run_tool("./obj_dir/Vcocotb_gyrofx_kf", &["3000"], &kf);
     assert!(passed && out.contains("PASS n=3000"), "{out}");
 }
+
+/// The DPI-C type a C parameter or return type of `gyrofx.h` takes (`output` for a pointer to
+/// a scalar), or `None` for one DPI-C cannot pass.
+fn dpi_type_of(c_type: &str) -> Option<String> {
+    let c_type = c_type.trim();
+    let scalar = |t: &str| match t {
+        "int64_t" => Some("longint"),
+        "int32_t" => Some("int"),
+        "void" => Some("void"),
+        _ => None,
+    };
+    if c_type == "const char *" || c_type == "const char*" {
+        return Some("string".into());
+    }
+    if c_type.starts_with("struct ") || c_type.starts_with("const struct ") {
+        return Some("chandle".into());
+    }
+    if let Some(pointee) = c_type.strip_suffix('*') {
+        return scalar(pointee.trim()).map(|t| format!("output {t}"));
+    }
+    scalar(c_type).map(str::to_string)
+}
+
+/// The package's `gyrofx_dpi_pkg.sv` against `gyrofx.h`: every import names a function of the
+/// C library with its arguments in order, each in the DPI-C type of its C type (`chandle` for a
+/// handle, `longint` for `int64_t`, `int` for `int32_t`, `string` for `const char *`, `output`
+/// for a pointer to a scalar), so the SystemVerilog side cannot drift from the library.
+#[test]
+fn every_dpi_import_is_the_c_headers_function_in_dpi_types() {
+    let package =
+        std::fs::read_to_string(repository().join("vectors/dpi/gyrofx_dpi_pkg.sv")).unwrap();
+    let header = std::fs::read_to_string(repository().join("capi/include/gyrofx.h")).unwrap();
+    let header: String = header
+        .lines()
+        .filter(|l| !l.trim_start().starts_with("//") && !l.trim_start().starts_with('#'))
+        .collect::<Vec<_>>()
+        .join(" ");
+    let mut checked = 0;
+    for statement in package
+        .split(';')
+        .filter(|s| s.contains("import \"DPI-C\""))
+    {
+        let signature = statement[statement.find("function ").unwrap() + 9..].trim();
+        let (head, arguments) = signature.split_once('(').unwrap();
+        let (return_type, name) = head.trim().rsplit_once(' ').unwrap();
+        let dpi_arguments: Vec<String> = arguments
+            .trim_end_matches(')')
+            .split(',')
+            .map(|a| a.split_whitespace().collect::<Vec<_>>())
+            .filter(|words| !words.is_empty())
+            .map(|words| {
+                let (direction, kind) = (words[0], words[1]);
+                if direction == "output" {
+                    format!("output {kind}")
+                } else {
+                    kind.to_string()
+                }
+            })
+            .collect();
+        let start = header
+            .match_indices(&format!("{name}("))
+            .map(|(i, _)| i)
+            .find(|&i| !header[..i].ends_with(|c: char| c.is_ascii_alphanumeric() || c == '_'))
+            .unwrap_or_else(|| panic!("{name} is not in gyrofx.h"));
+        let c_return = header[..start]
+            .rsplit([';', '{', '}'])
+            .next()
+            .unwrap()
+            .trim()
+            .to_string();
+        let c_arguments = &header[start + name.len() + 1..];
+        let c_arguments = &c_arguments[..c_arguments.find(')').unwrap()];
+        let c_types: Vec<Option<String>> = c_arguments
+            .split(',')
+            .map(str::trim)
+            .filter(|a| !a.is_empty() && *a != "void")
+            .map(|a| {
+                let cut = a.rfind([' ', '*']).unwrap();
+                dpi_type_of(&a[..=cut])
+            })
+            .collect();
+        assert_eq!(
+            dpi_type_of(&c_return).as_deref(),
+            Some(return_type),
+            "{name}: returns {c_return} in C"
+        );
+        let want: Vec<Option<String>> = dpi_arguments.into_iter().map(Some).collect();
+        assert_eq!(c_types, want, "{name}: arguments ({c_arguments}) in C");
+        checked += 1;
+    }
+    assert!(checked >= 30, "only {checked} imports in the package");
+}

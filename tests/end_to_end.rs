@@ -555,3 +555,63 @@ fn truncating_instead_of_rounding_in_the_rtl_fails_the_chain_testbench() {
         );
     }
 }
+
+/// Samples sooner than a block's `min_clocks_per_sample` stop the simulation in every simulator
+/// (the RTL's simulation-only check) instead of giving wrong outputs without a word: the KF's
+/// testbench, made to feed a sample every second clock (one settle clock instead of three),
+/// stops at the second sample naming the instance. The untouched testbench passes.
+#[test]
+fn a_kf_fed_every_second_clock_stops_the_simulation_in_every_simulator() {
+    use gyrofx_lab::simulate::{self, Options, Simulator};
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("pkg");
+    let out_text = out.to_str().unwrap();
+    ok(&[
+        "generate",
+        "--out",
+        out_text,
+        "--blocks",
+        "kf",
+        "--samples",
+        "200",
+        "--no-csv",
+    ]);
+    let kf_only = Options {
+        blocks: Some(vec!["kf".to_string()]),
+        ..Options::default()
+    };
+    let passed = simulate::run(&out, Simulator::Icarus, &kf_only).unwrap();
+    assert!(passed.passed(), "{:?}", passed.blocks[0].log);
+    for (file, settle, faster) in [
+        (
+            "tb_gyrofx_kf.v",
+            "repeat (3) @(negedge clk);",
+            "@(negedge clk);",
+        ),
+        (
+            "tb_gyrofx_kf.vhd",
+            "for settle in 1 to 3 loop",
+            "for settle in 1 to 1 loop",
+        ),
+    ] {
+        let path = out.join("kf").join(file);
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.contains(settle), "{file} waits three settle clocks");
+        std::fs::write(&path, text.replace(settle, faster)).unwrap();
+    }
+    for simulator in [Simulator::Icarus, Simulator::Verilator, Simulator::Ghdl] {
+        let outcome = simulate::run(&out, simulator, &kf_only).unwrap();
+        let log = &outcome.blocks[0].log;
+        assert!(!outcome.passed(), "{simulator:?}: {log}");
+        assert!(
+            log.contains(
+                "a sample 2 clocks after the previous one; gyrofx_kf takes one at most every 3 clocks"
+            ) && log.contains("dut"),
+            "{simulator:?}: {log}"
+        );
+        assert!(
+            !log.contains("FAIL mismatches="),
+            "{simulator:?} ran on: {log}"
+        );
+    }
+}

@@ -93,10 +93,10 @@ struct GyrofxKf *gyrofx_kf_new(const struct GyrofxPlan *plan);
 // `kf` is NULL or from `gyrofx_kf_new`, not freed before.
 void gyrofx_kf_free(struct GyrofxKf *kf);
 
-// The pipeline in the RTL of the kF, as the package's manifest and
-// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
-// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
-// or -1 for a NULL handle.
+// The RTL pipeline of the KF, as the package's manifest and testbenches have it: writes the clocks
+// from a sample's `ce` to its registered outputs and the fewest clocks from one sample's `ce` to
+// the next one's (the RTL's simulation stops on a faster stream). Returns 0, or -1 for a NULL
+// handle.
 //
 // # Safety
 // `kf` is NULL or live; each output NULL or writable.
@@ -132,10 +132,10 @@ struct GyrofxSequencer *gyrofx_sequencer_new(const struct GyrofxPlan *plan);
 // `sequencer` is NULL or from `gyrofx_sequencer_new`, not freed before.
 void gyrofx_sequencer_free(struct GyrofxSequencer *sequencer);
 
-// The pipeline in the RTL of the sequencer, as the package's manifest and
-// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
-// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
-// or -1 for a NULL handle.
+// The RTL pipeline of the sequencer, as the package's manifest and testbenches have it: writes the
+// clocks from a sample's `ce` to its registered outputs and the fewest clocks from one sample's
+// `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0, or -1 for a
+// NULL handle.
 //
 // # Safety
 // `sequencer` is NULL or live; each output NULL or writable.
@@ -177,10 +177,10 @@ struct GyrofxEstimator *gyrofx_estimator_new(const struct GyrofxPlan *plan);
 // `estimator` is NULL or from `gyrofx_estimator_new`, not freed before.
 void gyrofx_estimator_free(struct GyrofxEstimator *estimator);
 
-// The pipeline in the RTL of the estimator, as the package's manifest and
-// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
-// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
-// or -1 for a NULL handle.
+// The RTL pipeline of the estimator, as the package's manifest and testbenches have it: writes the
+// clocks from a sample's `ce` to its registered outputs and the fewest clocks from one sample's
+// `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0, or -1 for a
+// NULL handle.
 //
 // # Safety
 // `estimator` is NULL or live; each output NULL or writable.
@@ -225,10 +225,10 @@ struct GyrofxMeanFilter *gyrofx_mean_filter_new(const struct GyrofxPlan *plan);
 // `filter` is NULL or from `gyrofx_mean_filter_new`, not freed before.
 void gyrofx_mean_filter_free(struct GyrofxMeanFilter *filter);
 
-// The pipeline in the RTL of the mean filter (as the plan's `architecture` builds it), as the package's manifest and
-// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
-// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
-// or -1 for a NULL handle.
+// The RTL pipeline of the mean filter (as the plan's `architecture` builds it), as the package's
+// manifest and testbenches have it: writes the clocks from a sample's `ce` to its registered
+// outputs and the fewest clocks from one sample's `ce` to the next one's (the RTL's simulation
+// stops on a faster stream). Returns 0, or -1 for a NULL handle.
 //
 // # Safety
 // `filter` is NULL or live; each output NULL or writable.
@@ -265,10 +265,10 @@ struct GyrofxChain *gyrofx_chain_new(const struct GyrofxPlan *plan);
 // `chain` is NULL or from `gyrofx_chain_new`, not freed before.
 void gyrofx_chain_free(struct GyrofxChain *chain);
 
-// The pipeline in the RTL of the chain (`gyrofx_top`, or `gyrofx_top_serial` with `architecture = "serial"`), as the package's manifest and
-// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
-// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
-// or -1 for a NULL handle.
+// The RTL pipeline of the chain (`gyrofx_top`, or `gyrofx_top_serial` with `architecture =
+// "serial"`), as the package's manifest and testbenches have it: writes the clocks from a sample's
+// `ce` to its registered outputs and the fewest clocks from one sample's `ce` to the next one's
+// (the RTL's simulation stops on a faster stream). Returns 0, or -1 for a NULL handle.
 //
 // # Safety
 // `chain` is NULL or live; each output NULL or writable.
@@ -321,10 +321,10 @@ struct GyrofxGyroLoop *gyrofx_gyro_loop_new(const struct GyrofxPlan *plan,
 // `gyro_loop` is NULL or from `gyrofx_gyro_loop_new`, not freed before.
 void gyrofx_gyro_loop_free(struct GyrofxGyroLoop *gyro_loop);
 
-// The pipeline in the RTL of the loop, as the package's manifest and
-// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
-// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
-// or -1 for a NULL handle.
+// The RTL pipeline of the loop, as the package's manifest and testbenches have it: writes the
+// clocks from a sample's `ce` to its registered outputs and the fewest clocks from one sample's
+// `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0, or -1 for a
+// NULL handle.
 //
 // # Safety
 // `gyro_loop` is NULL or live; each output NULL or writable.
@@ -368,10 +368,10 @@ struct GyrofxSystem *gyrofx_system_new(const struct GyrofxPlan *plan);
 // `system` is NULL or from `gyrofx_system_new`, not freed before.
 void gyrofx_system_free(struct GyrofxSystem *system);
 
-// The pipeline in the RTL of the system, as the package's manifest and
-// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
-// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
-// or -1 for a NULL handle.
+// The RTL pipeline of the system, as the package's manifest and testbenches have it: writes the
+// clocks from a sample's `ce` to its registered outputs and the fewest clocks from one sample's
+// `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0, or -1 for a
+// NULL handle.
 //
 // # Safety
 // `system` is NULL or live; each output NULL or writable.

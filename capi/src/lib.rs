@@ -283,10 +283,10 @@ pub unsafe extern "C" fn gyrofx_kf_free(kf: *mut GyrofxKf) {
     unsafe { free(kf) }
 }
 
-/// The pipeline in the RTL of the kF, as the package's manifest and
-/// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
-/// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
-/// or -1 for a NULL handle.
+/// The RTL pipeline of the KF, as the package's manifest and testbenches have it: writes the clocks
+/// from a sample's `ce` to its registered outputs and the fewest clocks from one sample's `ce` to
+/// the next one's (the RTL's simulation stops on a faster stream). Returns 0, or -1 for a NULL
+/// handle.
 ///
 /// # Safety
 /// `kf` is NULL or live; each output NULL or writable.
@@ -367,10 +367,10 @@ pub unsafe extern "C" fn gyrofx_sequencer_free(sequencer: *mut GyrofxSequencer) 
     unsafe { free(sequencer) }
 }
 
-/// The pipeline in the RTL of the sequencer, as the package's manifest and
-/// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
-/// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
-/// or -1 for a NULL handle.
+/// The RTL pipeline of the sequencer, as the package's manifest and testbenches have it: writes the
+/// clocks from a sample's `ce` to its registered outputs and the fewest clocks from one sample's
+/// `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0, or -1 for a
+/// NULL handle.
 ///
 /// # Safety
 /// `sequencer` is NULL or live; each output NULL or writable.
@@ -470,10 +470,10 @@ pub unsafe extern "C" fn gyrofx_estimator_free(estimator: *mut GyrofxEstimator) 
     unsafe { free(estimator) }
 }
 
-/// The pipeline in the RTL of the estimator, as the package's manifest and
-/// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
-/// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
-/// or -1 for a NULL handle.
+/// The RTL pipeline of the estimator, as the package's manifest and testbenches have it: writes the
+/// clocks from a sample's `ce` to its registered outputs and the fewest clocks from one sample's
+/// `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0, or -1 for a
+/// NULL handle.
 ///
 /// # Safety
 /// `estimator` is NULL or live; each output NULL or writable.
@@ -576,10 +576,10 @@ pub unsafe extern "C" fn gyrofx_mean_filter_free(filter: *mut GyrofxMeanFilter) 
     unsafe { free(filter) }
 }
 
-/// The pipeline in the RTL of the mean filter (as the plan's `architecture` builds it), as the package's manifest and
-/// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
-/// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
-/// or -1 for a NULL handle.
+/// The RTL pipeline of the mean filter (as the plan's `architecture` builds it), as the package's
+/// manifest and testbenches have it: writes the clocks from a sample's `ce` to its registered
+/// outputs and the fewest clocks from one sample's `ce` to the next one's (the RTL's simulation
+/// stops on a faster stream). Returns 0, or -1 for a NULL handle.
 ///
 /// # Safety
 /// `filter` is NULL or live; each output NULL or writable.
@@ -663,10 +663,10 @@ pub unsafe extern "C" fn gyrofx_chain_free(chain: *mut GyrofxChain) {
     unsafe { free(chain) }
 }
 
-/// The pipeline in the RTL of the chain (`gyrofx_top`, or `gyrofx_top_serial` with `architecture = "serial"`), as the package's manifest and
-/// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
-/// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
-/// or -1 for a NULL handle.
+/// The RTL pipeline of the chain (`gyrofx_top`, or `gyrofx_top_serial` with `architecture =
+/// "serial"`), as the package's manifest and testbenches have it: writes the clocks from a sample's
+/// `ce` to its registered outputs and the fewest clocks from one sample's `ce` to the next one's
+/// (the RTL's simulation stops on a faster stream). Returns 0, or -1 for a NULL handle.
 ///
 /// # Safety
 /// `chain` is NULL or live; each output NULL or writable.
@@ -790,10 +790,10 @@ pub unsafe extern "C" fn gyrofx_gyro_loop_free(gyro_loop: *mut GyrofxGyroLoop) {
     unsafe { free(gyro_loop) }
 }
 
-/// The pipeline in the RTL of the loop, as the package's manifest and
-/// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
-/// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
-/// or -1 for a NULL handle.
+/// The RTL pipeline of the loop, as the package's manifest and testbenches have it: writes the
+/// clocks from a sample's `ce` to its registered outputs and the fewest clocks from one sample's
+/// `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0, or -1 for a
+/// NULL handle.
 ///
 /// # Safety
 /// `gyro_loop` is NULL or live; each output NULL or writable.
@@ -897,10 +897,10 @@ pub unsafe extern "C" fn gyrofx_system_free(system: *mut GyrofxSystem) {
     unsafe { free(system) }
 }
 
-/// The pipeline in the RTL of the system, as the package's manifest and
-/// testbenches have it: writes the clocks from a sample's `ce` to its registered outputs and the fewest clocks from one
-/// sample's `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0,
-/// or -1 for a NULL handle.
+/// The RTL pipeline of the system, as the package's manifest and testbenches have it: writes the
+/// clocks from a sample's `ce` to its registered outputs and the fewest clocks from one sample's
+/// `ce` to the next one's (the RTL's simulation stops on a faster stream). Returns 0, or -1 for a
+/// NULL handle.
 ///
 /// # Safety
 /// `system` is NULL or live; each output NULL or writable.

@@ -23,17 +23,52 @@ pub fn tested(blocks: &[Block]) -> Vec<&Block> {
     blocks.iter().filter(|b| b.dpi.is_some()).collect()
 }
 
-/// Every file of the package's `dpi/` folder: `(path, text)`.
+/// Every file of the package's `dpi/` folder: `(path, text)`: the imports' package, then a
+/// testbench per tested block (none at all when no block is tested).
 pub fn files(blocks: &[Block], provenance: &Provenance) -> Vec<(String, String)> {
-    tested(blocks)
-        .into_iter()
-        .map(|block| {
-            (
-                format!("{FOLDER}/tb_dpi_{}.sv", block.module),
-                testbench(block, provenance),
-            )
-        })
-        .collect()
+    let tested = tested(blocks);
+    if tested.is_empty() {
+        return Vec::new();
+    }
+    let mut files = vec![(
+        format!("{FOLDER}/{PACKAGE}.sv"),
+        package(&tested, provenance),
+    )];
+    files.extend(tested.into_iter().map(|block| {
+        (
+            format!("{FOLDER}/tb_dpi_{}.sv", block.module),
+            testbench(block, provenance),
+        )
+    }));
+    files
+}
+
+/// The SystemVerilog package every DPI-C testbench imports.
+pub const PACKAGE: &str = "gyrofx_dpi_pkg";
+
+/// `gyrofx_dpi_pkg`: the C ABI's common imports and each tested block's own, once.
+fn package(tested: &[&Block], provenance: &Provenance) -> String {
+    // Two blocks may import one function: each import statement (to its `;`, lines and all)
+    // once.
+    let mut imports: Vec<&str> = Vec::new();
+    for statement in tested
+        .iter()
+        .filter_map(|b| b.dpi.map(|parts| parts.imports))
+        .flat_map(|text| text.split_inclusive(';'))
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
+    {
+        if !imports.contains(&statement) {
+            imports.push(statement);
+        }
+    }
+    fill(
+        PACKAGE_TEMPLATE,
+        &[
+            ("provenance", &provenance.line("//")),
+            ("imports", &imports.join("\n")),
+        ],
+    )
 }
 
 fn declaration(signal: &Signal, kind: &str) -> String {
@@ -95,7 +130,6 @@ pub fn testbench(block: &Block, provenance: &Provenance) -> String {
             ("title", block.title),
             ("params_file", &block.file("params.vh")),
             ("interval_width", &interval_width.to_string()),
-            ("imports", parts.imports.trim_end()),
             ("declarations", &declarations.join("\n")),
             ("instance", &instance(block)),
             ("samples", &parts.samples.to_string()),
@@ -110,3 +144,4 @@ pub fn testbench(block: &Block, provenance: &Provenance) -> String {
 /// stream, its monitor (`codegen/templates/dpi/`), filled by [`fill`].
 const TESTBENCH: &str = include_str!("../templates/dpi/testbench.sv");
 const STREAM_MONITOR: &str = include_str!("../templates/dpi/stream_monitor.sv");
+const PACKAGE_TEMPLATE: &str = include_str!("../templates/dpi/package.sv");

@@ -14,14 +14,7 @@ module tb_dpi_gyrofx_gyro_loop;
 `include "gyro_loop_params.vh"
 localparam integer TB_INTERVAL_W = 1;
 
-import "DPI-C" function chandle gyrofx_plan_from_package(input string folder);
-import "DPI-C" function void gyrofx_plan_free(input chandle plan);
-import "DPI-C" function string gyrofx_last_error();
-import "DPI-C" function chandle gyrofx_gyro_loop_new(input chandle plan, input int gyro);
-import "DPI-C" function int gyrofx_gyro_loop_reset(input chandle gyro_loop);
-import "DPI-C" function int gyrofx_gyro_loop_step(input chandle gyro_loop, input longint adc_x, input longint adc_y,
-    input int mode, output longint dac_x, output longint dac_y, output int locked, output int out_valid,
-    output longint rate, output longint quadrature);
+import gyrofx_dpi_pkg::*;
 
 logic clk = 1'b0;
 always #5 clk = ~clk;

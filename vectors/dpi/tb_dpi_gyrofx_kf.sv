@@ -14,12 +14,7 @@ module tb_dpi_gyrofx_kf;
 `include "kf_params.vh"
 localparam integer TB_INTERVAL_W = 1;
 
-import "DPI-C" function chandle gyrofx_plan_from_package(input string folder);
-import "DPI-C" function void gyrofx_plan_free(input chandle plan);
-import "DPI-C" function string gyrofx_last_error();
-import "DPI-C" function chandle gyrofx_kf_new(input chandle plan);
-import "DPI-C" function int gyrofx_kf_reset(input chandle kf);
-import "DPI-C" function int gyrofx_kf_step(input chandle kf, input longint z, input int bw_sel, output longint rate_out);
+import gyrofx_dpi_pkg::*;
 
 logic clk = 1'b0;
 always #5 clk = ~clk;

@@ -14,12 +14,7 @@ module tb_dpi_gyrofx_mean_filter;
 `include "mean_filter_params.vh"
 localparam integer TB_INTERVAL_W = 1;
 
-import "DPI-C" function chandle gyrofx_plan_from_package(input string folder);
-import "DPI-C" function void gyrofx_plan_free(input chandle plan);
-import "DPI-C" function string gyrofx_last_error();
-import "DPI-C" function chandle gyrofx_mean_filter_new(input chandle plan);
-import "DPI-C" function int gyrofx_mean_filter_reset(input chandle filter);
-import "DPI-C" function int gyrofx_mean_filter_step(input chandle filter, input longint x, output int y_valid, output longint y, output longint kept);
+import gyrofx_dpi_pkg::*;
 
 logic clk = 1'b0;
 always #5 clk = ~clk;

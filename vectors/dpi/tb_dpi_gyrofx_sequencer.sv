@@ -14,20 +14,7 @@ module tb_dpi_gyrofx_sequencer;
 `include "sequencer_params.vh"
 localparam integer TB_INTERVAL_W = 2;
 
-import "DPI-C" function chandle gyrofx_plan_from_package(input string folder);
-import "DPI-C" function void gyrofx_plan_free(input chandle plan);
-import "DPI-C" function string gyrofx_last_error();
-import "DPI-C" function chandle gyrofx_sequencer_new(input chandle plan);
-import "DPI-C" function int gyrofx_sequencer_reset(input chandle sequencer);
-import "DPI-C" function int gyrofx_sequencer_step(input chandle sequencer, output int mode_a, output int mode_b,
-    output int blank_a, output int blank_b, output int interval_a, output int interval_b,
-    output int done_a, output int done_b, output int window_done);
-import "DPI-C" function chandle gyrofx_estimator_new(input chandle plan);
-import "DPI-C" function int gyrofx_estimator_reset(input chandle estimator);
-import "DPI-C" function int gyrofx_estimator_step(input chandle estimator, input longint y_a, input longint y_b,
-    input int blank_a, input int blank_b, input int done_a, input int done_b,
-    input int interval_a, input int interval_b, input int window_done,
-    output longint bias_a, output longint bias_b, output int estimated);
+import gyrofx_dpi_pkg::*;
 
 logic clk = 1'b0;
 always #5 clk = ~clk;

@@ -14,14 +14,7 @@ module tb_dpi_gyrofx_top;
 `include "top_params.vh"
 localparam integer TB_INTERVAL_W = 1;
 
-import "DPI-C" function chandle gyrofx_plan_from_package(input string folder);
-import "DPI-C" function void gyrofx_plan_free(input chandle plan);
-import "DPI-C" function string gyrofx_last_error();
-import "DPI-C" function chandle gyrofx_chain_new(input chandle plan);
-import "DPI-C" function int gyrofx_chain_reset(input chandle chain);
-import "DPI-C" function int gyrofx_chain_step(input chandle chain, input longint y_a, input longint y_b, input int bw_sel,
-    output int mode_a, output int mode_b, output int out_valid, output longint rate_out,
-    output longint bias_a, output longint bias_b, output int estimated);
+import gyrofx_dpi_pkg::*;
 
 logic clk = 1'b0;
 always #5 clk = ~clk;

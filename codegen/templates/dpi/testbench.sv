@@ -14,10 +14,7 @@ module @tb@;
 `include "@params_file@"
 localparam integer TB_INTERVAL_W = @interval_width@;
 
-import "DPI-C" function chandle gyrofx_plan_from_package(input string folder);
-import "DPI-C" function void gyrofx_plan_free(input chandle plan);
-import "DPI-C" function string gyrofx_last_error();
-@imports@
+import gyrofx_dpi_pkg::*;
 
 logic clk = 1'b0;
 always #5 clk = ~clk;
