@@ -4,8 +4,8 @@
 #   scripts/test.sh
 #
 # Installs the simulators and synthesis tools with apt-get where missing (iverilog, verilator,
-# ghdl, yosys, nextpnr-ice40, make, cbindgen for the C header's test, ccache for Verilator's
-# runtime, and the DejaVu font the plots use), FuseSoC with pip in a virtualenv, and maturin,
+# ghdl, yosys, nextpnr-ice40, make, cbindgen for the C header's test, pkg-config for the
+# installed C library's, ccache for Verilator's runtime, and the DejaVu font the plots use), FuseSoC with pip in a virtualenv, and maturin,
 # numpy, pytest and pytest-xdist in another (for the Python package in python/):
 # a missing simulator is a failure, never a skipped test. Then: rustfmt, Verilator and GHDL lint
 # of the RTL, and the whole test suite with cargo-nextest (unit, property, end-to-end in every
@@ -33,7 +33,7 @@ export CARGO_INCREMENTAL=0
 
 font=/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf
 missing=()
-for program in iverilog vvp verilator ghdl yosys nextpnr-ice40 make sha256sum cbindgen ccache; do
+for program in iverilog vvp verilator ghdl yosys nextpnr-ice40 make sha256sum cbindgen ccache pkg-config; do
     command -v "$program" >/dev/null 2>&1 || missing+=("$program")
 done
 [ -f "$font" ] || missing+=("$font")
@@ -43,7 +43,7 @@ if [ ${#missing[@]} -gt 0 ]; then
     if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
     $sudo apt-get update -qq
     DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq \
-        iverilog verilator ghdl yosys nextpnr-ice40 make coreutils cbindgen ccache fonts-dejavu-core >/dev/null
+        iverilog verilator ghdl yosys nextpnr-ice40 make coreutils cbindgen ccache pkgconf fonts-dejavu-core >/dev/null
 fi
 # GHDL's LLVM back end runs the closed-loop testbenches about 3x faster than the default mcode
 # one (2310 us of the system testbench: 90 s against 258 s); Debian's ghdl wrapper takes it from
@@ -57,7 +57,7 @@ if [ ! -x /usr/bin/ghdl-llvm ] && command -v apt-get >/dev/null 2>&1; then
 fi
 if [ -x /usr/bin/ghdl-llvm ]; then export GHDL_BACKEND=llvm; fi
 [ -f "$font" ] || { echo "FAIL: $font is still missing after apt-get (plots need it)" >&2; exit 1; }
-for program in iverilog vvp verilator ghdl yosys nextpnr-ice40 make sha256sum cbindgen ccache; do
+for program in iverilog vvp verilator ghdl yosys nextpnr-ice40 make sha256sum cbindgen ccache pkg-config; do
     command -v "$program" >/dev/null 2>&1 || { echo "FAIL: $program is still missing after apt-get" >&2; exit 1; }
 done
 

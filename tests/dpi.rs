@@ -346,3 +346,54 @@ fn every_dpi_import_is_the_c_headers_function_in_dpi_types() {
     }
     assert!(checked >= 30, "only {checked} imports in the package");
 }
+
+/// `scripts/install-capi.sh` installs the library, the header and a pkg-config file under a
+/// prefix; `pkg-config` then gives the flags that build `check_api.c` against the installed
+/// copy, which runs. A second install over it is refused without `--force`.
+#[test]
+fn the_installed_library_builds_a_c_program_through_pkg_config() {
+    let dir = tempfile::tempdir().unwrap();
+    let prefix = dir.path().join("prefix");
+    let from = library().parent().unwrap().to_path_buf();
+    let script = repository().join("scripts/install-capi.sh");
+    let install = |extra: &[&str]| {
+        let mut command = Command::new(&script);
+        command.arg(&prefix).arg("--from").arg(&from).args(extra);
+        text(&command.output().unwrap())
+    };
+    let log = install(&[]);
+    assert!(log.contains("installed gyrofx_capi"), "{log}");
+    assert!(prefix.join("include/gyrofx.h").is_file());
+    let refused = install(&[]);
+    assert!(
+        refused.contains("exists; remove it or pass --force"),
+        "{refused}"
+    );
+    assert!(install(&["--force"]).contains("installed gyrofx_capi"));
+    let flags = Command::new("pkg-config")
+        .args(["--cflags", "--libs", "--static", "gyrofx_capi"])
+        .env("PKG_CONFIG_PATH", prefix.join("lib/pkgconfig"))
+        .output()
+        .expect("pkg-config runs (scripts/test.sh installs it)");
+    assert!(flags.status.success(), "{}", text(&flags));
+    let flags = String::from_utf8(flags.stdout).unwrap();
+    assert!(
+        flags.contains(&format!("-I{}", prefix.join("include").display())),
+        "{flags}"
+    );
+    let program = dir.path().join("check_api");
+    let mut gcc = Command::new("gcc");
+    gcc.args(["-std=c99", "-Wall", "-Werror"])
+        .arg(repository().join("capi/examples/check_api.c"))
+        .args(flags.split_whitespace())
+        .arg("-o")
+        .arg(&program);
+    let built = gcc.output().unwrap();
+    assert!(built.status.success(), "{}", text(&built));
+    let ran = Command::new(&program)
+        .env("LD_LIBRARY_PATH", prefix.join("lib"))
+        .output()
+        .unwrap();
+    assert!(ran.status.success(), "{}", text(&ran));
+    assert!(text(&ran).contains("pipeline kf 4 3"), "{}", text(&ran));
+}
