@@ -214,3 +214,77 @@ fn every_clocked_blocks_page_states_its_pipeline() {
     let drifted = kf.replace("`latency_clocks` = 4", "`latency_clocks` = 1");
     assert_ne!(doc_pipeline(&drifted), doc_pipeline(&kf));
 }
+
+/// The port-level golden models' port lists (`gyrofx_job::golden::ports`, which the Python
+/// classes and the C API give) are the package's, name, direction and format, in the vector
+/// files' order: for the default config, the serial architecture and narrower formats.
+#[test]
+fn the_golden_models_ports_are_the_packages() {
+    use gyrofx_job::golden;
+    let configs = [
+        Config::embedded(),
+        Config::from_toml("architecture = \"serial\"\n", "serial").unwrap(),
+        Config::from_toml(
+            "[kf]\nbandwidths_hz = [0.5, 2.0, 5.0, 10.0, 20.0]\ninput_format = \"s20.10\"\n\
+             [loop]\noutput_format = \"s20.10\"\ndemod_output_format = \"s24.22\"\n",
+            "narrow",
+        )
+        .unwrap(),
+    ];
+    let provenance = Provenance {
+        version: "test".into(),
+        command: "test".into(),
+        config_sha256: "0".repeat(64),
+    };
+    for config in configs {
+        let job = Job::new(config).unwrap();
+        let roms = RomImages::new(&job, &provenance);
+        let [a, b] = &job.gyro_loops;
+        let system_chain = job.system_chain.as_ref().unwrap();
+        let models: [(&str, Vec<golden::ports::Port>); 7] = [
+            (
+                "sequencer",
+                golden::Sequencer::new(&job.chain.estimator.schedule).ports(),
+            ),
+            (
+                "estimator",
+                golden::Estimator::new(&job.chain.estimator).ports(),
+            ),
+            ("kf", golden::Kf::new(job.kf()).ports()),
+            ("top", golden::Chain::new(&job.chain).ports()),
+            (
+                "mean_filter",
+                golden::MeanFilter::new(&job.mean_filter).ports(),
+            ),
+            ("gyro_loop", golden::GyroLoop::new(&a.plan).ports()),
+            (
+                "system",
+                golden::System::new([&a.plan, &b.plan], system_chain).ports(),
+            ),
+        ];
+        for (name, ports) in models {
+            let block = REGISTRY
+                .iter()
+                .find(|r| r.name() == name)
+                .unwrap()
+                .block(&job, &roms);
+            let package: Vec<(String, &str, String)> = block
+                .inputs
+                .iter()
+                .map(|s| (s.name.to_string(), "in", s.format.to_string()))
+                .chain(block.outputs.iter().map(|o| {
+                    (
+                        o.signal.name.to_string(),
+                        "out",
+                        o.signal.format.to_string(),
+                    )
+                }))
+                .collect();
+            let model: Vec<(String, &str, String)> = ports
+                .iter()
+                .map(|p| (p.name.to_string(), p.direction(), p.format.to_string()))
+                .collect();
+            assert_eq!(model, package, "{name}: {}", job.config.to_toml());
+        }
+    }
+}

@@ -99,6 +99,25 @@ fn a_c_program_gets_the_models_results_and_its_errors() {
     }
     assert!(out.contains("pipeline kf 4 3\n"), "{out}");
     assert!(out.contains("null pipeline: -1"), "{out}");
+    // The KF's ports, as the golden model lists them (and tests/blocks.rs holds that list to
+    // the package's), and the refusal past the last.
+    let kf_job =
+        Job::new(Config::from_toml("[kf]\nbandwidths_hz = [5.0, 10.0]\n", "t").unwrap()).unwrap();
+    let ports = golden::Kf::new(kf_job.kf()).ports();
+    let want: Vec<String> = ports
+        .iter()
+        .map(|p| format!("port kf {} {} {}", p.name, p.direction(), p.format))
+        .collect();
+    let got: Vec<&str> = out.lines().filter(|l| l.starts_with("port kf ")).collect();
+    assert_eq!(got, want);
+    assert!(
+        out.contains(&format!(
+            "no port: -1 port index = {0}: allowed 0 to {1} (the block has {0} ports)",
+            ports.len(),
+            ports.len() - 1
+        )),
+        "{out}"
+    );
     // The same steps in Rust: the C side must see the same codes.
     let job =
         Job::new(Config::from_toml("[kf]\nbandwidths_hz = [5.0, 10.0]\n", "t").unwrap()).unwrap();

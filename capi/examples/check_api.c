@@ -92,6 +92,16 @@ int main(void) {
         if (gyrofx_kf_step(kf, z, (int)(k / 25), &rate) != 0) return 1;
         printf("rate %lld\n", (long long)rate);
     }
+    int ports = gyrofx_kf_port_count(kf);
+    for (int index = 0; index < ports; ++index) {
+        const char *name;
+        int width, fraction, is_signed, is_output;
+        if (gyrofx_kf_port(kf, index, &name, &width, &fraction, &is_signed, &is_output) != 0) return 1;
+        printf("port kf %s %s %c%d.%d\n", name, is_output ? "out" : "in", is_signed ? 's' : 'u', width,
+               fraction);
+    }
+    status = gyrofx_kf_port(kf, ports, NULL, NULL, NULL, NULL, NULL);
+    printf("no port: %d %s\n", status, gyrofx_last_error());
     if (gyrofx_kf_pipeline(kf, &latency, &spacing) != 0) return 1;
     printf("pipeline kf %d %d\n", latency, spacing);
     gyrofx_kf_free(kf);

@@ -104,6 +104,28 @@ int32_t gyrofx_kf_pipeline(const struct GyrofxKf *kf,
                            int32_t *latency_clocks,
                            int32_t *min_clocks_per_sample);
 
+// How many ports the KF has (after `clk`, `rst` and `ce`; see `gyrofx_kf_port`),
+// or -1 for a NULL handle.
+//
+// # Safety
+// `kf` is NULL or live.
+int32_t gyrofx_kf_port_count(const struct GyrofxKf *kf);
+
+// Port `index` of the KF, in its vector files' order (inputs, then outputs): writes its
+// name (a string the library keeps: do not free it), its format's width and fraction bits,
+// whether it is signed and whether it is an output. Returns 0, or -1 for a NULL handle or
+// an index out of range (`gyrofx_last_error()` says which are allowed).
+//
+// # Safety
+// `kf` is NULL or live; each output NULL or writable.
+int32_t gyrofx_kf_port(const struct GyrofxKf *kf,
+                       int32_t index,
+                       const char **name,
+                       int32_t *width,
+                       int32_t *fraction,
+                       int32_t *is_signed,
+                       int32_t *is_output);
+
 // The synchronous reset. Returns 0, or -1 for a NULL handle.
 //
 // # Safety
@@ -142,6 +164,28 @@ void gyrofx_sequencer_free(struct GyrofxSequencer *sequencer);
 int32_t gyrofx_sequencer_pipeline(const struct GyrofxSequencer *sequencer,
                                   int32_t *latency_clocks,
                                   int32_t *min_clocks_per_sample);
+
+// How many ports the sequencer has (after `clk`, `rst` and `ce`; see `gyrofx_sequencer_port`),
+// or -1 for a NULL handle.
+//
+// # Safety
+// `sequencer` is NULL or live.
+int32_t gyrofx_sequencer_port_count(const struct GyrofxSequencer *sequencer);
+
+// Port `index` of the sequencer, in its vector files' order (inputs, then outputs): writes its
+// name (a string the library keeps: do not free it), its format's width and fraction bits,
+// whether it is signed and whether it is an output. Returns 0, or -1 for a NULL handle or
+// an index out of range (`gyrofx_last_error()` says which are allowed).
+//
+// # Safety
+// `sequencer` is NULL or live; each output NULL or writable.
+int32_t gyrofx_sequencer_port(const struct GyrofxSequencer *sequencer,
+                              int32_t index,
+                              const char **name,
+                              int32_t *width,
+                              int32_t *fraction,
+                              int32_t *is_signed,
+                              int32_t *is_output);
 
 // The synchronous reset. Returns 0, or -1 for a NULL handle.
 //
@@ -187,6 +231,28 @@ void gyrofx_estimator_free(struct GyrofxEstimator *estimator);
 int32_t gyrofx_estimator_pipeline(const struct GyrofxEstimator *estimator,
                                   int32_t *latency_clocks,
                                   int32_t *min_clocks_per_sample);
+
+// How many ports the estimator has (after `clk`, `rst` and `ce`; see `gyrofx_estimator_port`),
+// or -1 for a NULL handle.
+//
+// # Safety
+// `estimator` is NULL or live.
+int32_t gyrofx_estimator_port_count(const struct GyrofxEstimator *estimator);
+
+// Port `index` of the estimator, in its vector files' order (inputs, then outputs): writes its
+// name (a string the library keeps: do not free it), its format's width and fraction bits,
+// whether it is signed and whether it is an output. Returns 0, or -1 for a NULL handle or
+// an index out of range (`gyrofx_last_error()` says which are allowed).
+//
+// # Safety
+// `estimator` is NULL or live; each output NULL or writable.
+int32_t gyrofx_estimator_port(const struct GyrofxEstimator *estimator,
+                              int32_t index,
+                              const char **name,
+                              int32_t *width,
+                              int32_t *fraction,
+                              int32_t *is_signed,
+                              int32_t *is_output);
 
 // The synchronous reset. Returns 0, or -1 for a NULL handle.
 //
@@ -236,6 +302,28 @@ int32_t gyrofx_mean_filter_pipeline(const struct GyrofxMeanFilter *filter,
                                     int32_t *latency_clocks,
                                     int32_t *min_clocks_per_sample);
 
+// How many ports the mean filter has (after `clk`, `rst` and `ce`; see `gyrofx_mean_filter_port`),
+// or -1 for a NULL handle.
+//
+// # Safety
+// `filter` is NULL or live.
+int32_t gyrofx_mean_filter_port_count(const struct GyrofxMeanFilter *filter);
+
+// Port `index` of the mean filter, in its vector files' order (inputs, then outputs): writes its
+// name (a string the library keeps: do not free it), its format's width and fraction bits,
+// whether it is signed and whether it is an output. Returns 0, or -1 for a NULL handle or
+// an index out of range (`gyrofx_last_error()` says which are allowed).
+//
+// # Safety
+// `filter` is NULL or live; each output NULL or writable.
+int32_t gyrofx_mean_filter_port(const struct GyrofxMeanFilter *filter,
+                                int32_t index,
+                                const char **name,
+                                int32_t *width,
+                                int32_t *fraction,
+                                int32_t *is_signed,
+                                int32_t *is_output);
+
 // The synchronous reset. Returns 0, or -1 for a NULL handle.
 //
 // # Safety
@@ -275,6 +363,28 @@ void gyrofx_chain_free(struct GyrofxChain *chain);
 int32_t gyrofx_chain_pipeline(const struct GyrofxChain *chain,
                               int32_t *latency_clocks,
                               int32_t *min_clocks_per_sample);
+
+// How many ports the chain has (after `clk`, `rst` and `ce`; see `gyrofx_chain_port`),
+// or -1 for a NULL handle.
+//
+// # Safety
+// `chain` is NULL or live.
+int32_t gyrofx_chain_port_count(const struct GyrofxChain *chain);
+
+// Port `index` of the chain, in its vector files' order (inputs, then outputs): writes its
+// name (a string the library keeps: do not free it), its format's width and fraction bits,
+// whether it is signed and whether it is an output. Returns 0, or -1 for a NULL handle or
+// an index out of range (`gyrofx_last_error()` says which are allowed).
+//
+// # Safety
+// `chain` is NULL or live; each output NULL or writable.
+int32_t gyrofx_chain_port(const struct GyrofxChain *chain,
+                          int32_t index,
+                          const char **name,
+                          int32_t *width,
+                          int32_t *fraction,
+                          int32_t *is_signed,
+                          int32_t *is_output);
 
 // The synchronous reset. Returns 0, or -1 for a NULL handle.
 //
@@ -332,6 +442,28 @@ int32_t gyrofx_gyro_loop_pipeline(const struct GyrofxGyroLoop *gyro_loop,
                                   int32_t *latency_clocks,
                                   int32_t *min_clocks_per_sample);
 
+// How many ports the loop has (after `clk`, `rst` and `ce`; see `gyrofx_gyro_loop_port`),
+// or -1 for a NULL handle.
+//
+// # Safety
+// `gyro_loop` is NULL or live.
+int32_t gyrofx_gyro_loop_port_count(const struct GyrofxGyroLoop *gyro_loop);
+
+// Port `index` of the loop, in its vector files' order (inputs, then outputs): writes its
+// name (a string the library keeps: do not free it), its format's width and fraction bits,
+// whether it is signed and whether it is an output. Returns 0, or -1 for a NULL handle or
+// an index out of range (`gyrofx_last_error()` says which are allowed).
+//
+// # Safety
+// `gyro_loop` is NULL or live; each output NULL or writable.
+int32_t gyrofx_gyro_loop_port(const struct GyrofxGyroLoop *gyro_loop,
+                              int32_t index,
+                              const char **name,
+                              int32_t *width,
+                              int32_t *fraction,
+                              int32_t *is_signed,
+                              int32_t *is_output);
+
 // The synchronous reset. Returns 0, or -1 for a NULL handle.
 //
 // # Safety
@@ -378,6 +510,28 @@ void gyrofx_system_free(struct GyrofxSystem *system);
 int32_t gyrofx_system_pipeline(const struct GyrofxSystem *system,
                                int32_t *latency_clocks,
                                int32_t *min_clocks_per_sample);
+
+// How many ports the system has (after `clk`, `rst` and `ce`; see `gyrofx_system_port`),
+// or -1 for a NULL handle.
+//
+// # Safety
+// `system` is NULL or live.
+int32_t gyrofx_system_port_count(const struct GyrofxSystem *system);
+
+// Port `index` of the system, in its vector files' order (inputs, then outputs): writes its
+// name (a string the library keeps: do not free it), its format's width and fraction bits,
+// whether it is signed and whether it is an output. Returns 0, or -1 for a NULL handle or
+// an index out of range (`gyrofx_last_error()` says which are allowed).
+//
+// # Safety
+// `system` is NULL or live; each output NULL or writable.
+int32_t gyrofx_system_port(const struct GyrofxSystem *system,
+                           int32_t index,
+                           const char **name,
+                           int32_t *width,
+                           int32_t *fraction,
+                           int32_t *is_signed,
+                           int32_t *is_output);
 
 // The synchronous reset. Returns 0, or -1 for a NULL handle.
 //

@@ -17,11 +17,13 @@
 #![allow(unsafe_code)]
 
 use std::cell::RefCell;
+use std::collections::BTreeMap;
 use std::ffi::{c_char, CStr, CString};
 use std::path::Path;
+use std::sync::Mutex;
 
 use gyrofx_job::config::Config;
-use gyrofx_job::golden;
+use gyrofx_job::golden::{self, ports::Port};
 use gyrofx_job::job::Job;
 use gyrofx_job::pipeline::{self, Pipeline};
 
@@ -256,6 +258,81 @@ unsafe fn pipeline_of<T>(
     0
 }
 
+/// A port name as a C string that lives as long as the library: each name is made once and
+/// kept (the names are a fixed, small set).
+fn c_name(name: &'static str) -> *const c_char {
+    static NAMES: Mutex<BTreeMap<&'static str, CString>> = Mutex::new(BTreeMap::new());
+    let mut names = NAMES
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    names
+        .entry(name)
+        .or_insert_with(|| CString::new(name).unwrap_or_default())
+        .as_ptr()
+}
+
+/// How many ports a live block has; -1 for a NULL block.
+///
+/// # Safety
+/// `block` is NULL or a live block of type `T`.
+unsafe fn port_count_of<T>(block: *const T, ports: impl FnOnce(&T) -> Vec<Port>) -> i32 {
+    // SAFETY: NULL or live, by contract.
+    match unsafe { block.as_ref() } {
+        Some(block) => i32::try_from(ports(block).len()).unwrap_or(i32::MAX),
+        None => {
+            fail("block is NULL");
+            -1
+        }
+    }
+}
+
+/// Writes port `index` of a live block (the vector files' order: inputs, then outputs):
+/// its name (a string the library keeps), width, fraction bits, whether it is signed and
+/// whether it is an output. 0, or -1 for a NULL block or an index out of range.
+///
+/// # Safety
+/// `block` is NULL or a live block of type `T`; each output NULL or writable.
+unsafe fn port_of<T>(
+    block: *const T,
+    ports: impl FnOnce(&T) -> Vec<Port>,
+    index: i32,
+    outputs: PortOutputs,
+) -> i32 {
+    // SAFETY: NULL or live, by contract.
+    let Some(block) = (unsafe { block.as_ref() }) else {
+        fail("block is NULL");
+        return -1;
+    };
+    let ports = ports(block);
+    let Some(port) = usize::try_from(index).ok().and_then(|i| ports.get(i)) else {
+        fail(format!(
+            "port index = {index}: allowed 0 to {} (the block has {} ports)",
+            ports.len() - 1,
+            ports.len()
+        ));
+        return -1;
+    };
+    let to_i32 = |n: u32| i32::try_from(n).unwrap_or(i32::MAX);
+    // SAFETY: forwarded contract.
+    unsafe {
+        put(outputs.name, c_name(port.name));
+        put(outputs.width, to_i32(port.format.width));
+        put(outputs.fraction, port.format.frac);
+        put(outputs.is_signed, i32::from(port.format.signed));
+        put(outputs.is_output, i32::from(port.output));
+    }
+    0
+}
+
+/// Where [`port_of`] writes a port's facts.
+struct PortOutputs {
+    name: *mut *const c_char,
+    width: *mut i32,
+    fraction: *mut i32,
+    is_signed: *mut i32,
+    is_output: *mut i32,
+}
+
 /// The steady-state KF (`gyrofx_kf`).
 pub struct GyrofxKf(golden::Kf, Pipeline);
 
@@ -298,6 +375,45 @@ pub unsafe extern "C" fn gyrofx_kf_pipeline(
 ) -> i32 {
     // SAFETY: forwarded contract.
     unsafe { pipeline_of(kf, |b| b.1, latency_clocks, min_clocks_per_sample) }
+}
+
+/// How many ports the KF has (after `clk`, `rst` and `ce`; see `gyrofx_kf_port`),
+/// or -1 for a NULL handle.
+///
+/// # Safety
+/// `kf` is NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_kf_port_count(kf: *const GyrofxKf) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe { port_count_of(kf, |b| b.0.ports()) }
+}
+
+/// Port `index` of the KF, in its vector files' order (inputs, then outputs): writes its
+/// name (a string the library keeps: do not free it), its format's width and fraction bits,
+/// whether it is signed and whether it is an output. Returns 0, or -1 for a NULL handle or
+/// an index out of range (`gyrofx_last_error()` says which are allowed).
+///
+/// # Safety
+/// `kf` is NULL or live; each output NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_kf_port(
+    kf: *const GyrofxKf,
+    index: i32,
+    name: *mut *const c_char,
+    width: *mut i32,
+    fraction: *mut i32,
+    is_signed: *mut i32,
+    is_output: *mut i32,
+) -> i32 {
+    let outputs = PortOutputs {
+        name,
+        width,
+        fraction,
+        is_signed,
+        is_output,
+    };
+    // SAFETY: forwarded contract.
+    unsafe { port_of(kf, |b| b.0.ports(), index, outputs) }
 }
 
 /// The synchronous reset. Returns 0, or -1 for a NULL handle.
@@ -382,6 +498,45 @@ pub unsafe extern "C" fn gyrofx_sequencer_pipeline(
 ) -> i32 {
     // SAFETY: forwarded contract.
     unsafe { pipeline_of(sequencer, |b| b.1, latency_clocks, min_clocks_per_sample) }
+}
+
+/// How many ports the sequencer has (after `clk`, `rst` and `ce`; see `gyrofx_sequencer_port`),
+/// or -1 for a NULL handle.
+///
+/// # Safety
+/// `sequencer` is NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_sequencer_port_count(sequencer: *const GyrofxSequencer) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe { port_count_of(sequencer, |b| b.0.ports()) }
+}
+
+/// Port `index` of the sequencer, in its vector files' order (inputs, then outputs): writes its
+/// name (a string the library keeps: do not free it), its format's width and fraction bits,
+/// whether it is signed and whether it is an output. Returns 0, or -1 for a NULL handle or
+/// an index out of range (`gyrofx_last_error()` says which are allowed).
+///
+/// # Safety
+/// `sequencer` is NULL or live; each output NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_sequencer_port(
+    sequencer: *const GyrofxSequencer,
+    index: i32,
+    name: *mut *const c_char,
+    width: *mut i32,
+    fraction: *mut i32,
+    is_signed: *mut i32,
+    is_output: *mut i32,
+) -> i32 {
+    let outputs = PortOutputs {
+        name,
+        width,
+        fraction,
+        is_signed,
+        is_output,
+    };
+    // SAFETY: forwarded contract.
+    unsafe { port_of(sequencer, |b| b.0.ports(), index, outputs) }
 }
 
 /// The synchronous reset. Returns 0, or -1 for a NULL handle.
@@ -485,6 +640,45 @@ pub unsafe extern "C" fn gyrofx_estimator_pipeline(
 ) -> i32 {
     // SAFETY: forwarded contract.
     unsafe { pipeline_of(estimator, |b| b.1, latency_clocks, min_clocks_per_sample) }
+}
+
+/// How many ports the estimator has (after `clk`, `rst` and `ce`; see `gyrofx_estimator_port`),
+/// or -1 for a NULL handle.
+///
+/// # Safety
+/// `estimator` is NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_estimator_port_count(estimator: *const GyrofxEstimator) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe { port_count_of(estimator, |b| b.0.ports()) }
+}
+
+/// Port `index` of the estimator, in its vector files' order (inputs, then outputs): writes its
+/// name (a string the library keeps: do not free it), its format's width and fraction bits,
+/// whether it is signed and whether it is an output. Returns 0, or -1 for a NULL handle or
+/// an index out of range (`gyrofx_last_error()` says which are allowed).
+///
+/// # Safety
+/// `estimator` is NULL or live; each output NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_estimator_port(
+    estimator: *const GyrofxEstimator,
+    index: i32,
+    name: *mut *const c_char,
+    width: *mut i32,
+    fraction: *mut i32,
+    is_signed: *mut i32,
+    is_output: *mut i32,
+) -> i32 {
+    let outputs = PortOutputs {
+        name,
+        width,
+        fraction,
+        is_signed,
+        is_output,
+    };
+    // SAFETY: forwarded contract.
+    unsafe { port_of(estimator, |b| b.0.ports(), index, outputs) }
 }
 
 /// The synchronous reset. Returns 0, or -1 for a NULL handle.
@@ -593,6 +787,45 @@ pub unsafe extern "C" fn gyrofx_mean_filter_pipeline(
     unsafe { pipeline_of(filter, |b| b.1, latency_clocks, min_clocks_per_sample) }
 }
 
+/// How many ports the mean filter has (after `clk`, `rst` and `ce`; see `gyrofx_mean_filter_port`),
+/// or -1 for a NULL handle.
+///
+/// # Safety
+/// `filter` is NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_mean_filter_port_count(filter: *const GyrofxMeanFilter) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe { port_count_of(filter, |b| b.0.ports()) }
+}
+
+/// Port `index` of the mean filter, in its vector files' order (inputs, then outputs): writes its
+/// name (a string the library keeps: do not free it), its format's width and fraction bits,
+/// whether it is signed and whether it is an output. Returns 0, or -1 for a NULL handle or
+/// an index out of range (`gyrofx_last_error()` says which are allowed).
+///
+/// # Safety
+/// `filter` is NULL or live; each output NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_mean_filter_port(
+    filter: *const GyrofxMeanFilter,
+    index: i32,
+    name: *mut *const c_char,
+    width: *mut i32,
+    fraction: *mut i32,
+    is_signed: *mut i32,
+    is_output: *mut i32,
+) -> i32 {
+    let outputs = PortOutputs {
+        name,
+        width,
+        fraction,
+        is_signed,
+        is_output,
+    };
+    // SAFETY: forwarded contract.
+    unsafe { port_of(filter, |b| b.0.ports(), index, outputs) }
+}
+
 /// The synchronous reset. Returns 0, or -1 for a NULL handle.
 ///
 /// # Safety
@@ -678,6 +911,45 @@ pub unsafe extern "C" fn gyrofx_chain_pipeline(
 ) -> i32 {
     // SAFETY: forwarded contract.
     unsafe { pipeline_of(chain, |b| b.1, latency_clocks, min_clocks_per_sample) }
+}
+
+/// How many ports the chain has (after `clk`, `rst` and `ce`; see `gyrofx_chain_port`),
+/// or -1 for a NULL handle.
+///
+/// # Safety
+/// `chain` is NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_chain_port_count(chain: *const GyrofxChain) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe { port_count_of(chain, |b| b.0.ports()) }
+}
+
+/// Port `index` of the chain, in its vector files' order (inputs, then outputs): writes its
+/// name (a string the library keeps: do not free it), its format's width and fraction bits,
+/// whether it is signed and whether it is an output. Returns 0, or -1 for a NULL handle or
+/// an index out of range (`gyrofx_last_error()` says which are allowed).
+///
+/// # Safety
+/// `chain` is NULL or live; each output NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_chain_port(
+    chain: *const GyrofxChain,
+    index: i32,
+    name: *mut *const c_char,
+    width: *mut i32,
+    fraction: *mut i32,
+    is_signed: *mut i32,
+    is_output: *mut i32,
+) -> i32 {
+    let outputs = PortOutputs {
+        name,
+        width,
+        fraction,
+        is_signed,
+        is_output,
+    };
+    // SAFETY: forwarded contract.
+    unsafe { port_of(chain, |b| b.0.ports(), index, outputs) }
 }
 
 /// The synchronous reset. Returns 0, or -1 for a NULL handle.
@@ -807,6 +1079,45 @@ pub unsafe extern "C" fn gyrofx_gyro_loop_pipeline(
     unsafe { pipeline_of(gyro_loop, |b| b.1, latency_clocks, min_clocks_per_sample) }
 }
 
+/// How many ports the loop has (after `clk`, `rst` and `ce`; see `gyrofx_gyro_loop_port`),
+/// or -1 for a NULL handle.
+///
+/// # Safety
+/// `gyro_loop` is NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_gyro_loop_port_count(gyro_loop: *const GyrofxGyroLoop) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe { port_count_of(gyro_loop, |b| b.0.ports()) }
+}
+
+/// Port `index` of the loop, in its vector files' order (inputs, then outputs): writes its
+/// name (a string the library keeps: do not free it), its format's width and fraction bits,
+/// whether it is signed and whether it is an output. Returns 0, or -1 for a NULL handle or
+/// an index out of range (`gyrofx_last_error()` says which are allowed).
+///
+/// # Safety
+/// `gyro_loop` is NULL or live; each output NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_gyro_loop_port(
+    gyro_loop: *const GyrofxGyroLoop,
+    index: i32,
+    name: *mut *const c_char,
+    width: *mut i32,
+    fraction: *mut i32,
+    is_signed: *mut i32,
+    is_output: *mut i32,
+) -> i32 {
+    let outputs = PortOutputs {
+        name,
+        width,
+        fraction,
+        is_signed,
+        is_output,
+    };
+    // SAFETY: forwarded contract.
+    unsafe { port_of(gyro_loop, |b| b.0.ports(), index, outputs) }
+}
+
 /// The synchronous reset. Returns 0, or -1 for a NULL handle.
 ///
 /// # Safety
@@ -912,6 +1223,45 @@ pub unsafe extern "C" fn gyrofx_system_pipeline(
 ) -> i32 {
     // SAFETY: forwarded contract.
     unsafe { pipeline_of(system, |b| b.1, latency_clocks, min_clocks_per_sample) }
+}
+
+/// How many ports the system has (after `clk`, `rst` and `ce`; see `gyrofx_system_port`),
+/// or -1 for a NULL handle.
+///
+/// # Safety
+/// `system` is NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_system_port_count(system: *const GyrofxSystem) -> i32 {
+    // SAFETY: forwarded contract.
+    unsafe { port_count_of(system, |b| b.0.ports()) }
+}
+
+/// Port `index` of the system, in its vector files' order (inputs, then outputs): writes its
+/// name (a string the library keeps: do not free it), its format's width and fraction bits,
+/// whether it is signed and whether it is an output. Returns 0, or -1 for a NULL handle or
+/// an index out of range (`gyrofx_last_error()` says which are allowed).
+///
+/// # Safety
+/// `system` is NULL or live; each output NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn gyrofx_system_port(
+    system: *const GyrofxSystem,
+    index: i32,
+    name: *mut *const c_char,
+    width: *mut i32,
+    fraction: *mut i32,
+    is_signed: *mut i32,
+    is_output: *mut i32,
+) -> i32 {
+    let outputs = PortOutputs {
+        name,
+        width,
+        fraction,
+        is_signed,
+        is_output,
+    };
+    // SAFETY: forwarded contract.
+    unsafe { port_of(system, |b| b.0.ports(), index, outputs) }
 }
 
 /// The synchronous reset. Returns 0, or -1 for a NULL handle.

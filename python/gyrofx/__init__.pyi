@@ -6,7 +6,7 @@ reverse. Real values are °/s. Every refused input raises ``GyrofxError``.
 """
 
 from os import PathLike
-from typing import Dict, Optional, Tuple, Union
+from typing import Dict, List, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -81,6 +81,8 @@ class Kf:
     output_format: str
     latency_clocks: int
     min_clocks_per_sample: int
+    def ports(self) -> List[Tuple[str, str, str]]:
+        """``(name, format, direction)`` of each port, as the vector files carry them."""
     def reset(self) -> None: ...
     def step(self, z: int, bw_sel: int = 0) -> int:
         """One step: ``z`` (input-format code) -> ``rate_out`` (output-format code)."""
@@ -102,6 +104,8 @@ class Sequencer:
 
     latency_clocks: int
     min_clocks_per_sample: int
+    def ports(self) -> List[Tuple[str, str, str]]:
+        """``(name, format, direction)`` of each port, as the vector files carry them."""
     def reset(self) -> None: ...
     def step(self) -> Dict[str, int]:
         """mode_a, mode_b, blank_a, blank_b, interval_a, interval_b, done_a, done_b,
@@ -113,6 +117,8 @@ class Estimator:
 
     latency_clocks: int
     min_clocks_per_sample: int
+    def ports(self) -> List[Tuple[str, str, str]]:
+        """``(name, format, direction)`` of each port, as the vector files carry them."""
     input_format: str
     bias_format: str
     def reset(self) -> None: ...
@@ -164,6 +170,8 @@ class MeanFilter:
 
     latency_clocks: int
     min_clocks_per_sample: int
+    def ports(self) -> List[Tuple[str, str, str]]:
+        """``(name, format, direction)`` of each port, as the vector files carry them."""
     window: int
     input_format: str
     output_format: str
@@ -184,6 +192,8 @@ class Chain:
 
     latency_clocks: int
     min_clocks_per_sample: int
+    def ports(self) -> List[Tuple[str, str, str]]:
+        """``(name, format, direction)`` of each port, as the vector files carry them."""
     def reset(self) -> None: ...
     def next_modes(self) -> Tuple[int, int]:
         """The modes the next step runs in (what a plant needs first)."""
@@ -209,6 +219,8 @@ class GyroLoop:
 
     latency_clocks: int
     min_clocks_per_sample: int
+    def ports(self) -> List[Tuple[str, str, str]]:
+        """``(name, format, direction)`` of each port, as the vector files carry them."""
     adc_rate_hz: float
     decimation: int
     adc_format: str
@@ -234,6 +246,8 @@ class System:
 
     latency_clocks: int
     min_clocks_per_sample: int
+    def ports(self) -> List[Tuple[str, str, str]]:
+        """``(name, format, direction)`` of each port, as the vector files carry them."""
     decimation: int
     window: int
     def reset(self) -> None: ...

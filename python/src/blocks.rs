@@ -117,6 +117,16 @@ impl Kf {
 
 #[pymethods]
 impl Kf {
+    /// Its ports as the vector files carry them (after `rst`; inputs, then outputs): a list of
+    /// `(name, format, direction)`, e.g. `("z", "s24.14", "in")`.
+    fn ports(&self) -> Vec<(&'static str, String, &'static str)> {
+        self.ports
+            .ports()
+            .iter()
+            .map(|p| (p.name, p.format.to_string(), p.direction()))
+            .collect()
+    }
+
     /// Clocks from a sample's `ce` to its registered outputs in the RTL (`gyrofx_job::pipeline`,
     /// as the manifest and the testbenches have it).
     #[getter]
@@ -297,6 +307,16 @@ impl Sequencer {
 
 #[pymethods]
 impl Sequencer {
+    /// Its ports as the vector files carry them (after `rst`; inputs, then outputs): a list of
+    /// `(name, format, direction)`, e.g. `("z", "s24.14", "in")`.
+    fn ports(&self) -> Vec<(&'static str, String, &'static str)> {
+        self.ports
+            .ports()
+            .iter()
+            .map(|p| (p.name, p.format.to_string(), p.direction()))
+            .collect()
+    }
+
     /// Clocks from a sample's `ce` to its registered outputs in the RTL (`gyrofx_job::pipeline`,
     /// as the manifest and the testbenches have it).
     #[getter]
@@ -360,6 +380,16 @@ impl Estimator {
 
 #[pymethods]
 impl Estimator {
+    /// Its ports as the vector files carry them (after `rst`; inputs, then outputs): a list of
+    /// `(name, format, direction)`, e.g. `("z", "s24.14", "in")`.
+    fn ports(&self) -> Vec<(&'static str, String, &'static str)> {
+        self.ports
+            .ports()
+            .iter()
+            .map(|p| (p.name, p.format.to_string(), p.direction()))
+            .collect()
+    }
+
     /// Clocks from a sample's `ce` to its registered outputs in the RTL (`gyrofx_job::pipeline`,
     /// as the manifest and the testbenches have it).
     #[getter]
@@ -564,6 +594,16 @@ impl MeanFilter {
 
 #[pymethods]
 impl MeanFilter {
+    /// Its ports as the vector files carry them (after `rst`; inputs, then outputs): a list of
+    /// `(name, format, direction)`, e.g. `("z", "s24.14", "in")`.
+    fn ports(&self) -> Vec<(&'static str, String, &'static str)> {
+        self.ports
+            .ports()
+            .iter()
+            .map(|p| (p.name, p.format.to_string(), p.direction()))
+            .collect()
+    }
+
     /// Clocks from a sample's `ce` to its registered outputs in the RTL (`gyrofx_job::pipeline`,
     /// as the manifest and the testbenches have it).
     #[getter]
@@ -678,6 +718,16 @@ impl Chain {
 
 #[pymethods]
 impl Chain {
+    /// Its ports as the vector files carry them (after `rst`; inputs, then outputs): a list of
+    /// `(name, format, direction)`, e.g. `("z", "s24.14", "in")`.
+    fn ports(&self) -> Vec<(&'static str, String, &'static str)> {
+        self.ports
+            .ports()
+            .iter()
+            .map(|p| (p.name, p.format.to_string(), p.direction()))
+            .collect()
+    }
+
     /// Clocks from a sample's `ce` to its registered outputs in the RTL (`gyrofx_job::pipeline`,
     /// as the manifest and the testbenches have it).
     #[getter]

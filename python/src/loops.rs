@@ -39,6 +39,16 @@ impl GyroLoop {
 
 #[pymethods]
 impl GyroLoop {
+    /// Its ports as the vector files carry them (after `rst`; inputs, then outputs): a list of
+    /// `(name, format, direction)`, e.g. `("z", "s24.14", "in")`.
+    fn ports(&self) -> Vec<(&'static str, String, &'static str)> {
+        self.ports
+            .ports()
+            .iter()
+            .map(|p| (p.name, p.format.to_string(), p.direction()))
+            .collect()
+    }
+
     /// Clocks from a sample's `ce` to its registered outputs in the RTL (`gyrofx_job::pipeline`,
     /// as the manifest and the testbenches have it).
     #[getter]
@@ -205,6 +215,16 @@ impl System {
 
 #[pymethods]
 impl System {
+    /// Its ports as the vector files carry them (after `rst`; inputs, then outputs): a list of
+    /// `(name, format, direction)`, e.g. `("z", "s24.14", "in")`.
+    fn ports(&self) -> Vec<(&'static str, String, &'static str)> {
+        self.ports
+            .ports()
+            .iter()
+            .map(|p| (p.name, p.format.to_string(), p.direction()))
+            .collect()
+    }
+
     /// Clocks from a sample's `ce` to its registered outputs in the RTL (`gyrofx_job::pipeline`,
     /// as the manifest and the testbenches have it).
     #[getter]

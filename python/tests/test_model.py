@@ -294,3 +294,24 @@ def test_every_block_class_has_the_manifests_latency_and_spacing(tmp_path, archi
     assert (plan.chain().latency_clocks > 1000) == serial
     assert (plan.mean_filter().latency_clocks > 1) == serial
     assert (plan.sequencer().latency_clocks, plan.sequencer().min_clocks_per_sample) == (1, 1)
+
+
+def test_every_block_class_lists_the_manifests_ports(package):
+    # The ports a testbench of one's own drives and reads: names, formats and directions as
+    # the package's vector files declare them (the manifest's fields, after rst).
+    manifest = json.loads((package / "manifest.json").read_text())
+    plan = gyrofx.Plan.from_package(str(package))
+    classes = {
+        "sequencer": plan.sequencer(),
+        "estimator": plan.estimator(),
+        "kf": plan.kf(),
+        "top": plan.chain(),
+        "mean_filter": plan.mean_filter(),
+        "gyro_loop": plan.gyro_loop(),
+        "system": plan.system(),
+    }
+    for block, model in classes.items():
+        fields = manifest["blocks"][block]
+        expected = [(f["name"], f["format"], "in") for f in fields["stimulus"]["fields"] if f["name"] != "rst"]
+        expected += [(f["name"], f["format"], "out") for f in fields["expected"]["fields"]]
+        assert model.ports() == expected, block

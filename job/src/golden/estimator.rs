@@ -69,6 +69,11 @@ pub struct Estimator {
 }
 
 impl Estimator {
+    /// Its ports as the vector files carry them ([`super::ports`]).
+    pub fn ports(&self) -> Vec<super::ports::Port> {
+        super::ports::estimator(&self.plan)
+    }
+
     /// From reset.
     pub fn new(plan: &estimator::Plan) -> Estimator {
         Estimator {

@@ -26,6 +26,11 @@ pub struct GyroLoop {
 }
 
 impl GyroLoop {
+    /// Its ports as the vector files carry them ([`super::ports`]).
+    pub fn ports(&self) -> Vec<super::ports::Port> {
+        super::ports::gyro_loop(&self.plan)
+    }
+
     /// From reset.
     pub fn new(plan: &gyro_loop::Plan) -> GyroLoop {
         GyroLoop {

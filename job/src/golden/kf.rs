@@ -12,6 +12,11 @@ pub struct Kf {
 }
 
 impl Kf {
+    /// Its ports as the vector files carry them ([`super::ports`]).
+    pub fn ports(&self) -> Vec<super::ports::Port> {
+        super::ports::kf(&self.plan)
+    }
+
     /// From reset.
     pub fn new(plan: &kf::Plan) -> Kf {
         Kf {

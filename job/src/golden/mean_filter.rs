@@ -13,6 +13,11 @@ pub struct MeanFilter {
 }
 
 impl MeanFilter {
+    /// Its ports as the vector files carry them ([`super::ports`]).
+    pub fn ports(&self) -> Vec<super::ports::Port> {
+        super::ports::mean_filter(&self.plan)
+    }
+
     /// From reset.
     pub fn new(plan: &mean_filter::Plan) -> MeanFilter {
         MeanFilter {

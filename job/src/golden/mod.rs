@@ -12,6 +12,7 @@ mod estimator;
 mod gyro_loop;
 mod kf;
 mod mean_filter;
+pub mod ports;
 mod sequencer;
 mod system;
 mod top;

@@ -37,13 +37,21 @@ pub fn slot_codes(slot: &Slot) -> [i64; 9] {
 #[derive(Clone, Debug)]
 pub struct Sequencer {
     model: sequencer::Sequencer,
+    /// Width of the interval indices.
+    interval_bits: u32,
 }
 
 impl Sequencer {
+    /// Its ports as the vector files carry them ([`super::ports`]).
+    pub fn ports(&self) -> Vec<super::ports::Port> {
+        super::ports::sequencer(self.interval_bits)
+    }
+
     /// From reset.
     pub fn new(schedule: &Schedule) -> Sequencer {
         Sequencer {
             model: sequencer::Sequencer::new(schedule),
+            interval_bits: schedule.interval_bits(),
         }
     }
 

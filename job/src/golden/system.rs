@@ -41,6 +41,11 @@ pub struct System {
 }
 
 impl System {
+    /// Its ports as the vector files carry them ([`super::ports`]).
+    pub fn ports(&self) -> Vec<super::ports::Port> {
+        super::ports::system(&self.loops[0], &self.chain)
+    }
+
     /// From reset: gyro A's and B's loop plans and the system's chain plan.
     pub fn new(loops: [&gyro_loop::Plan; 2], chain: &chain::Plan) -> System {
         System {

@@ -23,6 +23,11 @@ pub struct Chain {
 }
 
 impl Chain {
+    /// Its ports as the vector files carry them ([`super::ports`]).
+    pub fn ports(&self) -> Vec<super::ports::Port> {
+        super::ports::chain(&self.plan)
+    }
+
     /// From reset.
     pub fn new(plan: &chain::Plan) -> Chain {
         Chain {
