@@ -30,17 +30,85 @@ fn int_array(py: Python<'_>, values: Vec<i64>) -> Array<'_, i64> {
     values.into_pyarray(py)
 }
 
-/// The codes of a numpy array (read in place when contiguous), each checked against `format`
-/// (`port` names it in errors).
+/// A record of integer codes as a port takes it: a numpy `int64` array (read in place), or
+/// anything numpy makes a one-dimensional integer array of (a list, any integer or bool dtype,
+/// either byte order).
+#[derive(FromPyObject)]
+pub(crate) enum Codes<'py> {
+    Native(PyReadonlyArray1<'py, i64>),
+    Like(Bound<'py, PyAny>),
+}
+
+impl Codes<'_> {
+    /// The codes (`port` names them in errors): borrowed from a contiguous `int64` array,
+    /// else converted; a record that is not one-dimensional, not integers, or holds a value
+    /// no `int64` holds is refused with gyrofx's own message.
+    pub(crate) fn resolve(&self, port: &str) -> PyResult<std::borrow::Cow<'_, [i64]>> {
+        match self {
+            Codes::Native(array) => Ok(match array.as_slice() {
+                Ok(slice) => std::borrow::Cow::Borrowed(slice),
+                Err(_) => std::borrow::Cow::Owned(array.as_array().to_vec()),
+            }),
+            Codes::Like(object) => integer_record(object, port).map(std::borrow::Cow::Owned),
+        }
+    }
+}
+
+/// What to say a record may be.
+const CODES_ALLOWED: &str =
+    "a one-dimensional record of integer codes: a list, or an array of any integer dtype";
+
+/// `object` as numpy sees it, as `int64` codes.
+fn integer_record(object: &Bound<'_, PyAny>, port: &str) -> PyResult<Vec<i64>> {
+    let numpy = object.py().import("numpy")?;
+    let array = numpy.call_method1("asarray", (object,))?;
+    let dimensions: usize = array.getattr("ndim")?.extract()?;
+    if dimensions != 1 {
+        return Err(refused(format!(
+            "{port}: {dimensions} dimensions; allowed: {CODES_ALLOWED}"
+        )));
+    }
+    if array.getattr("size")?.extract::<usize>()? == 0 {
+        return Ok(Vec::new());
+    }
+    let dtype = array.getattr("dtype")?;
+    let kind: String = dtype.getattr("kind")?.extract()?;
+    let name: String = dtype.getattr("name")?.extract()?;
+    match kind.as_str() {
+        "i" | "b" => {
+            let codes = array.call_method1("astype", ("int64",))?;
+            let codes: PyReadonlyArray1<'_, i64> = codes.extract()?;
+            Ok(codes.as_array().to_vec())
+        }
+        "u" => {
+            let codes = array.call_method1("astype", ("uint64",))?;
+            let codes: PyReadonlyArray1<'_, u64> = codes.extract()?;
+            codes
+                .as_array()
+                .iter()
+                .enumerate()
+                .map(|(index, code)| {
+                    i64::try_from(*code).map_err(|_| {
+                        refused(format!(
+                            "{port}[{index}] = {code}: not a code of any port (at most 2^63 - 1)"
+                        ))
+                    })
+                })
+                .collect()
+        }
+        _ => Err(refused(format!(
+            "{port}: an array of {name}; allowed: {CODES_ALLOWED} (quantize real values first: gyrofx.quantize)"
+        ))),
+    }
+}
+
+/// The codes of a record, each checked against `format` (`port` names it in errors).
 pub(crate) fn port_codes<'a>(
-    codes: &'a PyReadonlyArray1<'_, i64>,
+    codes: &'a Codes<'_>,
     format: Format,
     port: &str,
 ) -> PyResult<std::borrow::Cow<'a, [i64]>> {
-    let out = match codes.as_slice() {
-        Ok(slice) => std::borrow::Cow::Borrowed(slice),
-        Err(_) => std::borrow::Cow::Owned(codes.as_array().to_vec()),
-    };
+    let out = codes.resolve(port)?;
     check_codes(&out, format, port).map_err(refused)?;
     Ok(out)
 }
@@ -63,7 +131,7 @@ pub(crate) fn same_length(lengths: &[(&str, usize)]) -> PyResult<usize> {
 #[derive(FromPyObject)]
 pub(crate) enum PerSample<'py> {
     One(i64),
-    Each(PyReadonlyArray1<'py, i64>),
+    Each(Codes<'py>),
 }
 
 impl PerSample<'_> {
@@ -77,8 +145,8 @@ impl PerSample<'_> {
     ) -> PyResult<Vec<T>> {
         match self {
             PerSample::One(value) => Ok(vec![check(*value, port).map_err(refused)?; samples]),
-            PerSample::Each(array) => {
-                let array = array.as_array();
+            PerSample::Each(codes) => {
+                let array = codes.resolve(port)?;
                 same_length(&[("the input", samples), (port, array.len())])?;
                 array
                     .iter()
@@ -155,11 +223,11 @@ impl Kf {
 
     /// `step` over a record: `z` an int64 array, `bw_sel` one address or one per sample;
     /// returns `rate_out` as an int64 array.
-    #[pyo3(signature = (z, bw_sel = PerSample::One(0)))]
+    #[pyo3(signature = (z, bw_sel = PerSample::One(0)), text_signature = "($self, z, bw_sel=0)")]
     fn process<'py>(
         &mut self,
         py: Python<'py>,
-        z: PyReadonlyArray1<'py, i64>,
+        z: Codes<'py>,
         bw_sel: PerSample<'py>,
     ) -> PyResult<Array<'py, i64>> {
         let (input, depth) = (self.ports.plan().input, self.ports.plan().rom.len());
@@ -255,7 +323,7 @@ impl KfFloat {
     }
 
     /// `step` over a float64 record.
-    #[pyo3(signature = (z, bw_sel = PerSample::One(0)))]
+    #[pyo3(signature = (z, bw_sel = PerSample::One(0)), text_signature = "($self, z, bw_sel=0)")]
     fn process<'py>(
         &mut self,
         py: Python<'py>,
@@ -449,20 +517,20 @@ impl Estimator {
     fn process<'py>(
         &mut self,
         py: Python<'py>,
-        y_a: PyReadonlyArray1<'py, i64>,
-        y_b: PyReadonlyArray1<'py, i64>,
-        blank_a: PyReadonlyArray1<'py, i64>,
-        blank_b: PyReadonlyArray1<'py, i64>,
-        done_a: PyReadonlyArray1<'py, i64>,
-        done_b: PyReadonlyArray1<'py, i64>,
-        interval_a: PyReadonlyArray1<'py, i64>,
-        interval_b: PyReadonlyArray1<'py, i64>,
-        window_done: PyReadonlyArray1<'py, i64>,
+        y_a: Codes<'py>,
+        y_b: Codes<'py>,
+        blank_a: Codes<'py>,
+        blank_b: Codes<'py>,
+        done_a: Codes<'py>,
+        done_b: Codes<'py>,
+        interval_a: Codes<'py>,
+        interval_b: Codes<'py>,
+        window_done: Codes<'py>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let input = self.ports.plan().input;
         let y_a = port_codes(&y_a, input, "y_a")?;
         let y_b = port_codes(&y_b, input, "y_b")?;
-        let slot_arrays = [
+        let slot_records = [
             blank_a,
             blank_b,
             done_a,
@@ -471,15 +539,19 @@ impl Estimator {
             interval_b,
             window_done,
         ];
+        let views = ESTIMATOR_SLOT_PORTS
+            .iter()
+            .zip(&slot_records)
+            .map(|(name, record)| record.resolve(name))
+            .collect::<PyResult<Vec<_>>>()?;
         let mut lengths = vec![("y_a", y_a.len()), ("y_b", y_b.len())];
         lengths.extend(
             ESTIMATOR_SLOT_PORTS
                 .iter()
-                .zip(&slot_arrays)
-                .map(|(name, array)| (*name, array.len().unwrap_or(0))),
+                .zip(&views)
+                .map(|(name, view)| (*name, view.len())),
         );
         let samples = same_length(&lengths)?;
-        let views: Vec<_> = slot_arrays.iter().map(|a| a.as_array()).collect();
         let slots = (0..samples)
             .map(|i| {
                 let ports: [i64; 7] = std::array::from_fn(|p| views[p][i]);
@@ -631,11 +703,7 @@ impl MeanFilter {
 
     /// `step` over a record: a dict of `y_valid`, `y`, `kept` int64 arrays, one entry per input
     /// sample (`y` and `kept` are 0 where `y_valid` is 0).
-    fn process<'py>(
-        &mut self,
-        py: Python<'py>,
-        x: PyReadonlyArray1<'py, i64>,
-    ) -> PyResult<Bound<'py, PyDict>> {
+    fn process<'py>(&mut self, py: Python<'py>, x: Codes<'py>) -> PyResult<Bound<'py, PyDict>> {
         let x = port_codes(&x, self.ports.plan().input, "x")?;
         let ports = &mut self.ports;
         let columns = py.detach(|| {
@@ -773,12 +841,12 @@ impl Chain {
     }
 
     /// `step` over records: a dict of int64 arrays, one per output port.
-    #[pyo3(signature = (y_a, y_b, bw_sel = PerSample::One(0)))]
+    #[pyo3(signature = (y_a, y_b, bw_sel = PerSample::One(0)), text_signature = "($self, y_a, y_b, bw_sel=0)")]
     fn process<'py>(
         &mut self,
         py: Python<'py>,
-        y_a: PyReadonlyArray1<'py, i64>,
-        y_b: PyReadonlyArray1<'py, i64>,
+        y_a: Codes<'py>,
+        y_b: Codes<'py>,
         bw_sel: PerSample<'py>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let input = self.ports.plan().estimator.input;

@@ -6,6 +6,7 @@ use pyo3::prelude::*;
 use gyrofx_job::golden::check_code;
 use gyrofx_model::fx::{from_f64, Format, Overflow, Rounding};
 
+use crate::blocks::Codes;
 use crate::refused;
 
 /// Parses a format string (`s18.14`, `u12.12`) whose codes fit `int64`.
@@ -23,6 +24,20 @@ pub(crate) fn format(text: &str) -> PyResult<Format> {
     Ok(format)
 }
 
+/// `values` as a one-dimensional `float64` array: any real array-like numpy converts (a list,
+/// ints, a `float32` array).
+fn real_record<'py>(values: &Bound<'py, PyAny>) -> PyResult<PyReadonlyArray1<'py, f64>> {
+    let numpy = values.py().import("numpy")?;
+    let array = numpy.call_method1("asarray", (values, "float64"))?;
+    let dimensions: usize = array.getattr("ndim")?.extract()?;
+    if dimensions != 1 {
+        return Err(refused(format!(
+            "values: {dimensions} dimensions; allowed: a one-dimensional record of real values"
+        )));
+    }
+    array.extract()
+}
+
 /// Quantizes real values to codes of `fmt`.
 ///
 /// `rounding` is one of floor, ceil, zero, nearest, round, convergent and `overflow` one of
@@ -31,7 +46,7 @@ pub(crate) fn format(text: &str) -> PyResult<Format> {
 #[pyo3(signature = (values, fmt, rounding = "nearest", overflow = "saturate"))]
 pub(crate) fn quantize<'py>(
     py: Python<'py>,
-    values: PyReadonlyArray1<'py, f64>,
+    values: Bound<'py, PyAny>,
     fmt: &str,
     rounding: &str,
     overflow: &str,
@@ -47,6 +62,7 @@ pub(crate) fn quantize<'py>(
             "overflow = {overflow:?}: expected saturate or wrap"
         ))
     })?;
+    let values = real_record(&values)?;
     let values = values.as_array();
     let mut codes = Vec::with_capacity(values.len());
     for (index, value) in values.iter().enumerate() {
@@ -62,11 +78,11 @@ pub(crate) fn quantize<'py>(
 #[pyfunction]
 pub(crate) fn to_real<'py>(
     py: Python<'py>,
-    codes: PyReadonlyArray1<'py, i64>,
+    codes: Codes<'py>,
     fmt: &str,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let format = format(fmt)?;
-    let codes = codes.as_array();
+    let codes = codes.resolve("codes")?;
     let mut values = Vec::with_capacity(codes.len());
     for (index, code) in codes.iter().enumerate() {
         check_code(*code, format, &format!("codes[{index}]")).map_err(refused)?;

@@ -5,7 +5,6 @@
 //! Ports as in [`crate::blocks`]: codes exactly as the RTL carries them, a mode 1 normal / 0
 //! reverse, flags 0/1; `process` returns a dict of int64 arrays, one per output port.
 
-use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -17,7 +16,7 @@ use gyrofx_model::gyro_loop::gyro::{FloatGyroLoop, Plan as LoopPlan};
 use gyrofx_model::resonator::{Mode, Resonator as PhysicalResonator};
 use gyrofx_model::system::FloatSystem;
 
-use crate::blocks::{port_codes, port_dict, same_length, PerSample};
+use crate::blocks::{port_codes, port_dict, same_length, Codes, PerSample};
 use crate::refused;
 
 /// One gyro's digital loop (`gyrofx_gyro_loop`): NCOs, demodulators, PLL, AGC, CICs, lock
@@ -91,12 +90,12 @@ impl GyroLoop {
 
     /// `step` over records: `adc_x`, `adc_y` int64 arrays, `mode` one value or one per sample;
     /// a dict of int64 arrays, one per output port.
-    #[pyo3(signature = (adc_x, adc_y, mode = PerSample::One(1)))]
+    #[pyo3(signature = (adc_x, adc_y, mode = PerSample::One(1)), text_signature = "($self, adc_x, adc_y, mode=1)")]
     fn process<'py>(
         &mut self,
         py: Python<'py>,
-        adc_x: PyReadonlyArray1<'py, i64>,
-        adc_y: PyReadonlyArray1<'py, i64>,
+        adc_x: Codes<'py>,
+        adc_y: Codes<'py>,
         mode: PerSample<'py>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let adc = self.ports.plan().adc;
@@ -280,15 +279,15 @@ impl System {
 
     /// `step` over records: four int64 ADC arrays; `enable` and `bw_sel` one value or one per
     /// sample. A dict of int64 arrays, one per output port.
-    #[pyo3(signature = (adc_a_x, adc_a_y, adc_b_x, adc_b_y, enable = PerSample::One(1), bw_sel = PerSample::One(0)))]
+    #[pyo3(signature = (adc_a_x, adc_a_y, adc_b_x, adc_b_y, enable = PerSample::One(1), bw_sel = PerSample::One(0)), text_signature = "($self, adc_a_x, adc_a_y, adc_b_x, adc_b_y, enable=1, bw_sel=0)")]
     #[allow(clippy::too_many_arguments)]
     fn process<'py>(
         &mut self,
         py: Python<'py>,
-        adc_a_x: PyReadonlyArray1<'py, i64>,
-        adc_a_y: PyReadonlyArray1<'py, i64>,
-        adc_b_x: PyReadonlyArray1<'py, i64>,
-        adc_b_y: PyReadonlyArray1<'py, i64>,
+        adc_a_x: Codes<'py>,
+        adc_a_y: Codes<'py>,
+        adc_b_x: Codes<'py>,
+        adc_b_y: Codes<'py>,
         enable: PerSample<'py>,
         bw_sel: PerSample<'py>,
     ) -> PyResult<Bound<'py, PyDict>> {

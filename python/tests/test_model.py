@@ -315,3 +315,43 @@ def test_every_block_class_lists_the_manifests_ports(package):
         expected = [(f["name"], f["format"], "in") for f in fields["stimulus"]["fields"] if f["name"] != "rst"]
         expected += [(f["name"], f["format"], "out") for f in fields["expected"]["fields"]]
         assert model.ports() == expected, block
+
+
+def test_records_of_any_integer_dtype_and_lists_are_accepted_and_others_refused_by_name():
+    kf = gyrofx.Plan.default().kf()
+    codes = np.array([5, -7, 1200, 0, -3000, 42], dtype=np.int64)
+    want = kf.process(codes)
+    kf.reset()
+    for record in (codes.tolist(), codes.astype(np.int32), codes.astype(">i8"), codes[::-1][::-1].copy()):
+        kf.reset()
+        assert np.array_equal(kf.process(record), want), type(record)
+    small = np.array([0, 1, 200, 255], dtype=np.uint8)
+    kf.reset()
+    via_uint8 = kf.process(small)
+    kf.reset()
+    assert np.array_equal(via_uint8, kf.process(small.astype(np.int64)))
+    assert len(kf.process([])) == 0
+    for record, message in (
+        (codes.astype(np.float64), "z: an array of float64; allowed: a one-dimensional record of integer codes"),
+        (codes.reshape(2, 3), "z: 2 dimensions; allowed"),
+        (np.array([2**63], dtype=np.uint64), "z[0] = 9223372036854775808: not a code of any port"),
+    ):
+        with pytest.raises(gyrofx.GyrofxError, match=message.replace("[", r"\[").replace("]", r"\]")):
+            kf.process(record)
+    # bw_sel per sample takes the same records.
+    kf.reset()
+    both = kf.process(codes, bw_sel=[0, 1, 2, 0, 1, 2])
+    kf.reset()
+    assert np.array_equal(both, kf.process(codes, bw_sel=np.array([0, 1, 2, 0, 1, 2], dtype=np.uint8)))
+    assert np.array_equal(gyrofx.to_real([1, -2], "s4.1"), gyrofx.to_real(np.array([1, -2]), "s4.1"))
+
+
+def test_the_package_docstring_runs_and_signatures_read_plainly():
+    import doctest
+    import inspect
+
+    failures, tried = doctest.testmod(gyrofx, raise_on_error=False, verbose=False)
+    assert tried > 0 and failures == 0
+    assert str(inspect.signature(gyrofx.Kf.process)) == "(self, /, z, bw_sel=0)"
+    assert "Ellipsis" not in str(inspect.signature(gyrofx.System.process))
+    assert np.array_equal(gyrofx.quantize([0.5, -1], "s8.4"), gyrofx.quantize(np.array([0.5, -1.0]), "s8.4"))
