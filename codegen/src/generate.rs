@@ -200,6 +200,10 @@ pub fn build_package(
     let mut package = Package::new(Kind::Generate, writers::build_outputs(&run.blocks));
     package.add("README.md", writers::package_readme(&run, provenance));
     package.add("Makefile", writers::makefile(&run.blocks, provenance));
+    package.add(
+        crate::fusesoc::CORE_FILE,
+        crate::fusesoc::core(&run.blocks, provenance),
+    );
     package.add("report.md", writers::report_md(&run, provenance));
     for (name, source) in hdl::RTL_SOURCES.iter().chain(&hdl::VHDL_SOURCES) {
         package.add(format!("hdl/{name}"), *source);

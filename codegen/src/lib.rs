@@ -15,6 +15,7 @@ pub mod cocotb;
 pub mod design;
 pub mod dpi;
 pub mod filter_package;
+pub mod fusesoc;
 pub mod generate;
 pub mod hdl;
 pub mod output_folder;

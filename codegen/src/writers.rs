@@ -210,6 +210,7 @@ pub fn build_outputs(blocks: &[Block]) -> Vec<String> {
         })
         .collect();
     outputs.extend(crate::cocotb::build_outputs(blocks));
+    outputs.push(crate::fusesoc::BUILD_OUTPUT.to_string());
     outputs.extend(crate::dpi::tested(blocks).iter().flat_map(|b| {
         [
             format!("{}/obj_dpi/", b.name),
