@@ -162,4 +162,5 @@ rm -rf python/target/wheels
 unset CARGO_TARGET_DIR RUSTC_WORKSPACE_WRAPPER CLIPPY_ARGS
 "$python_venv/bin/pip" install -q --force-reinstall --no-deps python/target/wheels/gyrofx-*.whl
 # One pytest worker per core (pytest-xdist): each cocotb run is one single-threaded simulator.
-GYROFX_CLI="$PWD/target/debug/gyrofx" "$python_venv/bin/python" -m pytest -q -n auto python/tests
+GYROFX_CLI="$PWD/target/debug/gyrofx" GYROFX_WHEEL="$(ls python/target/wheels/gyrofx-*.whl)" \
+    "$python_venv/bin/python" -m pytest -q -n auto python/tests

@@ -355,3 +355,31 @@ def test_the_package_docstring_runs_and_signatures_read_plainly():
     assert str(inspect.signature(gyrofx.Kf.process)) == "(self, /, z, bw_sel=0)"
     assert "Ellipsis" not in str(inspect.signature(gyrofx.System.process))
     assert np.array_equal(gyrofx.quantize([0.5, -1], "s8.4"), gyrofx.quantize(np.array([0.5, -1.0]), "s8.4"))
+
+
+def test_the_wheel_installs_into_a_clean_virtualenv_without_rust(tmp_path):
+    # The path the guide gives a user with no Rust toolchain: the abi3 wheel the build makes,
+    # installed with pip into a new virtualenv whose PATH has no cargo; numpy comes from PyPI.
+    import glob
+    import os
+    import subprocess
+    import sys
+
+    wheels = [os.environ["GYROFX_WHEEL"]] if os.environ.get("GYROFX_WHEEL") else sorted(
+        glob.glob(str(REPOSITORY / "python" / "target" / "wheels" / "gyrofx-*.whl")))
+    assert wheels, "no wheel: scripts/test.sh builds it (maturin build), or set GYROFX_WHEEL"
+    venv = tmp_path / "venv"
+    subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
+    environment = {"PATH": f"{venv / 'bin'}:/usr/bin:/bin", "HOME": str(tmp_path)}
+    for name in ("PIP_INDEX_URL", "PIP_EXTRA_INDEX_URL", "PIP_TRUSTED_HOST", "PIP_CERT",
+                 "HTTPS_PROXY", "HTTP_PROXY", "https_proxy", "http_proxy", "NO_PROXY", "no_proxy",
+                 "SSL_CERT_FILE", "REQUESTS_CA_BUNDLE"):
+        if name in os.environ:
+            environment[name] = os.environ[name]
+    subprocess.run([str(venv / "bin" / "pip"), "install", "-q", wheels[-1]], check=True, env=environment)
+    script = ("import shutil, gyrofx; assert shutil.which('cargo') is None; "
+              "kf = gyrofx.Plan.default().kf(); print(kf.latency_clocks, kf.process([0, 1000, -1000]).tolist())")
+    shown = subprocess.run([str(venv / "bin" / "python"), "-c", script], check=True, env=environment,
+                           capture_output=True, text=True).stdout.split(" ", 1)
+    kf = gyrofx.Plan.default().kf()
+    assert shown == ["4", f"{kf.process([0, 1000, -1000]).tolist()}\n"]
