@@ -278,26 +278,16 @@ assign bias_b = bias_b_reg;
 assign estimated = estimated_reg;
 
 `ifndef SYNTHESIS
-// Simulation only (yosys defines SYNTHESIS): the estimator takes a sample at most every
-// MIN_CLOCKS_PER_SAMPLE clocks (six register stages, one sample in flight); a sooner ce would be
-// lost without a trace, so the simulation stops, naming the instance (gyrofx_job::pipeline
-// holds the same figure for the testbenches and the models).
-localparam integer MIN_CLOCKS_PER_SAMPLE = 6;
-integer clocks_since_sample = MIN_CLOCKS_PER_SAMPLE;
-always @(posedge clk) begin
-    if (rst) begin
-        clocks_since_sample <= MIN_CLOCKS_PER_SAMPLE;
-    end else if (ce) begin
-        if (clocks_since_sample < MIN_CLOCKS_PER_SAMPLE) begin
-            $display("FAIL %m: a sample %0d clocks after the previous one; gyrofx_bias_estimator takes one at most every %0d clocks",
-                clocks_since_sample, MIN_CLOCKS_PER_SAMPLE);
-            $fatal(1, "%m: samples closer than MIN_CLOCKS_PER_SAMPLE");
-        end
-        clocks_since_sample <= 1;
-    end else if (clocks_since_sample < MIN_CLOCKS_PER_SAMPLE) begin
-        clocks_since_sample <= clocks_since_sample + 1;
-    end
-end
+// Simulation only (yosys defines SYNTHESIS): the estimator takes a sample at most every 6 clocks
+// (gyrofx_job::pipeline); a sooner ce stops the simulation, naming this instance.
+gyrofx_spacing_check #(
+    .MIN_CLOCKS_PER_SAMPLE(6),
+    .BLOCK_NAME("gyrofx_bias_estimator")
+) spacing_check (
+    .clk(clk),
+    .rst(rst),
+    .ce(ce)
+);
 `endif
 
 endmodule

@@ -311,27 +311,10 @@ begin
     estimated <= estimated_reg;
 
     -- pragma translate_off
-    -- Simulation only: the estimator takes a sample at most every MIN_CLOCKS_PER_SAMPLE clocks
-    -- (six register stages, one sample in flight); a sooner ce would be lost without a trace, so the
-    -- simulation stops, naming the instance (gyrofx_job::pipeline holds the same figure).
-    spacing_check : process (clk)
-        constant MIN_CLOCKS_PER_SAMPLE : positive := 6;
-        variable clocks_since_sample : natural := MIN_CLOCKS_PER_SAMPLE;
-    begin
-        if rising_edge(clk) then
-            if rst = '1' then
-                clocks_since_sample := MIN_CLOCKS_PER_SAMPLE;
-            elsif ce = '1' then
-                assert clocks_since_sample >= MIN_CLOCKS_PER_SAMPLE
-                    report spacing_check'path_name & ": a sample " & integer'image(clocks_since_sample)
-                        & " clocks after the previous one; gyrofx_bias_estimator takes one at most every "
-                        & integer'image(MIN_CLOCKS_PER_SAMPLE) & " clocks"
-                    severity failure;
-                clocks_since_sample := 1;
-            elsif clocks_since_sample < MIN_CLOCKS_PER_SAMPLE then
-                clocks_since_sample := clocks_since_sample + 1;
-            end if;
-        end if;
-    end process;
+    -- Simulation only: the estimator takes a sample at most every 6 clocks (gyrofx_job::pipeline);
+    -- a sooner ce stops the simulation, naming this instance.
+    spacing_check : entity work.gyrofx_spacing_check
+        generic map (MIN_CLOCKS_PER_SAMPLE => 6, BLOCK_NAME => "gyrofx_bias_estimator")
+        port map (clk => clk, rst => rst, ce => ce);
     -- pragma translate_on
 end architecture;

@@ -193,26 +193,16 @@ assign rate_out = rate_reg;
 assign out_valid = valid_reg;
 
 `ifndef SYNTHESIS
-// Simulation only (yosys defines SYNTHESIS): the KF takes a sample at most every
-// MIN_CLOCKS_PER_SAMPLE clocks (four register stages; the state update a sample needs is written 3 clocks after its ce); a sooner ce would be
-// lost without a trace, so the simulation stops, naming the instance (gyrofx_job::pipeline
-// holds the same figure for the testbenches and the models).
-localparam integer MIN_CLOCKS_PER_SAMPLE = 3;
-integer clocks_since_sample = MIN_CLOCKS_PER_SAMPLE;
-always @(posedge clk) begin
-    if (rst) begin
-        clocks_since_sample <= MIN_CLOCKS_PER_SAMPLE;
-    end else if (ce) begin
-        if (clocks_since_sample < MIN_CLOCKS_PER_SAMPLE) begin
-            $display("FAIL %m: a sample %0d clocks after the previous one; gyrofx_kf takes one at most every %0d clocks",
-                clocks_since_sample, MIN_CLOCKS_PER_SAMPLE);
-            $fatal(1, "%m: samples closer than MIN_CLOCKS_PER_SAMPLE");
-        end
-        clocks_since_sample <= 1;
-    end else if (clocks_since_sample < MIN_CLOCKS_PER_SAMPLE) begin
-        clocks_since_sample <= clocks_since_sample + 1;
-    end
-end
+// Simulation only (yosys defines SYNTHESIS): the KF takes a sample at most every 3 clocks
+// (gyrofx_job::pipeline); a sooner ce stops the simulation, naming this instance.
+gyrofx_spacing_check #(
+    .MIN_CLOCKS_PER_SAMPLE(3),
+    .BLOCK_NAME("gyrofx_kf")
+) spacing_check (
+    .clk(clk),
+    .rst(rst),
+    .ce(ce)
+);
 `endif
 
 endmodule

@@ -198,27 +198,10 @@ begin
     out_valid <= valid_reg;
 
     -- pragma translate_off
-    -- Simulation only: the KF takes a sample at most every MIN_CLOCKS_PER_SAMPLE clocks
-    -- (four register stages; the state update a sample needs is written 3 clocks after its ce); a sooner ce would be lost without a trace, so the
-    -- simulation stops, naming the instance (gyrofx_job::pipeline holds the same figure).
-    spacing_check : process (clk)
-        constant MIN_CLOCKS_PER_SAMPLE : positive := 3;
-        variable clocks_since_sample : natural := MIN_CLOCKS_PER_SAMPLE;
-    begin
-        if rising_edge(clk) then
-            if rst = '1' then
-                clocks_since_sample := MIN_CLOCKS_PER_SAMPLE;
-            elsif ce = '1' then
-                assert clocks_since_sample >= MIN_CLOCKS_PER_SAMPLE
-                    report spacing_check'path_name & ": a sample " & integer'image(clocks_since_sample)
-                        & " clocks after the previous one; gyrofx_kf takes one at most every "
-                        & integer'image(MIN_CLOCKS_PER_SAMPLE) & " clocks"
-                    severity failure;
-                clocks_since_sample := 1;
-            elsif clocks_since_sample < MIN_CLOCKS_PER_SAMPLE then
-                clocks_since_sample := clocks_since_sample + 1;
-            end if;
-        end if;
-    end process;
+    -- Simulation only: the KF takes a sample at most every 3 clocks (gyrofx_job::pipeline);
+    -- a sooner ce stops the simulation, naming this instance.
+    spacing_check : entity work.gyrofx_spacing_check
+        generic map (MIN_CLOCKS_PER_SAMPLE => 3, BLOCK_NAME => "gyrofx_kf")
+        port map (clk => clk, rst => rst, ce => ce);
     -- pragma translate_on
 end architecture;

@@ -358,27 +358,10 @@ begin
     mode_b <= chain_mode_b;
 
     -- pragma translate_off
-    -- Simulation only: the system takes a sample at most every MIN_CLOCKS_PER_SAMPLE clocks
-    -- (the loop's four stages, then the chain's six); a sooner ce would be lost without a trace, so the
-    -- simulation stops, naming the instance (gyrofx_job::pipeline holds the same figure).
-    spacing_check : process (clk)
-        constant MIN_CLOCKS_PER_SAMPLE : positive := 10;
-        variable clocks_since_sample : natural := MIN_CLOCKS_PER_SAMPLE;
-    begin
-        if rising_edge(clk) then
-            if rst = '1' then
-                clocks_since_sample := MIN_CLOCKS_PER_SAMPLE;
-            elsif ce = '1' then
-                assert clocks_since_sample >= MIN_CLOCKS_PER_SAMPLE
-                    report spacing_check'path_name & ": a sample " & integer'image(clocks_since_sample)
-                        & " clocks after the previous one; gyrofx_system takes one at most every "
-                        & integer'image(MIN_CLOCKS_PER_SAMPLE) & " clocks"
-                    severity failure;
-                clocks_since_sample := 1;
-            elsif clocks_since_sample < MIN_CLOCKS_PER_SAMPLE then
-                clocks_since_sample := clocks_since_sample + 1;
-            end if;
-        end if;
-    end process;
+    -- Simulation only: the system takes a sample at most every 10 clocks (gyrofx_job::pipeline);
+    -- a sooner ce stops the simulation, naming this instance.
+    spacing_check : entity work.gyrofx_spacing_check
+        generic map (MIN_CLOCKS_PER_SAMPLE => 10, BLOCK_NAME => "gyrofx_system")
+        port map (clk => clk, rst => rst, ce => ce);
     -- pragma translate_on
 end architecture;

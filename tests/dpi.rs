@@ -259,6 +259,7 @@ fn the_cpp_verilator_harness_checks_the_kf_against_the_c_api() {
             "--top-module",
             "cocotb_gyrofx_kf",
             "../hdl/gyrofx_quantize.v",
+            "../hdl/gyrofx_spacing_check.v",
             "../hdl/gyrofx_kf.v",
             "../cocotb/cocotb_gyrofx_kf.v",
             harness.to_str().unwrap(),

@@ -55,13 +55,14 @@ fn verilator_lint_is_clean_for_several_parameter_sets() {
     ];
     lint_clean(
         "gyrofx_kf",
-        &["gyrofx_quantize.v", "gyrofx_kf.v"],
+        &["gyrofx_quantize.v", "gyrofx_spacing_check.v", "gyrofx_kf.v"],
         &parameter_sets,
     );
 }
 
-const ALL_RTL: [&str; 7] = [
+const ALL_RTL: [&str; 8] = [
     "gyrofx_quantize.v",
+    "gyrofx_spacing_check.v",
     "gyrofx_kf.v",
     "gyrofx_sequencer.v",
     "gyrofx_bias_estimator.v",
@@ -138,6 +139,7 @@ fn icarus_compiles_without_warnings() {
             "-o",
             "kf.vvp",
             hdl("gyrofx_quantize.v").to_str().unwrap(),
+            hdl("gyrofx_spacing_check.v").to_str().unwrap(),
             hdl("gyrofx_kf.v").to_str().unwrap(),
             hdl("gyrofx_sequencer.v").to_str().unwrap(),
             hdl("gyrofx_bias_estimator.v").to_str().unwrap(),
@@ -266,9 +268,10 @@ endmodule
 }
 
 /// The VHDL RTL in compile order (packages first).
-const VHDL_RTL: [&str; 8] = [
+const VHDL_RTL: [&str; 9] = [
     "gyrofx_mem_pkg.vhd",
     "gyrofx_quantize.vhd",
+    "gyrofx_spacing_check.vhd",
     "gyrofx_kf.vhd",
     "gyrofx_sequencer.vhd",
     "gyrofx_bias_estimator.vhd",

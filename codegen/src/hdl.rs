@@ -2,10 +2,14 @@
 //! in compile order (a unit before its users), and the sources one module needs.
 
 /// The reference RTL, embedded so that every package is self-contained.
-pub const RTL_SOURCES: [(&str, &str); 16] = [
+pub const RTL_SOURCES: [(&str, &str); 17] = [
     (
         "gyrofx_quantize.v",
         include_str!("../../hdl/gyrofx_quantize.v"),
+    ),
+    (
+        "gyrofx_spacing_check.v",
+        include_str!("../../hdl/gyrofx_spacing_check.v"),
     ),
     ("gyrofx_kf.v", include_str!("../../hdl/gyrofx_kf.v")),
     (
@@ -120,7 +124,7 @@ pub fn vhdl_sources_of(module: &str) -> Vec<&'static (&'static str, &'static str
 
 /// The reference RTL in VHDL-2008, in compile order (packages first), and the package the VHDL
 /// testbenches share (last: simulation only).
-pub const VHDL_SOURCES: [(&str, &str); 18] = [
+pub const VHDL_SOURCES: [(&str, &str); 19] = [
     (
         "gyrofx_mem_pkg.vhd",
         include_str!("../../hdl/gyrofx_mem_pkg.vhd"),
@@ -128,6 +132,10 @@ pub const VHDL_SOURCES: [(&str, &str); 18] = [
     (
         "gyrofx_quantize.vhd",
         include_str!("../../hdl/gyrofx_quantize.vhd"),
+    ),
+    (
+        "gyrofx_spacing_check.vhd",
+        include_str!("../../hdl/gyrofx_spacing_check.vhd"),
     ),
     ("gyrofx_kf.vhd", include_str!("../../hdl/gyrofx_kf.vhd")),
     (
@@ -197,6 +205,7 @@ mod tests {
             names("gyrofx_top"),
             [
                 "gyrofx_quantize.v",
+                "gyrofx_spacing_check.v",
                 "gyrofx_kf.v",
                 "gyrofx_sequencer.v",
                 "gyrofx_bias_estimator.v",
@@ -217,6 +226,7 @@ mod tests {
             names("gyrofx_gyro_loop"),
             [
                 "gyrofx_quantize.v",
+                "gyrofx_spacing_check.v",
                 "gyrofx_nco.v",
                 "gyrofx_demodulator.v",
                 "gyrofx_pi.v",
@@ -239,6 +249,7 @@ mod tests {
             [
                 "gyrofx_mem_pkg.vhd",
                 "gyrofx_quantize.vhd",
+                "gyrofx_spacing_check.vhd",
                 "gyrofx_kf.vhd",
                 "gyrofx_testbench_pkg.vhd",
             ]
