@@ -6,7 +6,7 @@
 # Installs the simulators and synthesis tools with apt-get where missing (iverilog, verilator,
 # ghdl, yosys, nextpnr-ice40, make, cbindgen for the C header's test, pkg-config for the
 # installed C library's, ccache for Verilator's runtime, and the DejaVu font the plots use), FuseSoC with pip in a virtualenv, and maturin,
-# numpy, pytest and pytest-xdist in another (for the Python package in python/):
+# numpy, pytest, pytest-xdist, cocotb and mypy (stubtest) in another (for the Python package in python/):
 # a missing simulator is a failure, never a skipped test. Then: rustfmt, Verilator and GHDL lint
 # of the RTL, and the whole test suite with cargo-nextest (unit, property, end-to-end in every
 # simulator, golden vectors, doc tests), its build linted by clippy (-D warnings) as it
@@ -139,10 +139,10 @@ cargo test --workspace --doc
 # vectors, and the package's cocotb tests in Icarus (python/tests/test_cocotb.py).
 echo "== python: cargo fmt, maturin wheel (linted by clippy), pytest"
 python_venv="${XDG_CACHE_HOME:-$HOME/.cache}/gyrofx/python-venv"
-if [ ! -x "$python_venv/bin/maturin" ] || ! "$python_venv/bin/python" -c "import numpy, pytest, xdist, cocotb" >/dev/null 2>&1; then
-    echo "== installing maturin, numpy, pytest, pytest-xdist, cocotb into $python_venv"
+if [ ! -x "$python_venv/bin/maturin" ] || ! "$python_venv/bin/python" -c "import numpy, pytest, xdist, cocotb, mypy" >/dev/null 2>&1; then
+    echo "== installing maturin, numpy, pytest, pytest-xdist, cocotb, mypy into $python_venv"
     python3 -m venv "$python_venv"
-    "$python_venv/bin/pip" install -q "maturin>=1.5,<2" numpy pytest pytest-xdist "cocotb>=2.0,<3"
+    "$python_venv/bin/pip" install -q "maturin>=1.5,<2" numpy pytest pytest-xdist "cocotb>=2.0,<3" mypy
 fi
 cargo fmt --manifest-path python/Cargo.toml -- --check
 # In the workspace's target folder and its dev profile (the model fully optimised): a crate
@@ -161,6 +161,11 @@ rm -rf python/target/wheels
 "$python_venv/bin/maturin" build --profile dev --quiet -m python/Cargo.toml --features extension-module,workspace-features --out python/target/wheels
 unset CARGO_TARGET_DIR RUSTC_WORKSPACE_WRAPPER CLIPPY_ARGS
 "$python_venv/bin/pip" install -q --force-reinstall --no-deps python/target/wheels/gyrofx-*.whl
+# The type stubs against the compiled module (mypy's stubtest): a name, signature or class the
+# stubs describe otherwise than the wheel has fails here. In a folder of its own: mypy's cache.
+stubtest_folder="$(mktemp -d)"
+(cd "$stubtest_folder" && "$python_venv/bin/python" -m mypy.stubtest gyrofx)
+rm -rf "$stubtest_folder"
 # One pytest worker per core (pytest-xdist): each cocotb run is one single-threaded simulator.
 GYROFX_CLI="$PWD/target/debug/gyrofx" GYROFX_WHEEL="$(ls python/target/wheels/gyrofx-*.whl)" \
     "$python_venv/bin/python" -m pytest -q -n auto python/tests

@@ -6,29 +6,52 @@ reverse. Real values are °/s. Every refused input raises ``GyrofxError``.
 """
 
 from os import PathLike
-from typing import Dict, List, Optional, Tuple, Union
+from typing import Dict, List, Optional, Tuple, Union, final
 
 import numpy as np
 import numpy.typing as npt
 
+__all__ = [
+    "Chain",
+    "ChainFloat",
+    "Estimator",
+    "EstimatorFloat",
+    "GyroLoop",
+    "GyroLoopFloat",
+    "GyrofxError",
+    "Kf",
+    "KfFloat",
+    "MeanFilter",
+    "MeanFilterFloat",
+    "Plan",
+    "Resonator",
+    "Sequencer",
+    "System",
+    "SystemFloat",
+    "__version__",
+    "quantize",
+    "to_real",
+]
+
 __version__: str
 
-Codes = npt.NDArray[np.int64]
-Reals = npt.NDArray[np.float64]
-BandwidthSelect = Union[int, npt.ArrayLike]
+_Codes = npt.NDArray[np.int64]
+_Reals = npt.NDArray[np.float64]
+_BandwidthSelect = Union[int, npt.ArrayLike]
 
 class GyrofxError(ValueError):
     """A refused config, format or argument; the message is the CLI's."""
 
 def quantize(
     values: npt.ArrayLike, fmt: str, rounding: str = "nearest", overflow: str = "saturate"
-) -> Codes:
+) -> _Codes:
     """Real values to codes of ``fmt``. rounding: floor, ceil, zero, nearest (ties up),
     round (ties away from zero), convergent (ties to even); overflow: saturate or wrap."""
 
-def to_real(codes: npt.ArrayLike, fmt: str) -> Reals:
-    """Codes of ``fmt`` to real values (code · 2^-frac); codes outside ``fmt`` are refused."""
+def to_real(codes: npt.ArrayLike, fmt: str) -> _Reals:
+    """_Codes of ``fmt`` to real values (code · 2^-frac); codes outside ``fmt`` are refused."""
 
+@final
 class Plan:
     """A resolved config: every block's formats, ROMs and designs, as ``gyrofx generate``
     resolves them."""
@@ -73,6 +96,7 @@ class Plan:
     def resonator(self, gyro: str = "a", seed: Optional[int] = None, noise: bool = True) -> Resonator:
         """The simulated resonator; seed defaults to generate's (2·seed, 2·seed + 1)."""
 
+@final
 class Kf:
     """The bit-accurate steady-state KF (gyrofx_kf); the RTL shows rate_out latency_clocks after
     the sample's ce and takes a sample at most every min_clocks_per_sample clocks."""
@@ -86,19 +110,21 @@ class Kf:
     def reset(self) -> None: ...
     def step(self, z: int, bw_sel: int = 0) -> int:
         """One step: ``z`` (input-format code) -> ``rate_out`` (output-format code)."""
-    def process(self, z: npt.ArrayLike, bw_sel: BandwidthSelect = 0) -> Codes: ...
+    def process(self, z: npt.ArrayLike, bw_sel: _BandwidthSelect = 0) -> _Codes: ...
     def state(self) -> Tuple[int, int]:
         """``(x1, x2)`` as state-format codes."""
     def error_bound_lsb(self, samples: int, switches: int = 0) -> float:
         """Derived bound on |fixed - float twin| in output LSB after ``samples`` steps."""
 
+@final
 class KfFloat:
     """The KF's float twin, °/s."""
 
     def reset(self) -> None: ...
     def step(self, z: float, bw_sel: int = 0) -> float: ...
-    def process(self, z: npt.ArrayLike, bw_sel: BandwidthSelect = 0) -> Reals: ...
+    def process(self, z: npt.ArrayLike, bw_sel: _BandwidthSelect = 0) -> _Reals: ...
 
+@final
 class Sequencer:
     """The mode-reversal sequencer (gyrofx_sequencer): combinational slot outputs per clock."""
 
@@ -110,8 +136,9 @@ class Sequencer:
     def step(self) -> Dict[str, int]:
         """mode_a, mode_b, blank_a, blank_b, interval_a, interval_b, done_a, done_b,
         window_done of this clock; then advances."""
-    def process(self, samples: int) -> Dict[str, Codes]: ...
+    def process(self, samples: int) -> Dict[str, _Codes]: ...
 
+@final
 class Estimator:
     """The least-squares bias estimator (gyrofx_bias_estimator)."""
 
@@ -146,8 +173,9 @@ class Estimator:
         interval_a: npt.ArrayLike,
         interval_b: npt.ArrayLike,
         window_done: npt.ArrayLike,
-    ) -> Dict[str, Codes]: ...
+    ) -> Dict[str, _Codes]: ...
 
+@final
 class EstimatorFloat:
     """The estimator's float twin, °/s."""
 
@@ -165,6 +193,7 @@ class EstimatorFloat:
         window_done: int,
     ) -> Tuple[float, float]: ...
 
+@final
 class MeanFilter:
     """The mean filter with gross-error rejection (gyrofx_mean_filter)."""
 
@@ -178,15 +207,17 @@ class MeanFilter:
     def reset(self) -> None: ...
     def step(self, x: int) -> Optional[Tuple[int, int]]:
         """``(y, kept)`` on a block's last sample (y_valid), else None."""
-    def process(self, x: npt.ArrayLike) -> Dict[str, Codes]:
+    def process(self, x: npt.ArrayLike) -> Dict[str, _Codes]:
         """y_valid, y, kept per input sample (y and kept 0 where y_valid is 0)."""
 
+@final
 class MeanFilterFloat:
     """The mean filter's float twin, °/s."""
 
     def reset(self) -> None: ...
     def step(self, x: float) -> Optional[Tuple[float, int]]: ...
 
+@final
 class Chain:
     """The whole chain (gyrofx_top): sequencer, estimator, calibration and KF."""
 
@@ -200,9 +231,10 @@ class Chain:
     def step(self, y_a: int, y_b: int, bw_sel: int = 0) -> Dict[str, int]:
         """mode_a, mode_b, out_valid, rate_out, bias_a, bias_b, estimated."""
     def process(
-        self, y_a: npt.ArrayLike, y_b: npt.ArrayLike, bw_sel: BandwidthSelect = 0
-    ) -> Dict[str, Codes]: ...
+        self, y_a: npt.ArrayLike, y_b: npt.ArrayLike, bw_sel: _BandwidthSelect = 0
+    ) -> Dict[str, _Codes]: ...
 
+@final
 class ChainFloat:
     """The chain's float twin, °/s."""
 
@@ -210,8 +242,9 @@ class ChainFloat:
     def step(self, y_a: float, y_b: float, bw_sel: int = 0) -> Dict[str, Optional[float]]:
         """out_valid, rate (None when the KF did not step), bias_a, bias_b."""
 
-PerSample = Union[int, npt.ArrayLike]
+_PerSample = Union[int, npt.ArrayLike]
 
+@final
 class GyroLoop:
     """One gyro's digital loop (gyrofx_gyro_loop), one step per ADC sample: ADC codes of both
     axes and the mode (1 normal, 0 reverse) in; DAC codes, locked, and every decimation-th
@@ -230,9 +263,10 @@ class GyroLoop:
     def step(self, adc_x: int, adc_y: int, mode: int = 1) -> Dict[str, int]:
         """dac_x, dac_y, locked, out_valid, rate, quadrature."""
     def process(
-        self, adc_x: npt.ArrayLike, adc_y: npt.ArrayLike, mode: PerSample = 1
-    ) -> Dict[str, Codes]: ...
+        self, adc_x: npt.ArrayLike, adc_y: npt.ArrayLike, mode: _PerSample = 1
+    ) -> Dict[str, _Codes]: ...
 
+@final
 class GyroLoopFloat:
     """The loop's float twin: ADC in full-scale units, DAC in LSB (unquantized), rate in °/s."""
 
@@ -240,6 +274,7 @@ class GyroLoopFloat:
     def step(self, adc_x: float, adc_y: float, mode: int = 1) -> Dict[str, Optional[float]]:
         """dac_x, dac_y, locked, out_valid, rate and quadrature (None between outputs)."""
 
+@final
 class System:
     """The whole gyro at the ADC rate (gyrofx_system): both loops and the chain, whose
     sequencer commands the loops' modes. enable 0 holds the chain (start-up)."""
@@ -264,10 +299,11 @@ class System:
         adc_a_y: npt.ArrayLike,
         adc_b_x: npt.ArrayLike,
         adc_b_y: npt.ArrayLike,
-        enable: PerSample = 1,
-        bw_sel: BandwidthSelect = 0,
-    ) -> Dict[str, Codes]: ...
+        enable: _PerSample = 1,
+        bw_sel: _BandwidthSelect = 0,
+    ) -> Dict[str, _Codes]: ...
 
+@final
 class SystemFloat:
     """The system's float twin: ADC in full-scale units, DAC in LSB, rates and biases in °/s."""
 
@@ -279,6 +315,7 @@ class SystemFloat:
         """dac_*, locked_*, mode_a, mode_b, out_valid, and rate_out, bias_a, bias_b (None
         where the chain gave none)."""
 
+@final
 class Resonator:
     """A simulated resonator with its front end: DAC codes in, the next ADC codes out."""
 
