@@ -30,6 +30,8 @@ mod tests;
 
 use gyrofx_model::fx::{Format, Overflow, Rounding};
 use gyrofx_model::gyro_loop::RtlParameter;
+use rand_core::{RngCore, SeedableRng};
+use rand_xoshiro::SplitMix64;
 
 use crate::block::{Block, Param};
 use crate::rom::{self, Rom, RomFormat};
@@ -358,23 +360,19 @@ pub(crate) fn leaf_params(
     params
 }
 
-/// A deterministic stream of pseudo-random words (SplitMix64): the same codes on every
-/// platform for one seed.
-pub(crate) struct Words(u64);
+/// A deterministic stream of pseudo-random words: the model's SplitMix64 (`rand_xoshiro`),
+/// the same codes on every platform for one seed.
+pub(crate) struct Words(SplitMix64);
 
 impl Words {
     /// The stream of `seed`.
     pub(crate) fn new(seed: u64) -> Self {
-        Words(seed)
+        Words(SplitMix64::seed_from_u64(seed))
     }
 
     /// The next word.
     pub(crate) fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
+        self.0.next_u64()
     }
 
     /// A code of `format` (up to 64 bits wide), uniform over its range.
