@@ -229,6 +229,24 @@ unsafe fn put<V>(out: *mut V, value: V) {
     }
 }
 
+/// A live block to read, or None with "block is NULL" as the thread's error.
+///
+/// # Safety
+/// `block` is NULL or a live block of type `T`.
+unsafe fn live<'a, T>(block: *const T) -> Option<&'a T> {
+    // SAFETY: NULL or live, by contract.
+    let block = unsafe { block.as_ref() };
+    if block.is_none() {
+        fail("block is NULL");
+    }
+    block
+}
+
+/// A count or width as DPI-C's `int`.
+fn int(n: impl TryInto<i32>) -> i32 {
+    n.try_into().unwrap_or(i32::MAX)
+}
+
 /// Writes a live block's pipeline through the two outputs (each NULL or writable); 0, or -1
 /// for a NULL block.
 ///
@@ -240,20 +258,15 @@ unsafe fn pipeline_of<T>(
     latency_clocks: *mut i32,
     min_clocks_per_sample: *mut i32,
 ) -> i32 {
-    // SAFETY: NULL or live, by contract.
-    let Some(block) = (unsafe { block.as_ref() }) else {
-        fail("block is NULL");
+    // SAFETY: forwarded contract.
+    let Some(block) = (unsafe { live(block) }) else {
         return -1;
     };
     let pipeline = pipeline(block);
-    let clocks = |n: u32| i32::try_from(n).unwrap_or(i32::MAX);
     // SAFETY: forwarded contract.
     unsafe {
-        put(latency_clocks, clocks(pipeline.latency_clocks));
-        put(
-            min_clocks_per_sample,
-            clocks(pipeline.min_clocks_per_sample),
-        );
+        put(latency_clocks, int(pipeline.latency_clocks));
+        put(min_clocks_per_sample, int(pipeline.min_clocks_per_sample));
     }
     0
 }
@@ -276,14 +289,8 @@ fn c_name(name: &'static str) -> *const c_char {
 /// # Safety
 /// `block` is NULL or a live block of type `T`.
 unsafe fn port_count_of<T>(block: *const T, ports: impl FnOnce(&T) -> Vec<Port>) -> i32 {
-    // SAFETY: NULL or live, by contract.
-    match unsafe { block.as_ref() } {
-        Some(block) => i32::try_from(ports(block).len()).unwrap_or(i32::MAX),
-        None => {
-            fail("block is NULL");
-            -1
-        }
-    }
+    // SAFETY: forwarded contract.
+    unsafe { live(block) }.map_or(-1, |block| int(ports(block).len()))
 }
 
 /// Writes port `index` of a live block (the vector files' order: inputs, then outputs):
@@ -298,9 +305,8 @@ unsafe fn port_of<T>(
     index: i32,
     outputs: PortOutputs,
 ) -> i32 {
-    // SAFETY: NULL or live, by contract.
-    let Some(block) = (unsafe { block.as_ref() }) else {
-        fail("block is NULL");
+    // SAFETY: forwarded contract.
+    let Some(block) = (unsafe { live(block) }) else {
         return -1;
     };
     let ports = ports(block);
@@ -312,11 +318,10 @@ unsafe fn port_of<T>(
         ));
         return -1;
     };
-    let to_i32 = |n: u32| i32::try_from(n).unwrap_or(i32::MAX);
     // SAFETY: forwarded contract.
     unsafe {
         put(outputs.name, c_name(port.name));
-        put(outputs.width, to_i32(port.format.width));
+        put(outputs.width, int(port.format.width));
         put(outputs.fraction, port.format.frac);
         put(outputs.is_signed, i32::from(port.format.signed));
         put(outputs.is_output, i32::from(port.output));
