@@ -28,6 +28,10 @@ while [ $# -gt 0 ]; do
     esac
 done
 case "$prefix" in /*) ;; *) prefix="$PWD/$prefix" ;; esac
+if [ -e "$prefix" ] && [ ! -d "$prefix" ]; then
+    echo "FAIL: PREFIX $prefix exists and is not a folder" >&2
+    exit 1
+fi
 if [ -z "$from" ]; then
     cargo build --release -p gyrofx-capi
     from="${CARGO_TARGET_DIR:-target}/release"
