@@ -115,22 +115,32 @@ pub(crate) fn block_files(block: &Block, provenance: &Provenance) -> Vec<BlockFi
 pub fn blocks_package(blocks: &[Block], provenance: &Provenance) -> Package {
     let mut package = Package::new(Kind::Generate, writers::build_outputs(blocks));
     package.add("Makefile", writers::makefile(blocks, provenance));
-    for (name, source) in hdl::RTL_SOURCES.iter().chain(&hdl::VHDL_SOURCES) {
-        package.add(format!("hdl/{name}"), *source);
-    }
+    add_rtl(&mut package);
     for block in blocks {
         let (stimulus, expected) = writers::vector_hex(block, provenance);
         for (what, text) in [("stimulus.hex", stimulus), ("expected.hex", expected)] {
             package.add(format!("{}/{}", block.name, block.file(what)), text);
         }
-        for file in block_files(block, provenance) {
-            match file {
-                BlockFile::Text(path, text) => package.add(path, text),
-                BlockFile::Written(entry) => package.add_written(entry),
-            }
-        }
+        add_block_files(&mut package, block, provenance);
     }
     package
+}
+
+/// Adds the embedded reference RTL under `hdl/`.
+fn add_rtl(package: &mut Package) {
+    for (name, source) in hdl::RTL_SOURCES.iter().chain(&hdl::VHDL_SOURCES) {
+        package.add(format!("hdl/{name}"), *source);
+    }
+}
+
+/// Adds a block's folder ([`block_files`]).
+fn add_block_files(package: &mut Package, block: &Block, provenance: &Provenance) {
+    for file in block_files(block, provenance) {
+        match file {
+            BlockFile::Text(path, text) => package.add(path, text),
+            BlockFile::Written(entry) => package.add_written(entry),
+        }
+    }
 }
 
 pub(crate) fn block_manifest(block: &Block) -> serde_json::Value {
@@ -205,9 +215,7 @@ pub fn build_package(
         crate::fusesoc::core(&run.blocks, provenance),
     );
     package.add("report.md", writers::report_md(&run, provenance));
-    for (name, source) in hdl::RTL_SOURCES.iter().chain(&hdl::VHDL_SOURCES) {
-        package.add(format!("hdl/{name}"), *source);
-    }
+    add_rtl(&mut package);
     for image in roms.iter() {
         for format in RomFormat::ALL {
             package.add(
@@ -223,12 +231,7 @@ pub fn build_package(
         package.add(path, text);
     }
     for block in &run.blocks {
-        for file in block_files(block, provenance) {
-            match file {
-                BlockFile::Text(path, text) => package.add(path, text),
-                BlockFile::Written(entry) => package.add_written(entry),
-            }
-        }
+        add_block_files(&mut package, block, provenance);
     }
 
     let blocks: serde_json::Map<String, serde_json::Value> = run
