@@ -1,22 +1,28 @@
 //! The package's cocotb tests (`cocotb/`): per block with a Python model, a Verilog wrapper
 //! that sets the block's parameters from its `<block>_params.vh`, a cocotb makefile and a test
 //! module that drives the RTL with random and directed stimulus and checks it live against the
-//! `gyrofx` Python package (the same Rust model as the vectors). The shared driver and
-//! scoreboard are `cocotb/gyrofx_cocotb.py`.
+//! `gyrofx` Python package (the same Rust model as the vectors). The driver, the timing and the
+//! scoreboard are the Python package's `gyrofx.cocotb`; the tests' timing constants are written
+//! here from each block's pipeline.
 //!
-//! Run from the package: `make cocotb-<block>` (`SIM=icarus`, the default), or
+//! Run from the package: `make cocotb-<block>` (`SIM=icarus`, the default), `pytest cocotb`
+//! (cocotb's Python runner, one pytest test per cocotb test, RTL of your own with `--rtl`), or
 //! `gyrofx verify --sim cocotb`. cocotb 2.x runs Verilator only from 5.036 on; Debian 12's
 //! 5.006 is refused by cocotb's own makefile, so Icarus is the simulator CI runs.
 
 use std::fmt::Write as _;
+
+use serde::Serialize;
 
 use crate::block::Block;
 use crate::hdl::RTL_SOURCES;
 use crate::testbench::verilog::instance;
 use crate::text::Provenance;
 
-/// The shared driver, protocol and scoreboard.
-const SHARED: &str = include_str!("cocotb/gyrofx_cocotb.py");
+/// The pytest options (simulator, seed, your own RTL and its timing).
+const CONFTEST: &str = include_str!("../templates/cocotb/conftest.py");
+/// One pytest test per cocotb test, on cocotb's Python runner.
+const TEST_PACKAGE: &str = include_str!("../templates/cocotb/test_package.py");
 
 /// Folder of the cocotb files in a package.
 pub const FOLDER: &str = "cocotb";
@@ -34,8 +40,15 @@ pub fn files(blocks: &[Block], provenance: &Provenance) -> Vec<(String, String)>
         return Vec::new();
     }
     let python = |text: &str| format!("{}\n{text}", provenance.line("#"));
-    let mut files = vec![(format!("{FOLDER}/gyrofx_cocotb.py"), python(SHARED))];
-    for block in tested {
+    let mut files = vec![
+        (format!("{FOLDER}/conftest.py"), python(CONFTEST)),
+        (format!("{FOLDER}/test_package.py"), python(TEST_PACKAGE)),
+        (
+            format!("{FOLDER}/tests.json"),
+            tests_json(&tested, provenance),
+        ),
+    ];
+    for block in &tested {
         let test = block.cocotb_test.expect("tested blocks have a test");
         files.push((
             format!("{FOLDER}/test_{}.py", block.name),
@@ -53,23 +66,90 @@ pub fn files(blocks: &[Block], provenance: &Provenance) -> Vec<(String, String)>
     files
 }
 
-/// `test` with its pipeline constants set from `block`, the one source of its timing:
-/// `OUTPUT_CLOCKS` (clocks after the edge that takes a sample until the registered outputs show
-/// it) and `PIPELINE_CLOCKS` (idle clocks between samples at the fastest spacing).
+/// The line of a cocotb test that holds the DUT's timing (`gyrofx.cocotb.Timing`).
+const TIMING_LINE: &str = "TIMING = tb.Timing(";
+
+/// `test` with its `TIMING` line set from `block`'s pipeline, the one source of its timing.
+/// Every block's test has one such line (`blocks::tests` holds them to it).
 fn with_pipeline(test: &str, block: &Block) -> String {
     let mut text: String = test
         .lines()
         .map(|line| {
-            if line.starts_with("OUTPUT_CLOCKS = ") {
-                format!("OUTPUT_CLOCKS = {}", block.settle_clocks())
-            } else if line.starts_with("PIPELINE_CLOCKS = ") {
-                format!("PIPELINE_CLOCKS = {}", block.clocks_per_sample() - 1)
+            if line.starts_with(TIMING_LINE) {
+                timing_line(block)
             } else {
                 line.to_string()
             }
         })
         .collect::<Vec<_>>()
         .join("\n");
+    text.push('\n');
+    text
+}
+
+/// `TIMING = tb.Timing(latency_clocks=.., min_clocks_per_sample=..)` for `block`.
+fn timing_line(block: &Block) -> String {
+    format!(
+        "{TIMING_LINE}latency_clocks={}, min_clocks_per_sample={})",
+        block.pipeline.latency_clocks, block.pipeline.min_clocks_per_sample
+    )
+}
+
+/// The names of the cocotb tests in a test module: each `async def` right after a
+/// `@cocotb.test()` line.
+pub fn test_names(test: &str) -> Vec<&str> {
+    let lines: Vec<&str> = test.lines().collect();
+    lines
+        .windows(2)
+        .filter(|pair| pair[0].trim_start().starts_with("@cocotb.test("))
+        .filter_map(|pair| {
+            let rest = pair[1].trim_start().strip_prefix("async def ")?;
+            rest.split('(').next()
+        })
+        .collect()
+}
+
+/// `tests.json`: what `test_package.py` runs, one entry per tested block.
+#[derive(Serialize)]
+struct Tests<'a> {
+    generated_by: String,
+    /// The RTL sources, relative to the package.
+    sources: Vec<String>,
+    blocks: Vec<TestedBlock<'a>>,
+}
+
+#[derive(Serialize)]
+struct TestedBlock<'a> {
+    name: &'a str,
+    toplevel: String,
+    wrapper: String,
+    module: String,
+    tests: Vec<&'a str>,
+    latency_clocks: u32,
+    min_clocks_per_sample: u32,
+}
+
+fn tests_json(tested: &[&Block], provenance: &Provenance) -> String {
+    let tests = Tests {
+        generated_by: provenance.line("").trim_start().to_string(),
+        sources: RTL_SOURCES
+            .iter()
+            .map(|(name, _)| format!("hdl/{name}"))
+            .collect(),
+        blocks: tested
+            .iter()
+            .map(|block| TestedBlock {
+                name: block.name,
+                toplevel: format!("cocotb_{}", block.module),
+                wrapper: format!("{FOLDER}/cocotb_{}.v", block.module),
+                module: format!("test_{}", block.name),
+                tests: test_names(block.cocotb_test.expect("tested blocks have a test")),
+                latency_clocks: block.pipeline.latency_clocks,
+                min_clocks_per_sample: block.pipeline.min_clocks_per_sample,
+            })
+            .collect(),
+    };
+    let mut text = serde_json::to_string_pretty(&tests).expect("plain data serializes");
     text.push('\n');
     text
 }
@@ -158,6 +238,8 @@ pub fn build_outputs(blocks: &[Block]) -> Vec<String> {
         .collect();
     if !tested.is_empty() {
         out.push(format!("{FOLDER}/__pycache__/"));
+        out.push(format!("{FOLDER}/sim_build/"));
+        out.push(format!("{FOLDER}/.pytest_cache/"));
     }
     out
 }

@@ -279,7 +279,12 @@ Verilator from 5.036 on). Each drives the RTL with random and directed stimulus 
 `COCOTB_RANDOM_SEED`, default 1) and checks it live against the model of this package's
 manifest: outputs with a valid flag as a stream whatever the latency, so your own RTL with
 another pipeline depth passes as long as its valid-qualified stream matches; the reference
-timing for combinational ports and registered ports without a valid flag.
+timing for combinational ports and registered ports without a valid flag. The same tests run on
+cocotb's Python runner with `pytest cocotb` (one test per cocotb test: `-k kf`,
+`--junitxml=FILE`), and on RTL of your own: `pytest cocotb -k kf --rtl <your .v files>` (same
+module names and ports), `--toplevel NAME` for your own top, `--parameter NAME=VALUE`,
+`--latency-clocks N` when your pipeline differs (`pytest cocotb --help`). The driver and
+scoreboard are the Python package's `gyrofx.cocotb`.
 
 `dpi/` holds a SystemVerilog testbench per block of those that imports the model's `step`
 from gyrofx's C library through DPI-C and scoreboards the DUT in Verilator the same way:

@@ -61,10 +61,11 @@ def test_the_serial_blocks_pass_it_and_a_flipped_bit_fails_it(tmp_path):
     folder = tmp_path / "out"
     run_cli("generate", "--config", str(config), "--out", str(folder), "--samples", "800", "--quiet")
     manifest = json.loads((folder / "manifest.json").read_text())
-    # gyrofx writes the latency into the tests: outputs show latency - 1 clocks after the edge.
-    settle = manifest["chain"]["latency_clocks"] - 1
-    assert settle > 1000
-    assert f"OUTPUT_CLOCKS = {settle}\n" in (folder / "cocotb" / "test_top.py").read_text()
+    # gyrofx writes the serial chain's pipeline into the test.
+    latency = manifest["chain"]["latency_clocks"]
+    assert latency > 1000
+    timing = f"TIMING = tb.Timing(latency_clocks={latency}, min_clocks_per_sample={latency})\n"
+    assert timing in (folder / "cocotb" / "test_top.py").read_text()
     assert_passes(make(folder, "cocotb-top", GYROFX_COCOTB_SAMPLES="400"))
     # Two scoreboards: rate_out and the registered bias ports. The flip comes at the 40th value
     # of each; 150 samples reach it on both (rate_out is valid outside the blanking only). Each
@@ -72,9 +73,9 @@ def test_the_serial_blocks_pass_it_and_a_flipped_bit_fails_it(tmp_path):
     assert_fails(make(folder, "cocotb-top", GYROFX_COCOTB_SAMPLES="150", GYROFX_COCOTB_FLIP_EXPECTED="40"), 2)
     # The sequential mean filter beside it: the next sample after its latency.
     assert (folder / "cocotb" / "cocotb_gyrofx_mean_filter_serial.v").exists()
-    idle = manifest["mean_filter"]["min_clocks_per_sample"] - 1
-    assert idle > 0
-    assert f"PIPELINE_CLOCKS = {idle}\n" in (folder / "cocotb" / "test_mean_filter.py").read_text()
+    spacing = manifest["mean_filter"]["min_clocks_per_sample"]
+    assert spacing > 1
+    assert f", min_clocks_per_sample={spacing})\n" in (folder / "cocotb" / "test_mean_filter.py").read_text()
     assert_passes(make(folder, "cocotb-mean_filter", GYROFX_COCOTB_SAMPLES="1000"))
     assert_fails(make(folder, "cocotb-mean_filter", GYROFX_COCOTB_SAMPLES="1000", GYROFX_COCOTB_FLIP_EXPECTED="40"), 1)
 
@@ -121,3 +122,91 @@ def test_gyrofx_verify_runs_them(package, tmp_path):
     assert (package / "kf" / "sim_build").is_dir()
     again = run_cli("generate", "--out", str(package), "--samples", "3000", "--seed", "5", "--quiet", check=False)
     assert again.returncode == 0, again.stderr
+
+
+def one_stage_longer(wrapper_text, name):
+    """A top of the same ports as a package's cocotb wrapper whose every output comes one clock
+    later: the reference block with one more register stage, as your own RTL might be."""
+    lines = wrapper_text.splitlines()
+    registers = []
+    out = []
+    for line in lines:
+        stripped = line.strip()
+        if stripped.startswith("module cocotb_"):
+            line = f"module {name} ("
+        elif stripped.startswith("output wire "):
+            declaration = stripped[len("output wire "):].rstrip(",")
+            port = declaration.split()[-1]
+            registers.append((declaration[: -len(port)], port))
+            line = line.replace("output wire ", "output reg ", 1)
+        elif stripped.startswith(".") and any(stripped.startswith(f".{p}({p})") for _, p in registers):
+            port = stripped[1:].split("(")[0]
+            line = line.replace(f".{port}({port})", f".{port}({port}_early)")
+        elif stripped == "endmodule":
+            out.extend(f"wire {kind}{port}_early;" for kind, port in registers)
+            out.append("always @(posedge clk) begin")
+            out.extend(f"    {port} <= {port}_early;" for _, port in registers)
+            out.append("end")
+        out.append(line)
+    return "\n".join(out) + "\n"
+
+
+def pytest_package(package, *arguments, **extra):
+    """The package's own pytest file (cocotb/test_package.py on cocotb's Python runner)."""
+    return subprocess.run(
+        [sys.executable, "-m", "pytest", "-s", "-p", "no:cacheprovider", str(package / "cocotb"), *arguments],
+        capture_output=True, text=True, cwd=package, env=environment(**extra),
+    )
+
+
+def junit_cases(path):
+    import xml.etree.ElementTree as ElementTree
+
+    root = ElementTree.parse(path).getroot()
+    return {case.get("name"): case.find("failure") is None for case in root.iter("testcase")}
+
+
+def test_the_package_pytest_file_runs_one_test_per_cocotb_test(package, tmp_path):
+    copy = tmp_path / "package"
+    shutil.copytree(package, copy)
+    junit = tmp_path / "junit.xml"
+    result = pytest_package(copy, "-k", "kf or sequencer", f"--junitxml={junit}", "--samples", "400")
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    # JUnit per cocotb test: the KF's two and the sequencer's one, by block and test name.
+    assert junit_cases(junit) == {
+        "test_cocotb[kf-random_stimulus]": True,
+        "test_cocotb[kf-directed_full_scale]": True,
+        "test_cocotb[sequencer-cycles_with_idle_clocks_and_resets]": True,
+    }
+    # One flipped expected bit fails the one test that holds it.
+    result = pytest_package(copy, "-k", "kf-random", f"--junitxml={junit}", "--samples", "400",
+                            GYROFX_COCOTB_FLIP_EXPECTED="40")
+    assert result.returncode != 0
+    assert junit_cases(junit) == {"test_cocotb[kf-random_stimulus]": False}
+
+
+def test_your_own_rtl_one_stage_longer(package, tmp_path):
+    copy = tmp_path / "package"
+    shutil.copytree(package, copy)
+    rtl = sorted(str(p) for p in (copy / "hdl").glob("*.v"))
+    for block, module in [("estimator", "gyrofx_bias_estimator"), ("kf", "gyrofx_kf")]:
+        wrapper = (copy / "cocotb" / f"cocotb_{module}.v").read_text()
+        (tmp_path / f"longer_{block}.v").write_text(one_stage_longer(wrapper, f"longer_{block}"))
+    manifest = json.loads((copy / "manifest.json").read_text())
+    latency = manifest["estimator"]["latency_clocks"]
+
+    def run(block, *options):
+        return pytest_package(copy, "-k", block, "--samples", "600", "--rtl", *rtl,
+                              str(tmp_path / f"longer_{block}.v"), "--toplevel", f"longer_{block}", *options)
+
+    # The estimator's outputs have no valid flag: checked at the reference's latency, the longer
+    # pipeline fails; told its latency, it passes.
+    failed = run("estimator")
+    assert failed.returncode != 0 and "FAIL mismatches=" in failed.stdout, failed.stdout[-3000:]
+    passed = run("estimator", "--latency-clocks", str(latency + 1))
+    assert passed.returncode == 0, passed.stdout[-3000:] + passed.stderr[-3000:]
+    assert passed.stdout.count("PASS n=") == 2, passed.stdout[-3000:]
+    # The KF's output is a valid-qualified stream: any latency passes as it is.
+    passed = run("kf")
+    assert passed.returncode == 0, passed.stdout[-3000:] + passed.stderr[-3000:]
+    assert passed.stdout.count("PASS n=") == 2, passed.stdout[-3000:]

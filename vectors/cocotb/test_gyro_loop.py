@@ -7,10 +7,11 @@ clocks after the edge that takes the sample; `ce` every 4th clock at most); `rat
 
 import cocotb
 
-import gyrofx_cocotb as tb
+import gyrofx.cocotb as tb
 
-# Clocks after the edge that takes a sample before its outputs show (the RTL's pipeline).
-OUTPUT_CLOCKS = 3
+# The DUT's pipeline: the reference RTL's (gyrofx writes this package's values), or your RTL's
+# through GYROFX_COCOTB_LATENCY_CLOCKS / GYROFX_COCOTB_MIN_CLOCKS_PER_SAMPLE.
+TIMING = tb.Timing(latency_clocks=4, min_clocks_per_sample=4)
 INPUTS = ["adc_x", "adc_y", "mode"]
 
 
@@ -21,7 +22,7 @@ async def step(dut, loop, stream, registered, k, adc, mode):
     want = loop.step(adc[0], adc[1], mode)
     if want["out_valid"]:
         stream.expect([want["rate"], want["quadrature"]])
-    await tb.take_and_wait(dut, OUTPUT_CLOCKS)
+    await tb.take_and_wait(dut, TIMING.output_clocks)
     dac = [tb.signed(dut.dac_x), tb.signed(dut.dac_y)]
     registered.check(
         [want["dac_x"], want["dac_y"], want["locked"]],

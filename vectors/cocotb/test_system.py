@@ -9,10 +9,11 @@ wherever `out_valid` is 1 (any latency)."""
 
 import cocotb
 
-import gyrofx_cocotb as tb
+import gyrofx.cocotb as tb
 
-# Clocks after the edge that takes a sample before all its outputs show (the RTL's pipeline).
-OUTPUT_CLOCKS = 9
+# The DUT's pipeline: the reference RTL's (gyrofx writes this package's values), or your RTL's
+# through GYROFX_COCOTB_LATENCY_CLOCKS / GYROFX_COCOTB_MIN_CLOCKS_PER_SAMPLE.
+TIMING = tb.Timing(latency_clocks=10, min_clocks_per_sample=10)
 ADC_PORTS = ["adc_a_x", "adc_a_y", "adc_b_x", "adc_b_y"]
 REGISTERED = ["dac_a_x", "dac_a_y", "dac_b_x", "dac_b_y", "locked_a", "locked_b", "mode_a", "mode_b",
               "bias_a", "bias_b", "estimated"]
@@ -48,7 +49,7 @@ async def closed_around_both_resonators(dut):
         want = system.step(*adc, enable=enable, bw_sel=bw_sel)
         if want["out_valid"]:
             stream.expect([want["rate_out"]])
-        await tb.take_and_wait(dut, OUTPUT_CLOCKS)
+        await tb.take_and_wait(dut, TIMING.output_clocks)
         actual = {p: (tb.signed if p in SIGNED else tb.unsigned)(getattr(dut, p)) for p in REGISTERED}
         registered.check([want[p] for p in REGISTERED], [actual[p] for p in REGISTERED], f"sample {k}")
         adc = list(resonators[0].step(actual["dac_a_x"], actual["dac_a_y"]))

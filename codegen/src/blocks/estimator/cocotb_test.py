@@ -1,13 +1,14 @@
 """cocotb test of gyrofx_bias_estimator: the slot from the gyrofx sequencer model, random rates
-with a bias per gyro; `(bias_a, bias_b, estimated)` checked 5 clocks after the edge that takes
-each sample (the reference RTL's pipeline; `ce` every 6th clock at most)."""
+with a bias per gyro; `(bias_a, bias_b, estimated)` checked `TIMING.output_clocks` clocks after the
+edge that takes each sample (the reference RTL's 5; `ce` every 6th clock at most)."""
 
 import cocotb
 
-import gyrofx_cocotb as tb
+import gyrofx.cocotb as tb
 
-# Clocks after the edge that takes a sample before the estimates show it (the RTL's pipeline).
-OUTPUT_CLOCKS = 5
+# The DUT's pipeline: the reference RTL's (gyrofx writes this package's values), or your RTL's
+# through GYROFX_COCOTB_LATENCY_CLOCKS / GYROFX_COCOTB_MIN_CLOCKS_PER_SAMPLE.
+TIMING = tb.Timing(latency_clocks=6, min_clocks_per_sample=6)
 SLOT = ["blank_a", "blank_b", "done_a", "done_b", "interval_a", "interval_b", "window_done"]
 
 
@@ -22,7 +23,7 @@ async def run(dut, rates):
         inputs = {"y_a": y_a, "y_b": y_b, **{p: slot[p] for p in SLOT}}
         await tb.drive(dut, inputs)
         expected = estimator.step(*(inputs[p] for p in ["y_a", "y_b"] + SLOT))
-        await tb.take_and_wait(dut, OUTPUT_CLOCKS)
+        await tb.take_and_wait(dut, TIMING.output_clocks)
         actual = [tb.signed(dut.bias_a), tb.signed(dut.bias_b), tb.unsigned(dut.estimated)]
         scoreboard.check(expected, actual, f"sample {k}")
         await tb.idle(dut, rng.choice([0, 0, 0, 1]))

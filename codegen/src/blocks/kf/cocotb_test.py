@@ -3,11 +3,11 @@ model wherever `out_valid` is 1 (any latency)."""
 
 import cocotb
 
-import gyrofx_cocotb as tb
+import gyrofx.cocotb as tb
 
-# Idle clocks the KF's pipeline needs after the edge that takes a sample (`ce` every 3rd clock
-# at most).
-PIPELINE_CLOCKS = 2
+# The DUT's pipeline: the reference RTL's (gyrofx writes this package's values), or your RTL's
+# through GYROFX_COCOTB_LATENCY_CLOCKS / GYROFX_COCOTB_MIN_CLOCKS_PER_SAMPLE.
+TIMING = tb.Timing(latency_clocks=4, min_clocks_per_sample=3)
 
 
 async def run(dut, stimulus):
@@ -23,7 +23,7 @@ async def run(dut, stimulus):
             kf.reset()
         await tb.drive(dut, {"z": z, "bw_sel": bw_sel})
         scoreboard.expect([kf.step(z, bw_sel)])
-        await tb.take(dut, PIPELINE_CLOCKS + rng.choice([0, 0, 0, 1, 2]))
+        await tb.take(dut, TIMING.idle_clocks + rng.choice([0, 0, 0, 1, 2]))
     await tb.reset(dut, [scoreboard])
     tb.finish([scoreboard])
 

@@ -3,11 +3,12 @@
 
 import cocotb
 
-import gyrofx_cocotb as tb
+import gyrofx.cocotb as tb
 
-# Idle clocks after each sample at the fastest spacing (gyrofx sets it from the block: 0 for
-# gyrofx_mean_filter, the latency for the sequential gyrofx_mean_filter_serial).
-PIPELINE_CLOCKS = 0
+# The DUT's pipeline (gyrofx writes the block's: every clock for gyrofx_mean_filter, its latency
+# for the sequential gyrofx_mean_filter_serial), or your RTL's through
+# GYROFX_COCOTB_LATENCY_CLOCKS / GYROFX_COCOTB_MIN_CLOCKS_PER_SAMPLE.
+TIMING = tb.Timing(latency_clocks=1, min_clocks_per_sample=1)
 
 
 async def run(dut, stimulus):
@@ -24,7 +25,7 @@ async def run(dut, stimulus):
         out = model.step(x)
         if out is not None:
             scoreboard.expect(out)
-        await tb.take(dut, PIPELINE_CLOCKS + rng.choice([0, 0, 1, 3]))
+        await tb.take(dut, TIMING.idle_clocks + rng.choice([0, 0, 1, 3]))
     await tb.reset(dut, [scoreboard])
     tb.finish([scoreboard])
 

@@ -1,16 +1,16 @@
 """cocotb test of the chain (gyrofx_top, or gyrofx_top_serial with architecture = "serial":
 sequencer, estimator, calibration, KF): `rate_out` checked against the gyrofx chain model
 wherever `out_valid` is 1 (any latency); the modes before each clock edge and the bias ports
-OUTPUT_CLOCKS clocks after the edge that takes each sample (the RTL's latency; `ce` one clock
+`TIMING.output_clocks` clocks after the edge that takes each sample (the RTL's latency; `ce` one clock
 later at the earliest)."""
 
 import cocotb
 
-import gyrofx_cocotb as tb
+import gyrofx.cocotb as tb
 
-# Clocks after the edge that takes a sample before the estimates show it (the RTL's latency;
-# gyrofx writes this package's value).
-OUTPUT_CLOCKS = 5
+# The DUT's pipeline: the reference RTL's (gyrofx writes this package's values), or your RTL's
+# through GYROFX_COCOTB_LATENCY_CLOCKS / GYROFX_COCOTB_MIN_CLOCKS_PER_SAMPLE.
+TIMING = tb.Timing(latency_clocks=6, min_clocks_per_sample=6)
 
 
 @cocotb.test()
@@ -46,7 +46,7 @@ async def two_gyros_under_mode_reversal(dut):
         )
         if want["out_valid"]:
             rate_out.expect([want["rate_out"]])
-        await tb.take_and_wait(dut, OUTPUT_CLOCKS)
+        await tb.take_and_wait(dut, TIMING.output_clocks)
         registered.check(
             [want["bias_a"], want["bias_b"], want["estimated"]],
             [tb.signed(dut.bias_a), tb.signed(dut.bias_b), tb.unsigned(dut.estimated)],
