@@ -7,8 +7,18 @@ or ``numpy.int64`` exactly as the RTL ports carry them; real values are °/s.
     >>> import gyrofx
     >>> plan = gyrofx.Plan.default()
     >>> kf = plan.kf()
-    >>> z = gyrofx.quantize([0.5, 0.25], plan.formats()["kf.input"])
-    >>> rate = kf.process(z)
+    >>> fmt = gyrofx.Format(plan.formats()["kf.input"])
+    >>> fmt, fmt.width, fmt.fraction, fmt.max_code, fmt.lsb
+    (Format('s24.14'), 24, 14, 8388607, 6.103515625e-05)
+    >>> z = gyrofx.quantize([0.5, 0.25], fmt)
+    >>> gyrofx.quantize([1e9, 0.5], fmt, gyrofx.Rounding.FLOOR, "saturate", counts=True)
+    (array([8388607,    8192]), 1)
+    >>> out = kf.process(z)
+    >>> sorted(out)
+    ['out_valid', 'rate_out']
+    >>> kf.reset()
+    >>> kf.step(int(z[0]))["rate_out"] == int(out["rate_out"][0])
+    True
 """
 
 from ._gyrofx import (
@@ -16,6 +26,7 @@ from ._gyrofx import (
     ChainFloat,
     Estimator,
     EstimatorFloat,
+    Format,
     GyroLoop,
     GyroLoopFloat,
     GyrofxError,
@@ -23,8 +34,10 @@ from ._gyrofx import (
     KfFloat,
     MeanFilter,
     MeanFilterFloat,
+    Overflow,
     Plan,
     Resonator,
+    Rounding,
     Sequencer,
     System,
     SystemFloat,
@@ -38,6 +51,7 @@ __all__ = [
     "ChainFloat",
     "Estimator",
     "EstimatorFloat",
+    "Format",
     "GyroLoop",
     "GyroLoopFloat",
     "GyrofxError",
@@ -45,8 +59,10 @@ __all__ = [
     "KfFloat",
     "MeanFilter",
     "MeanFilterFloat",
+    "Overflow",
     "Plan",
     "Resonator",
+    "Rounding",
     "Sequencer",
     "System",
     "SystemFloat",

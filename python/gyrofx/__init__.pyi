@@ -6,7 +6,7 @@ reverse. Real values are °/s. Every refused input raises ``GyrofxError``.
 """
 
 from os import PathLike
-from typing import Dict, List, Optional, Tuple, Union, final
+from typing import ClassVar, Dict, List, Literal, Optional, Tuple, TypedDict, Union, final, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -16,6 +16,7 @@ __all__ = [
     "ChainFloat",
     "Estimator",
     "EstimatorFloat",
+    "Format",
     "GyroLoop",
     "GyroLoopFloat",
     "GyrofxError",
@@ -23,8 +24,10 @@ __all__ = [
     "KfFloat",
     "MeanFilter",
     "MeanFilterFloat",
+    "Overflow",
     "Plan",
     "Resonator",
+    "Rounding",
     "Sequencer",
     "System",
     "SystemFloat",
@@ -39,17 +42,136 @@ _Codes = npt.NDArray[np.int64]
 _Reals = npt.NDArray[np.float64]
 _BandwidthSelect = Union[int, npt.ArrayLike]
 
+# What `step` returns: a dict of the block's output ports, named as ``ports()`` lists them
+# (``process``: the same keys, numpy arrays).
+class _KfStep(TypedDict):
+    out_valid: int
+    rate_out: int
+
+class _KfProcess(TypedDict):
+    out_valid: _Codes
+    rate_out: _Codes
+
+class _KfFloatStep(TypedDict):
+    out_valid: int
+    rate_out: float
+
+class _KfFloatProcess(TypedDict):
+    out_valid: _Codes
+    rate_out: _Reals
+
+class _EstimatorStep(TypedDict):
+    bias_a: int
+    bias_b: int
+    estimated: int
+
+class _EstimatorFloatStep(TypedDict):
+    bias_a: float
+    bias_b: float
+
+class _MeanFilterStep(TypedDict):
+    y_valid: int
+    y: int
+    kept: int
+
+class _MeanFilterFloatStep(TypedDict):
+    y_valid: int
+    y: float
+    kept: int
+
+class _ResonatorStep(TypedDict):
+    adc_x: int
+    adc_y: int
+
 class GyrofxError(ValueError):
     """A refused config, format or argument; the message is the CLI's."""
 
+@final
+class Format:
+    """A fixed-point format: ``Format("s24.14")`` or ``Format(width=24, fraction=14)``; equal to
+    its string. A code's real value is ``code * lsb``."""
+
+    def __new__(
+        cls,
+        text: Optional[str] = None,
+        *,
+        width: Optional[int] = None,
+        fraction: Optional[int] = None,
+        signed: bool = True,
+    ) -> Format: ...
+    @property
+    def width(self) -> int: ...
+    @property
+    def fraction(self) -> int: ...
+    @property
+    def signed(self) -> bool: ...
+    @property
+    def min_code(self) -> int: ...
+    @property
+    def max_code(self) -> int: ...
+    @property
+    def lsb(self) -> float:
+        """2^-fraction."""
+    def to_real(self, codes: npt.ArrayLike) -> _Reals: ...
+    def quantize(
+        self,
+        values: npt.ArrayLike,
+        rounding: Union[Rounding, _RoundingName] = "nearest",
+        overflow: Union[Overflow, _OverflowName] = "saturate",
+    ) -> _Codes: ...
+    def __eq__(self, other: object, /) -> bool: ...
+    def __hash__(self) -> int: ...
+
+@final
+class Rounding:
+    """Rounding of the dropped bits; each has the config's name (``config_name``)."""
+
+    FLOOR: ClassVar[Rounding]
+    CEIL: ClassVar[Rounding]
+    ZERO: ClassVar[Rounding]
+    NEAREST: ClassVar[Rounding]
+    ROUND: ClassVar[Rounding]
+    CONVERGENT: ClassVar[Rounding]
+    @property
+    def config_name(self) -> str: ...
+
+@final
+class Overflow:
+    """What a value outside the format becomes."""
+
+    SATURATE: ClassVar[Overflow]
+    WRAP: ClassVar[Overflow]
+    @property
+    def config_name(self) -> str: ...
+
+_FormatLike = Union[Format, str]
+_RoundingName = Literal["floor", "ceil", "zero", "nearest", "round", "convergent"]
+_OverflowName = Literal["saturate", "wrap"]
+
+@overload
 def quantize(
-    values: npt.ArrayLike, fmt: str, rounding: str = "nearest", overflow: str = "saturate"
+    values: npt.ArrayLike,
+    fmt: _FormatLike,
+    rounding: Union[Rounding, _RoundingName] = "nearest",
+    overflow: Union[Overflow, _OverflowName] = "saturate",
+    *,
+    counts: Literal[False] = False,
 ) -> _Codes:
     """Real values to codes of ``fmt``. rounding: floor, ceil, zero, nearest (ties up),
     round (ties away from zero), convergent (ties to even); overflow: saturate or wrap."""
+@overload
+def quantize(
+    values: npt.ArrayLike,
+    fmt: _FormatLike,
+    rounding: Union[Rounding, _RoundingName] = "nearest",
+    overflow: Union[Overflow, _OverflowName] = "saturate",
+    *,
+    counts: Literal[True],
+) -> Tuple[_Codes, int]:
+    """``(codes, overflowed)``: also how many values did not fit ``fmt``."""
 
-def to_real(codes: npt.ArrayLike, fmt: str) -> _Reals:
-    """_Codes of ``fmt`` to real values (code · 2^-frac); codes outside ``fmt`` are refused."""
+def to_real(codes: npt.ArrayLike, fmt: _FormatLike) -> _Reals:
+    """Codes of ``fmt`` to real values (code · 2^-frac); codes outside ``fmt`` are refused."""
 
 @final
 class Plan:
@@ -108,9 +230,9 @@ class Kf:
     def ports(self) -> List[Tuple[str, str, str]]:
         """``(name, format, direction)`` of each port, as the vector files carry them."""
     def reset(self) -> None: ...
-    def step(self, z: int, bw_sel: int = 0) -> int:
-        """One step: ``z`` (input-format code) -> ``rate_out`` (output-format code)."""
-    def process(self, z: npt.ArrayLike, bw_sel: _BandwidthSelect = 0) -> _Codes: ...
+    def step(self, z: int, bw_sel: int = 0) -> _KfStep:
+        """One step: ``z`` (input-format code) -> out_valid (1) and rate_out (output-format code)."""
+    def process(self, z: npt.ArrayLike, bw_sel: _BandwidthSelect = 0) -> _KfProcess: ...
     def state(self) -> Tuple[int, int]:
         """``(x1, x2)`` as state-format codes."""
     def error_bound_lsb(self, samples: int, switches: int = 0) -> float:
@@ -121,8 +243,8 @@ class KfFloat:
     """The KF's float twin, °/s."""
 
     def reset(self) -> None: ...
-    def step(self, z: float, bw_sel: int = 0) -> float: ...
-    def process(self, z: npt.ArrayLike, bw_sel: _BandwidthSelect = 0) -> _Reals: ...
+    def step(self, z: float, bw_sel: int = 0) -> _KfFloatStep: ...
+    def process(self, z: npt.ArrayLike, bw_sel: _BandwidthSelect = 0) -> _KfFloatProcess: ...
 
 @final
 class Sequencer:
@@ -160,8 +282,8 @@ class Estimator:
         interval_a: int,
         interval_b: int,
         window_done: int,
-    ) -> Tuple[int, int, int]:
-        """``(bias_a, bias_b, estimated)`` after the clock."""
+    ) -> _EstimatorStep:
+        """bias_a, bias_b, estimated after the clock."""
     def process(
         self,
         y_a: npt.ArrayLike,
@@ -191,7 +313,7 @@ class EstimatorFloat:
         interval_a: int,
         interval_b: int,
         window_done: int,
-    ) -> Tuple[float, float]: ...
+    ) -> _EstimatorFloatStep: ...
 
 @final
 class MeanFilter:
@@ -205,8 +327,8 @@ class MeanFilter:
     input_format: str
     output_format: str
     def reset(self) -> None: ...
-    def step(self, x: int) -> Optional[Tuple[int, int]]:
-        """``(y, kept)`` on a block's last sample (y_valid), else None."""
+    def step(self, x: int) -> _MeanFilterStep:
+        """y_valid (1 on a block's last sample), y, kept (0 where y_valid is 0)."""
     def process(self, x: npt.ArrayLike) -> Dict[str, _Codes]:
         """y_valid, y, kept per input sample (y and kept 0 where y_valid is 0)."""
 
@@ -215,7 +337,7 @@ class MeanFilterFloat:
     """The mean filter's float twin, °/s."""
 
     def reset(self) -> None: ...
-    def step(self, x: float) -> Optional[Tuple[float, int]]: ...
+    def step(self, x: float) -> _MeanFilterFloatStep: ...
 
 @final
 class Chain:
@@ -240,7 +362,7 @@ class ChainFloat:
 
     def reset(self) -> None: ...
     def step(self, y_a: float, y_b: float, bw_sel: int = 0) -> Dict[str, Optional[float]]:
-        """out_valid, rate (None when the KF did not step), bias_a, bias_b."""
+        """out_valid, rate_out (None when the KF did not step), bias_a, bias_b."""
 
 _PerSample = Union[int, npt.ArrayLike]
 
@@ -324,4 +446,5 @@ class Resonator:
     def set_rate_dps(self, rate_dps: float) -> None: ...
     def set_mode(self, mode: int) -> None:
         """The pick-offs follow the loop's mode (1 normal, 0 reverse) from this sample on."""
-    def step(self, dac_x: int, dac_y: int) -> Tuple[int, int]: ...
+    def step(self, dac_x: int, dac_y: int) -> _ResonatorStep:
+        """The ADC codes adc_x, adc_y the loop reads next."""

@@ -92,9 +92,11 @@ def rng() -> random.Random:
     return random.Random(cocotb.RANDOM_SEED)
 
 
-def code_range(fmt: str) -> tuple[int, int]:
-    """The (min, max) codes of a gyrofx format string such as ``s24.14`` (signed, 24 bits) or
-    ``u8.0`` (unsigned)."""
+def code_range(fmt: gyrofx.Format | str) -> tuple[int, int]:
+    """The (min, max) codes of a ``gyrofx.Format`` or a format string such as ``s24.14``
+    (signed, 24 bits) or ``u8.0`` (unsigned)."""
+    if isinstance(fmt, gyrofx.Format):
+        return fmt.min_code, fmt.max_code
     kind = fmt[:1]
     try:
         width = int(fmt[1:].split(".")[0])

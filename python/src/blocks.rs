@@ -1,8 +1,10 @@
 //! One class per block, each the Rust model behind the block's RTL ports, and the float twins.
 //!
-//! `step` takes one clock's inputs and returns that clock's outputs as the RTL ports carry them
-//! (codes; flags 0/1; a mode 1 normal, 0 reverse); `process` does the same for whole numpy
-//! records and returns a dict of arrays, one per output port, releasing the GIL while it runs.
+//! One return shape per kind of method, for every block: `step` takes one clock's inputs and
+//! returns a dict of that clock's output ports, named as `ports()` lists them, holding codes as
+//! the RTL ports carry them (flags 0/1; a mode 1 normal, 0 reverse); `process` does the same
+//! for whole numpy records and returns a dict of arrays with the same keys, releasing the GIL
+//! while it runs. A float twin returns the same keys, its values in °/s.
 //! Inputs outside their port's format are refused, naming the port, the value and the range.
 
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
@@ -214,22 +216,24 @@ impl Kf {
         self.ports.reset();
     }
 
-    /// One step: `z` a code of the input format, `bw_sel` the ROM address; returns `rate_out`
-    /// (a code of the output format).
+    /// One step: `z` a code of the input format, `bw_sel` the ROM address; returns
+    /// `{"out_valid": 1, "rate_out": code}` (`rate_out` a code of the output format; every
+    /// sample gives one, `latency_clocks` later in the RTL).
     #[pyo3(signature = (z, bw_sel = 0))]
-    fn step(&mut self, z: i64, bw_sel: i64) -> PyResult<i64> {
-        self.ports.step(z, bw_sel).map_err(refused)
+    fn step<'py>(&mut self, py: Python<'py>, z: i64, bw_sel: i64) -> PyResult<Bound<'py, PyDict>> {
+        let rate_out = self.ports.step(z, bw_sel).map_err(refused)?;
+        value_dict(py, ["out_valid", "rate_out"], [1, rate_out])
     }
 
-    /// `step` over a record: `z` an int64 array, `bw_sel` one address or one per sample;
-    /// returns `rate_out` as an int64 array.
+    /// `step` over a record: `z` integer codes, `bw_sel` one address or one per sample;
+    /// returns a dict of `out_valid`, `rate_out` int64 arrays.
     #[pyo3(signature = (z, bw_sel = PerSample::One(0)), text_signature = "($self, z, bw_sel=0)")]
     fn process<'py>(
         &mut self,
         py: Python<'py>,
         z: Codes<'py>,
         bw_sel: PerSample<'py>,
-    ) -> PyResult<Array<'py, i64>> {
+    ) -> PyResult<Bound<'py, PyDict>> {
         let (input, depth) = (self.ports.plan().input, self.ports.plan().rom.len());
         let z = port_codes(&z, input, "z")?;
         let select = match bw_sel {
@@ -258,7 +262,7 @@ impl Kf {
             }
             out
         });
-        Ok(int_array(py, out))
+        port_dict(py, ["out_valid", "rate_out"], [vec![1; out.len()], out])
     }
 
     /// The state `[x1, x2]` as codes of the state format.
@@ -315,21 +319,25 @@ impl KfFloat {
         self.model.reset();
     }
 
-    /// One step on `z` (°/s); returns the rate estimate (°/s).
+    /// One step on `z` (°/s); returns `{"out_valid": 1, "rate_out": °/s}`.
     #[pyo3(signature = (z, bw_sel = 0))]
-    fn step(&mut self, z: f64, bw_sel: i64) -> PyResult<f64> {
+    fn step<'py>(&mut self, py: Python<'py>, z: f64, bw_sel: i64) -> PyResult<Bound<'py, PyDict>> {
         let bw_sel = check_bw_sel(bw_sel, self.rom_depth, "bw_sel").map_err(refused)?;
-        Ok(self.model.step(z, bw_sel))
+        let dict = PyDict::new(py);
+        dict.set_item("out_valid", 1)?;
+        dict.set_item("rate_out", self.model.step(z, bw_sel))?;
+        Ok(dict)
     }
 
-    /// `step` over a float64 record.
+    /// `step` over a record of real values (°/s): a dict of `out_valid` (int64) and
+    /// `rate_out` (float64) arrays.
     #[pyo3(signature = (z, bw_sel = PerSample::One(0)), text_signature = "($self, z, bw_sel=0)")]
     fn process<'py>(
         &mut self,
         py: Python<'py>,
         z: PyReadonlyArray1<'py, f64>,
         bw_sel: PerSample<'py>,
-    ) -> PyResult<Array<'py, f64>> {
+    ) -> PyResult<Bound<'py, PyDict>> {
         let z = z.as_array().to_vec();
         let select = bw_sel.per_sample(z.len(), self.rom_depth)?;
         let model = &mut self.model;
@@ -339,8 +347,27 @@ impl KfFloat {
                 .map(|(z, b)| model.step(*z, *b))
                 .collect::<Vec<_>>()
         });
-        Ok(out.into_pyarray(py))
+        let dict = PyDict::new(py);
+        dict.set_item("out_valid", int_array(py, vec![1; out.len()]))?;
+        dict.set_item("rate_out", out.into_pyarray(py))?;
+        Ok(dict)
     }
+}
+
+/// A dict of one value per port: what every `step` returns.
+pub(crate) fn value_dict<'py, T, const N: usize>(
+    py: Python<'py>,
+    names: [&str; N],
+    values: [T; N],
+) -> PyResult<Bound<'py, PyDict>>
+where
+    T: IntoPyObject<'py>,
+{
+    let dict = PyDict::new(py);
+    for (name, value) in names.into_iter().zip(values) {
+        dict.set_item(name, value)?;
+    }
+    Ok(dict)
 }
 
 /// A dict of one int64 array per port.
@@ -477,11 +504,12 @@ impl Estimator {
         self.ports.reset();
     }
 
-    /// One clock: both gyros' samples (input-format codes) and the sequencer's slot; returns
-    /// `(bias_a, bias_b, estimated)` after the clock.
+    /// One clock: both gyros' samples (input-format codes) and the sequencer's slot; returns a
+    /// dict of `bias_a`, `bias_b`, `estimated` after the clock.
     #[allow(clippy::too_many_arguments)]
-    fn step(
+    fn step<'py>(
         &mut self,
+        py: Python<'py>,
         y_a: i64,
         y_b: i64,
         blank_a: i64,
@@ -491,8 +519,8 @@ impl Estimator {
         interval_a: i64,
         interval_b: i64,
         window_done: i64,
-    ) -> PyResult<(i64, i64, i64)> {
-        let [a, b, estimated] = self
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let outputs = self
             .ports
             .step(
                 [y_a, y_b],
@@ -507,7 +535,7 @@ impl Estimator {
                 ],
             )
             .map_err(refused)?;
-        Ok((a, b, estimated))
+        value_dict(py, ESTIMATOR_OUTPUTS, outputs)
     }
 
     /// `step` over records: `y_a`, `y_b` and the seven slot ports as int64 arrays of one
@@ -613,10 +641,12 @@ impl EstimatorFloat {
         self.model.reset();
     }
 
-    /// One clock on `y_a`, `y_b` (°/s) and the slot's ports; returns `(bias_a, bias_b)` (°/s).
+    /// One clock on `y_a`, `y_b` (°/s) and the slot's ports; returns a dict of `bias_a`,
+    /// `bias_b` (°/s).
     #[allow(clippy::too_many_arguments)]
-    fn step(
+    fn step<'py>(
         &mut self,
+        py: Python<'py>,
         y_a: f64,
         y_b: f64,
         blank_a: i64,
@@ -626,7 +656,7 @@ impl EstimatorFloat {
         interval_a: i64,
         interval_b: i64,
         window_done: i64,
-    ) -> PyResult<(f64, f64)> {
+    ) -> PyResult<Bound<'py, PyDict>> {
         let slot = slot_from_ports(
             &self.schedule,
             &self.modes,
@@ -644,7 +674,7 @@ impl EstimatorFloat {
         .map_err(refused)?;
         self.model.step(&slot, [y_a, y_b]);
         let [a, b] = self.model.bias();
-        Ok((a, b))
+        value_dict(py, ["bias_a", "bias_b"], [a, b])
     }
 }
 
@@ -695,10 +725,14 @@ impl MeanFilter {
         self.ports.reset();
     }
 
-    /// One sample `x` (input-format code); returns `(y, kept)` on the block's last sample
-    /// (`y_valid`), else `None`.
-    fn step(&mut self, x: i64) -> PyResult<Option<(i64, i64)>> {
-        self.ports.step(x).map_err(refused)
+    /// One sample `x` (input-format code); returns a dict of `y_valid`, `y`, `kept`: `y_valid`
+    /// 1 on the block's last sample, else 0 with `y` and `kept` 0 (as `process` has them).
+    fn step<'py>(&mut self, py: Python<'py>, x: i64) -> PyResult<Bound<'py, PyDict>> {
+        let (valid, y, kept) = match self.ports.step(x).map_err(refused)? {
+            Some((y, kept)) => (1, y, kept),
+            None => (0, 0, 0),
+        };
+        value_dict(py, ["y_valid", "y", "kept"], [valid, y, kept])
     }
 
     /// `step` over a record: a dict of `y_valid`, `y`, `kept` int64 arrays, one entry per input
@@ -762,9 +796,18 @@ impl MeanFilterFloat {
         self.model.reset();
     }
 
-    /// One sample (°/s); `(mean, kept)` on the block's last sample, else `None`.
-    fn step(&mut self, x: f64) -> Option<(f64, u32)> {
-        self.model.step(x)
+    /// One sample (°/s); a dict of `y_valid`, `y` (the block's mean, °/s), `kept`, as
+    /// `MeanFilter.step` has them (0 where `y_valid` is 0).
+    fn step<'py>(&mut self, py: Python<'py>, x: f64) -> PyResult<Bound<'py, PyDict>> {
+        let (valid, y, kept) = match self.model.step(x) {
+            Some((y, kept)) => (1, y, kept),
+            None => (0, 0.0, 0),
+        };
+        let dict = PyDict::new(py);
+        dict.set_item("y_valid", valid)?;
+        dict.set_item("y", y)?;
+        dict.set_item("kept", kept)?;
+        Ok(dict)
     }
 }
 
@@ -909,7 +952,7 @@ impl ChainFloat {
         let sample = self.model.step([y_a, y_b], bw_sel);
         let dict = PyDict::new(py);
         dict.set_item("out_valid", i64::from(sample.rate.is_some()))?;
-        dict.set_item("rate", sample.rate)?;
+        dict.set_item("rate_out", sample.rate)?;
         dict.set_item("bias_a", sample.estimator.bias[0])?;
         dict.set_item("bias_b", sample.estimator.bias[1])?;
         Ok(dict)

@@ -7,6 +7,7 @@ use gyrofx_job::golden::check_code;
 use gyrofx_model::fx::{from_f64, Format, Overflow, Rounding};
 
 use crate::blocks::Codes;
+use crate::format::{FormatArg, OverflowArg, RoundingArg};
 use crate::refused;
 
 /// Parses a format string (`s18.14`, `u12.12`) whose codes fit `int64`.
@@ -38,50 +39,75 @@ fn real_record<'py>(values: &Bound<'py, PyAny>) -> PyResult<PyReadonlyArray1<'py
     array.extract()
 }
 
-/// Quantizes real values to codes of `fmt`.
+/// Quantizes real values to codes of `fmt` (a `Format` or its string).
 ///
-/// `rounding` is one of floor, ceil, zero, nearest, round, convergent and `overflow` one of
-/// saturate, wrap (the config's names). NaN and ±inf are refused with their index.
+/// `rounding` is a `Rounding` or one of floor, ceil, zero, nearest, round, convergent, and
+/// `overflow` an `Overflow` or saturate, wrap (the config's names). NaN and ±inf are refused
+/// with their index. With `counts=True` it returns `(codes, overflowed)`: how many values did
+/// not fit the format (saturated or wrapped).
 #[pyfunction]
-#[pyo3(signature = (values, fmt, rounding = "nearest", overflow = "saturate"))]
+#[pyo3(signature = (values, fmt, rounding = RoundingArg::Text("nearest".into()), overflow = OverflowArg::Text("saturate".into()), *, counts = false),
+       text_signature = "(values, fmt, rounding='nearest', overflow='saturate', *, counts=False)")]
 pub(crate) fn quantize<'py>(
     py: Python<'py>,
     values: Bound<'py, PyAny>,
-    fmt: &str,
-    rounding: &str,
-    overflow: &str,
-) -> PyResult<Bound<'py, PyArray1<i64>>> {
-    let format = format(fmt)?;
-    let rounding: Rounding = rounding.parse().map_err(|_| {
-        refused(format!(
-            "rounding = {rounding:?}: expected one of floor, ceil, zero, nearest, round, convergent"
-        ))
-    })?;
-    let overflow: Overflow = overflow.parse().map_err(|_| {
-        refused(format!(
-            "overflow = {overflow:?}: expected saturate or wrap"
-        ))
-    })?;
-    let values = real_record(&values)?;
+    fmt: FormatArg,
+    rounding: RoundingArg,
+    overflow: OverflowArg,
+    counts: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (codes, overflowed) = quantize_values(
+        py,
+        &values,
+        fmt.format()?,
+        rounding.mode()?,
+        overflow.mode()?,
+    )?;
+    if counts {
+        Ok((codes, overflowed).into_pyobject(py)?.into_any())
+    } else {
+        Ok(codes.into_any())
+    }
+}
+
+/// `values` quantized to `format`, and how many did not fit it.
+pub(crate) fn quantize_values<'py>(
+    py: Python<'py>,
+    values: &Bound<'py, PyAny>,
+    format: Format,
+    rounding: Rounding,
+    overflow: Overflow,
+) -> PyResult<(Bound<'py, PyArray1<i64>>, u64)> {
+    let values = real_record(values)?;
     let values = values.as_array();
     let mut codes = Vec::with_capacity(values.len());
+    let mut overflowed = 0u64;
     for (index, value) in values.iter().enumerate() {
         let quantized = from_f64(*value, format, rounding, overflow)
             .map_err(|e| refused(format!("values[{index}] = {value}: {e}")))?;
+        overflowed += u64::from(quantized.overflowed);
         codes.push(quantized.code as i64);
     }
-    Ok(codes.into_pyarray(py))
+    Ok((codes.into_pyarray(py), overflowed))
 }
 
-/// The real values (`code · 2^-frac`) of codes of `fmt`; a code outside the format is refused
-/// with its index.
+/// The real values (`code · 2^-frac`) of codes of `fmt` (a `Format` or its string); a code
+/// outside the format is refused with its index.
 #[pyfunction]
 pub(crate) fn to_real<'py>(
     py: Python<'py>,
     codes: Codes<'py>,
-    fmt: &str,
+    fmt: FormatArg,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let format = format(fmt)?;
+    codes_to_real(py, codes, fmt.format()?)
+}
+
+/// [`to_real`] on a parsed format.
+pub(crate) fn codes_to_real<'py>(
+    py: Python<'py>,
+    codes: Codes<'py>,
+    format: Format,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let codes = codes.resolve("codes")?;
     let mut values = Vec::with_capacity(codes.len());
     for (index, code) in codes.iter().enumerate() {

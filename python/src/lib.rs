@@ -12,6 +12,7 @@ use pyo3::prelude::*;
 
 mod blocks;
 mod codes;
+mod format;
 mod loops;
 mod plan;
 
@@ -47,6 +48,9 @@ fn _gyrofx(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<loops::System>()?;
     module.add_class::<loops::SystemFloat>()?;
     module.add_class::<loops::Resonator>()?;
+    module.add_class::<format::Format>()?;
+    module.add_class::<format::Rounding>()?;
+    module.add_class::<format::Overflow>()?;
     module.add_function(wrap_pyfunction!(codes::quantize, module)?)?;
     module.add_function(wrap_pyfunction!(codes::to_real, module)?)?;
     Ok(())

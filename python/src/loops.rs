@@ -452,13 +452,18 @@ impl Resonator {
         Ok(())
     }
 
-    /// One ADC sample: the DAC codes the loop drives, the ADC codes `(adc_x, adc_y)` it reads
-    /// next.
-    fn step(&mut self, dac_x: i64, dac_y: i64) -> PyResult<(i64, i64)> {
+    /// One ADC sample: the DAC codes the loop drives; returns a dict of the ADC codes
+    /// `adc_x`, `adc_y` it reads next (the loop's input ports).
+    fn step<'py>(
+        &mut self,
+        py: Python<'py>,
+        dac_x: i64,
+        dac_y: i64,
+    ) -> PyResult<Bound<'py, PyDict>> {
         check_code(dac_x, self.dac, "dac_x").map_err(refused)?;
         check_code(dac_y, self.dac, "dac_y").map_err(refused)?;
-        let [x, y] = self.model.step_codes([dac_x, dac_y]);
-        Ok((x, y))
+        let adc = self.model.step_codes([dac_x, dac_y]);
+        crate::blocks::value_dict(py, ["adc_x", "adc_y"], adc)
     }
 
     /// ADC sample rate, Hz.

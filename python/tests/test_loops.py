@@ -84,7 +84,8 @@ def test_a_loop_closed_around_the_resonator_retraces_the_vectors_run(package):
             resonator.set_mode(mode)
         assert adc == (int(row["adc_x"]), int(row["adc_y"])), f"sample {k}"
         out = loop.step(adc[0], adc[1], mode)
-        adc = resonator.step(out["dac_x"], out["dac_y"])
+        read = resonator.step(out["dac_x"], out["dac_y"])
+        adc = (read["adc_x"], read["adc_y"])
     # Another seed gives another noise record.
     other = plan.resonator("a", seed=12345)
     other.set_rate_dps(manifest_rate)
@@ -93,7 +94,8 @@ def test_a_loop_closed_around_the_resonator_retraces_the_vectors_run(package):
     for row in rows[:2000]:
         differs |= adc != (int(row["adc_x"]), int(row["adc_y"]))
         out = loop.step(adc[0], adc[1], 1)
-        adc = other.step(out["dac_x"], out["dac_y"])
+        read = other.step(out["dac_x"], out["dac_y"])
+        adc = (read["adc_x"], read["adc_y"])
     assert differs
 
 

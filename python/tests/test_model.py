@@ -25,7 +25,8 @@ def replay_kf(kf, rows):
             kf.reset()
             continue
         got = kf.step(int(row["z"]), int(row["bw_sel"]))
-        assert row["out_valid"] == "1", row
+        assert row["out_valid"] == "1" and got["out_valid"] == 1, row
+        got = got["rate_out"]
         assert got == int(row["rate_out"]), f"sample {row['sample']}: {got} != {row['rate_out']}"
         compared += 1
     return compared
@@ -83,7 +84,8 @@ def test_the_estimator_reproduces_its_vectors(package):
         if row["rst"] == "1":
             estimator.reset()
             continue
-        bias_a, bias_b, done = estimator.step(*(int(row[p]) for p in inputs))
+        got = estimator.step(*(int(row[p]) for p in inputs))
+        bias_a, bias_b, done = got["bias_a"], got["bias_b"], got["estimated"]
         assert (bias_a, bias_b, done) == (int(row["bias_a"]), int(row["bias_b"]), int(row["estimated"])), row
         estimated += done
     assert estimated > 0, "the record reaches an estimate"
@@ -105,10 +107,10 @@ def test_the_mean_filter_reproduces_its_vectors(package):
             continue
         got = mean_filter.step(int(row["x"]))
         if row["y_valid"] == "1":
-            assert got == (int(row["y"]), int(row["kept"])), row
+            assert got == {"y_valid": 1, "y": int(row["y"]), "kept": int(row["kept"])}, row
             blocks += 1
         else:
-            assert got is None, row
+            assert got == {"y_valid": 0, "y": 0, "kept": 0}, row
     assert blocks > 10
 
 
@@ -132,10 +134,10 @@ def test_the_chain_and_its_float_twin_reproduce_the_top_vectors(package):
         float_sample = twin.step(float(y_real[0]), float(y_real[1]), int(row["bw_sel"]))
         if row["float_rate_dps"]:
             # The CSV prints the shortest round-trip text: equal as doubles.
-            assert float_sample["rate"] == float(row["float_rate_dps"]), row
+            assert float_sample["rate_out"] == float(row["float_rate_dps"]), row
             valid += 1
         else:
-            assert float_sample["rate"] is None
+            assert float_sample["rate_out"] is None
     assert valid > 100
     # process() over the same stimulus: the same port streams.
     body = leading_run(rows)
@@ -156,8 +158,8 @@ def test_the_kf_stays_within_its_derived_bound_of_the_float_twin():
     rng = np.random.default_rng(7)
     samples = 20_000
     z = gyrofx.quantize(rng.normal(5.0, 30.0, samples), fmt_in)
-    fixed = gyrofx.to_real(kf.process(z, 2), fmt_out)
-    real = twin.process(gyrofx.to_real(z, fmt_in), 2)
+    fixed = gyrofx.to_real(kf.process(z, 2)["rate_out"], fmt_out)
+    real = twin.process(gyrofx.to_real(z, fmt_in), 2)["rate_out"]
     lsb = 2.0 ** -int(fmt_out.split(".")[1])
     worst = np.max(np.abs(fixed - real)) / lsb
     bound = kf.error_bound_lsb(samples)
@@ -170,15 +172,17 @@ def test_process_equals_step_for_the_kf_and_mean_filter():
     z = gyrofx.quantize(rng.normal(0.0, 50.0, 3000), plan.kf().input_format)
     select = rng.integers(0, len(plan.bandwidths_hz), z.size)
     stepped = plan.kf()
-    assert list(plan.kf().process(z, select)) == [stepped.step(int(a), int(b)) for a, b in zip(z, select)]
+    out = plan.kf().process(z, select)
+    steps = [stepped.step(int(a), int(b)) for a, b in zip(z, select)]
+    assert set(out) == set(steps[0]) == {"out_valid", "rate_out"}
+    for port in out:
+        assert list(out[port]) == [s[port] for s in steps], port
     mean = plan.mean_filter()
     x = gyrofx.quantize(rng.normal(0.0, 50.0, 3000), mean.input_format)
     out = plan.mean_filter().process(x)
     for i, code in enumerate(x):
         got = mean.step(int(code))
-        assert (got is not None) == bool(out["y_valid"][i])
-        if got is not None:
-            assert got == (out["y"][i], out["kept"][i])
+        assert got == {port: out[port][i] for port in ("y_valid", "y", "kept")}, i
 
 
 def exact_quantize(value, frac, width, rounding, overflow):
@@ -320,17 +324,17 @@ def test_every_block_class_lists_the_manifests_ports(package):
 def test_records_of_any_integer_dtype_and_lists_are_accepted_and_others_refused_by_name():
     kf = gyrofx.Plan.default().kf()
     codes = np.array([5, -7, 1200, 0, -3000, 42], dtype=np.int64)
-    want = kf.process(codes)
+    want = kf.process(codes)["rate_out"]
     kf.reset()
     for record in (codes.tolist(), codes.astype(np.int32), codes.astype(">i8"), codes[::-1][::-1].copy()):
         kf.reset()
-        assert np.array_equal(kf.process(record), want), type(record)
+        assert np.array_equal(kf.process(record)["rate_out"], want), type(record)
     small = np.array([0, 1, 200, 255], dtype=np.uint8)
     kf.reset()
-    via_uint8 = kf.process(small)
+    via_uint8 = kf.process(small)["rate_out"]
     kf.reset()
-    assert np.array_equal(via_uint8, kf.process(small.astype(np.int64)))
-    assert len(kf.process([])) == 0
+    assert np.array_equal(via_uint8, kf.process(small.astype(np.int64))["rate_out"])
+    assert len(kf.process([])["rate_out"]) == 0
     for record, message in (
         (codes.astype(np.float64), "z: an array of float64; allowed: a one-dimensional record of integer codes"),
         (codes.reshape(2, 3), "z: 2 dimensions; allowed"),
@@ -340,9 +344,9 @@ def test_records_of_any_integer_dtype_and_lists_are_accepted_and_others_refused_
             kf.process(record)
     # bw_sel per sample takes the same records.
     kf.reset()
-    both = kf.process(codes, bw_sel=[0, 1, 2, 0, 1, 2])
+    both = kf.process(codes, bw_sel=[0, 1, 2, 0, 1, 2])["rate_out"]
     kf.reset()
-    assert np.array_equal(both, kf.process(codes, bw_sel=np.array([0, 1, 2, 0, 1, 2], dtype=np.uint8)))
+    assert np.array_equal(both, kf.process(codes, bw_sel=np.array([0, 1, 2, 0, 1, 2], dtype=np.uint8))["rate_out"])
     assert np.array_equal(gyrofx.to_real([1, -2], "s4.1"), gyrofx.to_real(np.array([1, -2]), "s4.1"))
 
 
@@ -378,8 +382,99 @@ def test_the_wheel_installs_into_a_clean_virtualenv_without_rust(tmp_path):
             environment[name] = os.environ[name]
     subprocess.run([str(venv / "bin" / "pip"), "install", "-q", wheels[-1]], check=True, env=environment)
     script = ("import shutil, gyrofx; assert shutil.which('cargo') is None; "
-              "kf = gyrofx.Plan.default().kf(); print(kf.latency_clocks, kf.process([0, 1000, -1000]).tolist())")
+              "kf = gyrofx.Plan.default().kf(); print(kf.latency_clocks, kf.process([0, 1000, -1000])['rate_out'].tolist())")
     shown = subprocess.run([str(venv / "bin" / "python"), "-c", script], check=True, env=environment,
                            capture_output=True, text=True).stdout.split(" ", 1)
     kf = gyrofx.Plan.default().kf()
-    assert shown == ["4", f"{kf.process([0, 1000, -1000]).tolist()}\n"]
+    assert shown == ["4", f"{kf.process([0, 1000, -1000])['rate_out'].tolist()}\n"]
+
+
+def test_every_step_returns_its_output_ports_and_process_the_same_keys():
+    # One return shape per kind of method: step a dict keyed by the block's output ports,
+    # process the same keys (arrays), a float twin a subset of them.
+    plan = gyrofx.Plan.default()
+    slot_ports = ["blank_a", "blank_b", "done_a", "done_b", "interval_a", "interval_b", "window_done"]
+    slot = plan.sequencer().step()
+    estimator_inputs = [0, 0] + [slot[p] for p in slot_ports]
+    cases = [
+        (plan.kf(), (0,), ([0, 1],), (plan.kf_float(), (0.0,))),
+        (plan.sequencer(), (), (2,), None),
+        (plan.estimator(), estimator_inputs, [[v] for v in estimator_inputs],
+         (plan.estimator_float(), [0.0, 0.0] + estimator_inputs[2:])),
+        (plan.mean_filter(), (0,), ([0, 1],), (plan.mean_filter_float(), (0.0,))),
+        (plan.chain(), (0, 0), ([0], [0]), (plan.chain_float(), (0.0, 0.0))),
+        (plan.gyro_loop(), (0, 0, 1), ([0], [0]), (plan.gyro_loop_float(), (0.0, 0.0, 1))),
+        (plan.system(), (0, 0, 0, 0), ([0], [0], [0], [0]), (plan.system_float(), (0.0, 0.0, 0.0, 0.0))),
+    ]
+    for block, step_inputs, process_inputs, twin in cases:
+        outputs = {name for name, _, direction in block.ports() if direction == "out"}
+        name = type(block).__name__
+        assert set(block.step(*step_inputs)) == outputs, name
+        processed = block.process(*process_inputs)
+        assert set(processed) == outputs, name
+        assert all(isinstance(v, np.ndarray) for v in processed.values()), name
+        if twin is not None:
+            model, inputs = twin
+            assert set(model.step(*inputs)) <= outputs, type(model).__name__
+    loop_inputs = {name for name, _, direction in plan.gyro_loop().ports() if direction == "in"}
+    assert set(plan.resonator("a").step(0, 0)) == {"adc_x", "adc_y"} <= loop_inputs
+
+
+def test_mypy_refuses_what_fails_at_run_time(tmp_path):
+    # The stubs type each step's dict: a misspelt port or a tuple unpacking of a dict is a type
+    # error before it is a KeyError or a ValueError at run time.
+    import mypy.api
+
+    good = tmp_path / "good.py"
+    good.write_text(
+        "import gyrofx\n"
+        "plan = gyrofx.Plan.default()\n"
+        "rate: int = plan.kf().step(0)['rate_out']\n"
+        "adc = plan.resonator('a').step(0, 0)\n"
+        "x: int = adc['adc_x']\n"
+    )
+    out, _, status = mypy.api.run(["--strict", "--no-incremental", str(good)])
+    assert status == 0, out
+    for bad, message in (
+        ("rate = gyrofx.Plan.default().kf().step(0)['rate']\n", 'has no key "rate"'),
+        ("a, b, c = gyrofx.Plan.default().estimator().step(0, 0, 0, 0, 0, 0, 0, 0, 0)['bias_a']\n", "int"),
+        ("gyrofx.quantize([0.5], 's24.14', rounding='nearset')\n", 'No overload variant of "quantize"'),
+    ):
+        path = tmp_path / "bad.py"
+        path.write_text("import gyrofx\n" + bad)
+        out, _, status = mypy.api.run(["--no-incremental", str(path)])
+        assert status != 0 and message in out, (bad, out)
+
+
+def test_format_rounding_and_overflow_objects_and_overflow_counts():
+    fmt = gyrofx.Format("s8.4")
+    assert (fmt.width, fmt.fraction, fmt.signed, fmt.min_code, fmt.max_code, fmt.lsb) == (8, 4, True, -128, 127, 1 / 16)
+    assert fmt == "s8.4" and fmt == gyrofx.Format(width=8, fraction=4) and fmt != "s8.3"
+    assert hash(fmt) == hash("s8.4") and repr(fmt) == "Format('s8.4')" and str(fmt) == "s8.4"
+    unsigned = gyrofx.Format(width=4, fraction=0, signed=False)
+    assert (str(unsigned), unsigned.min_code, unsigned.max_code) == ("u4.0", 0, 15)
+    values = [0.03125, -0.03125, 100.0, -100.0, 1.5]
+    # Enums and the config's strings are the same modes, for quantize and Format.quantize.
+    for rounding in ("floor", "ceil", "zero", "nearest", "round", "convergent"):
+        enum = getattr(gyrofx.Rounding, rounding.upper())
+        assert enum.config_name == rounding
+        for overflow in ("saturate", "wrap"):
+            by_name = gyrofx.quantize(values, "s8.4", rounding, overflow)
+            by_enum = gyrofx.quantize(values, fmt, enum, getattr(gyrofx.Overflow, overflow.upper()))
+            assert np.array_equal(by_name, by_enum) and np.array_equal(by_name, fmt.quantize(values, enum, overflow))
+    # Two of the five values do not fit s8.4 (±100): counted, saturated or wrapped.
+    codes, overflowed = gyrofx.quantize(values, fmt, counts=True)
+    assert overflowed == 2 and list(codes) == [1, 0, 127, -128, 24]
+    codes, overflowed = gyrofx.quantize(values, fmt, overflow=gyrofx.Overflow.WRAP, counts=True)
+    assert overflowed == 2 and list(codes[2:4]) == [(1600 + 128) % 256 - 128, (-1600 + 128) % 256 - 128]
+    assert gyrofx.quantize([0.5], fmt, counts=True)[1] == 0
+    assert np.array_equal(fmt.to_real([16, -8]), gyrofx.to_real([16, -8], "s8.4"))
+    for call, message in (
+        (lambda: gyrofx.Format("q8.4"), 'format "q8.4"'),
+        (lambda: gyrofx.Format(width=0, fraction=0), "width=0"),
+        (lambda: gyrofx.Format(), "give a string"),
+        (lambda: gyrofx.quantize([0.5], fmt, "nearset"), 'rounding = "nearset"'),
+        (lambda: gyrofx.quantize([0.5], fmt, overflow="clip"), 'overflow = "clip"'),
+    ):
+        with pytest.raises(gyrofx.GyrofxError, match=message):
+            call()

@@ -53,7 +53,8 @@ async def closed_around_the_resonator(dut):
             mode = 0
             resonator.set_mode(mode)
         want, dac = await step(dut, loop, stream, registered, k, adc, mode)
-        adc = resonator.step(dac[0], dac[1])
+        read = resonator.step(dac[0], dac[1])
+        adc = (read["adc_x"], read["adc_y"])
     await tb.reset(dut, [stream])
     tb.finish([stream, registered])
 

@@ -22,7 +22,7 @@ async def run(dut, stimulus):
             await tb.reset(dut, [scoreboard])
             kf.reset()
         await tb.drive(dut, {"z": z, "bw_sel": bw_sel})
-        scoreboard.expect([kf.step(z, bw_sel)])
+        scoreboard.expect([kf.step(z, bw_sel)["rate_out"]])
         await tb.take(dut, TIMING.idle_clocks + rng.choice([0, 0, 0, 1, 2]))
     await tb.reset(dut, [scoreboard])
     tb.finish([scoreboard])

@@ -51,8 +51,9 @@ async def closed_around_both_resonators(dut):
         await tb.take_and_wait(dut, TIMING.output_clocks)
         actual = {p: (tb.signed if p in SIGNED else tb.unsigned)(getattr(dut, p)) for p in REGISTERED}
         registered.check([want[p] for p in REGISTERED], [actual[p] for p in REGISTERED], f"sample {k}")
-        adc = list(resonators[0].step(actual["dac_a_x"], actual["dac_a_y"]))
-        adc += list(resonators[1].step(actual["dac_b_x"], actual["dac_b_y"]))
+        read = [resonators[0].step(actual["dac_a_x"], actual["dac_a_y"]),
+                resonators[1].step(actual["dac_b_x"], actual["dac_b_y"])]
+        adc = [r[port] for r in read for port in ("adc_x", "adc_y")]
     assert want["estimated"] == 1, "the run covers a whole estimator window"
     await tb.reset(dut, [stream])
     tb.finish([stream, registered])
