@@ -115,6 +115,11 @@ impl FixedSystem {
     pub fn chain(&self) -> &FixedChain {
         &self.chain
     }
+
+    /// Gyro A's and B's loops (their overflow counts).
+    pub fn loops(&self) -> &[FixedGyroLoop; 2] {
+        &self.loops
+    }
 }
 
 /// What one ADC sample of the float system gives.

@@ -229,6 +229,8 @@ class Kf:
     min_clocks_per_sample: int
     def ports(self) -> List[Tuple[str, str, str]]:
         """``(name, format, direction)`` of each port, as the vector files carry them."""
+    def overflow_counts(self) -> Dict[str, int]:
+        """Saturations and wraps per quantization point since it was made (a reset keeps them)."""
     def reset(self) -> None: ...
     def step(self, z: int, bw_sel: int = 0) -> _KfStep:
         """One step: ``z`` (input-format code) -> out_valid (1) and rate_out (output-format code)."""
@@ -254,6 +256,8 @@ class Sequencer:
     min_clocks_per_sample: int
     def ports(self) -> List[Tuple[str, str, str]]:
         """``(name, format, direction)`` of each port, as the vector files carry them."""
+    def overflow_counts(self) -> Dict[str, int]:
+        """Saturations and wraps per quantization point since it was made (a reset keeps them)."""
     def reset(self) -> None: ...
     def step(self) -> Dict[str, int]:
         """mode_a, mode_b, blank_a, blank_b, interval_a, interval_b, done_a, done_b,
@@ -268,6 +272,8 @@ class Estimator:
     min_clocks_per_sample: int
     def ports(self) -> List[Tuple[str, str, str]]:
         """``(name, format, direction)`` of each port, as the vector files carry them."""
+    def overflow_counts(self) -> Dict[str, int]:
+        """Saturations and wraps per quantization point since it was made (a reset keeps them)."""
     input_format: str
     bias_format: str
     def reset(self) -> None: ...
@@ -323,6 +329,8 @@ class MeanFilter:
     min_clocks_per_sample: int
     def ports(self) -> List[Tuple[str, str, str]]:
         """``(name, format, direction)`` of each port, as the vector files carry them."""
+    def overflow_counts(self) -> Dict[str, int]:
+        """Saturations and wraps per quantization point since it was made (a reset keeps them)."""
     window: int
     input_format: str
     output_format: str
@@ -347,6 +355,8 @@ class Chain:
     min_clocks_per_sample: int
     def ports(self) -> List[Tuple[str, str, str]]:
         """``(name, format, direction)`` of each port, as the vector files carry them."""
+    def overflow_counts(self) -> Dict[str, int]:
+        """Saturations and wraps per quantization point since it was made (a reset keeps them)."""
     def reset(self) -> None: ...
     def next_modes(self) -> Tuple[int, int]:
         """The modes the next step runs in (what a plant needs first)."""
@@ -376,6 +386,8 @@ class GyroLoop:
     min_clocks_per_sample: int
     def ports(self) -> List[Tuple[str, str, str]]:
         """``(name, format, direction)`` of each port, as the vector files carry them."""
+    def overflow_counts(self) -> Dict[str, int]:
+        """Saturations and wraps per quantization point since it was made (a reset keeps them)."""
     adc_rate_hz: float
     decimation: int
     adc_format: str
@@ -405,6 +417,8 @@ class System:
     min_clocks_per_sample: int
     def ports(self) -> List[Tuple[str, str, str]]:
         """``(name, format, direction)`` of each port, as the vector files carry them."""
+    def overflow_counts(self) -> Dict[str, int]:
+        """Saturations and wraps per quantization point since it was made (a reset keeps them)."""
     decimation: int
     window: int
     def reset(self) -> None: ...

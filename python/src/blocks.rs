@@ -187,6 +187,17 @@ impl Kf {
 
 #[pymethods]
 impl Kf {
+    /// Saturations and wraps per quantization point since it was made (a reset keeps them):
+    /// a dict of counts, e.g. `{"x1": 0, "x2": 0, "rate_out": 3}` for the KF; empty for a block
+    /// that cannot overflow.
+    fn overflow_counts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        crate::blocks::overflow_dict(py, self.ports.overflows())
+    }
+
+    fn __repr__(&self) -> String {
+        crate::blocks::block_repr("Kf", &self.ports.ports())
+    }
+
     /// Its ports as the vector files carry them (after `rst`; inputs, then outputs): a list of
     /// `(name, format, direction)`, e.g. `("z", "s24.14", "in")`.
     fn ports(&self) -> Vec<(&'static str, String, &'static str)> {
@@ -354,6 +365,32 @@ impl KfFloat {
     }
 }
 
+/// `overflows` as a dict, in the model's order.
+pub(crate) fn overflow_dict(
+    py: Python<'_>,
+    overflows: golden::Overflows,
+) -> PyResult<Bound<'_, PyDict>> {
+    let dict = PyDict::new(py);
+    for (point, count) in overflows {
+        dict.set_item(point, count)?;
+    }
+    Ok(dict)
+}
+
+/// `Kf(z: s24.14, bw_sel: u2.0 -> out_valid: u1.0, rate_out: s24.14)`: a block's ports and
+/// their formats.
+pub(crate) fn block_repr(name: &str, ports: &[golden::ports::Port]) -> String {
+    let list = |output: bool| {
+        ports
+            .iter()
+            .filter(|p| p.output == output)
+            .map(|p| format!("{}: {}", p.name, p.format))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    format!("{name}({} -> {})", list(false), list(true))
+}
+
 /// A dict of one value per port: what every `step` returns.
 pub(crate) fn value_dict<'py, T, const N: usize>(
     py: Python<'py>,
@@ -402,6 +439,17 @@ impl Sequencer {
 
 #[pymethods]
 impl Sequencer {
+    /// Saturations and wraps per quantization point since it was made (a reset keeps them):
+    /// a dict of counts, e.g. `{"x1": 0, "x2": 0, "rate_out": 3}` for the KF; empty for a block
+    /// that cannot overflow.
+    fn overflow_counts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        crate::blocks::overflow_dict(py, self.ports.overflows())
+    }
+
+    fn __repr__(&self) -> String {
+        crate::blocks::block_repr("Sequencer", &self.ports.ports())
+    }
+
     /// Its ports as the vector files carry them (after `rst`; inputs, then outputs): a list of
     /// `(name, format, direction)`, e.g. `("z", "s24.14", "in")`.
     fn ports(&self) -> Vec<(&'static str, String, &'static str)> {
@@ -475,6 +523,17 @@ impl Estimator {
 
 #[pymethods]
 impl Estimator {
+    /// Saturations and wraps per quantization point since it was made (a reset keeps them):
+    /// a dict of counts, e.g. `{"x1": 0, "x2": 0, "rate_out": 3}` for the KF; empty for a block
+    /// that cannot overflow.
+    fn overflow_counts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        crate::blocks::overflow_dict(py, self.ports.overflows())
+    }
+
+    fn __repr__(&self) -> String {
+        crate::blocks::block_repr("Estimator", &self.ports.ports())
+    }
+
     /// Its ports as the vector files carry them (after `rst`; inputs, then outputs): a list of
     /// `(name, format, direction)`, e.g. `("z", "s24.14", "in")`.
     fn ports(&self) -> Vec<(&'static str, String, &'static str)> {
@@ -696,6 +755,17 @@ impl MeanFilter {
 
 #[pymethods]
 impl MeanFilter {
+    /// Saturations and wraps per quantization point since it was made (a reset keeps them):
+    /// a dict of counts, e.g. `{"x1": 0, "x2": 0, "rate_out": 3}` for the KF; empty for a block
+    /// that cannot overflow.
+    fn overflow_counts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        crate::blocks::overflow_dict(py, self.ports.overflows())
+    }
+
+    fn __repr__(&self) -> String {
+        crate::blocks::block_repr("MeanFilter", &self.ports.ports())
+    }
+
     /// Its ports as the vector files carry them (after `rst`; inputs, then outputs): a list of
     /// `(name, format, direction)`, e.g. `("z", "s24.14", "in")`.
     fn ports(&self) -> Vec<(&'static str, String, &'static str)> {
@@ -829,6 +899,17 @@ impl Chain {
 
 #[pymethods]
 impl Chain {
+    /// Saturations and wraps per quantization point since it was made (a reset keeps them):
+    /// a dict of counts, e.g. `{"x1": 0, "x2": 0, "rate_out": 3}` for the KF; empty for a block
+    /// that cannot overflow.
+    fn overflow_counts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        crate::blocks::overflow_dict(py, self.ports.overflows())
+    }
+
+    fn __repr__(&self) -> String {
+        crate::blocks::block_repr("Chain", &self.ports.ports())
+    }
+
     /// Its ports as the vector files carry them (after `rst`; inputs, then outputs): a list of
     /// `(name, format, direction)`, e.g. `("z", "s24.14", "in")`.
     fn ports(&self) -> Vec<(&'static str, String, &'static str)> {

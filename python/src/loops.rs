@@ -38,6 +38,17 @@ impl GyroLoop {
 
 #[pymethods]
 impl GyroLoop {
+    /// Saturations and wraps per quantization point since it was made (a reset keeps them):
+    /// a dict of counts, e.g. `{"x1": 0, "x2": 0, "rate_out": 3}` for the KF; empty for a block
+    /// that cannot overflow.
+    fn overflow_counts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        crate::blocks::overflow_dict(py, self.ports.overflows())
+    }
+
+    fn __repr__(&self) -> String {
+        crate::blocks::block_repr("GyroLoop", &self.ports.ports())
+    }
+
     /// Its ports as the vector files carry them (after `rst`; inputs, then outputs): a list of
     /// `(name, format, direction)`, e.g. `("z", "s24.14", "in")`.
     fn ports(&self) -> Vec<(&'static str, String, &'static str)> {
@@ -214,6 +225,17 @@ impl System {
 
 #[pymethods]
 impl System {
+    /// Saturations and wraps per quantization point since it was made (a reset keeps them):
+    /// a dict of counts, e.g. `{"x1": 0, "x2": 0, "rate_out": 3}` for the KF; empty for a block
+    /// that cannot overflow.
+    fn overflow_counts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        crate::blocks::overflow_dict(py, self.ports.overflows())
+    }
+
+    fn __repr__(&self) -> String {
+        crate::blocks::block_repr("System", &self.ports.ports())
+    }
+
     /// Its ports as the vector files carry them (after `rst`; inputs, then outputs): a list of
     /// `(name, format, direction)`, e.g. `("z", "s24.14", "in")`.
     fn ports(&self) -> Vec<(&'static str, String, &'static str)> {

@@ -478,3 +478,31 @@ def test_format_rounding_and_overflow_objects_and_overflow_counts():
     ):
         with pytest.raises(gyrofx.GyrofxError, match=message):
             call()
+
+
+def test_blocks_count_their_overflows_and_show_their_ports():
+    plan = gyrofx.Plan.default()
+    kf = plan.kf()
+    assert kf.overflow_counts() == {"x1": 0, "x2": 0, "rate_out": 0}
+    assert repr(kf) == "Kf(" + ", ".join(f"{n}: {f}" for n, f, d in kf.ports() if d == "in") + " -> " + \
+        ", ".join(f"{n}: {f}" for n, f, d in kf.ports() if d == "out") + ")"
+    # A KF fed full scale long enough to saturate: the state or output quantizers count it, a
+    # reset keeps the counts, and the step's outputs are the saturated codes.
+    small = gyrofx.Plan.from_toml('[kf]\noutput_format = "s16.12"\n').kf()
+    full_scale = gyrofx.Format(small.input_format).max_code
+    for _ in range(4000):
+        out = small.step(full_scale)
+    assert out["rate_out"] == gyrofx.Format(small.output_format).max_code
+    counts = small.overflow_counts()
+    assert sum(counts.values()) > 0, counts
+    small.reset()
+    assert small.overflow_counts() == counts
+    # Every block names its points; the chain and the system by their parts.
+    assert set(plan.estimator().overflow_counts()) == {
+        "mean_a", "mean_b", "bias_a", "bias_b", "calibrated_a", "calibrated_b", "combined"}
+    chain = plan.chain().overflow_counts()
+    assert {"kf.x1", "kf.rate_out", "estimator.combined"} <= set(chain)
+    system = plan.system().overflow_counts()
+    assert set(chain) <= set(system) and any(k.startswith("a.") for k in system) and any(k.startswith("b.") for k in system)
+    assert set(plan.gyro_loop().overflow_counts()) == {k[2:] for k in system if k.startswith("a.")}
+    assert plan.sequencer().overflow_counts() == {} and plan.mean_filter().overflow_counts() == {}

@@ -69,6 +69,11 @@ pub struct Estimator {
 }
 
 impl Estimator {
+    /// Saturations and wraps per quantization point since it was made ([`Overflows`]).
+    pub fn overflows(&self) -> super::Overflows {
+        super::overflows::estimator(&self.model)
+    }
+
     /// Its ports as the vector files carry them ([`super::ports`]).
     pub fn ports(&self) -> Vec<super::ports::Port> {
         super::ports::estimator(&self.plan)

@@ -26,6 +26,11 @@ pub struct GyroLoop {
 }
 
 impl GyroLoop {
+    /// Saturations and wraps per quantization point since it was made ([`Overflows`]).
+    pub fn overflows(&self) -> super::Overflows {
+        super::overflows::gyro_loop(&self.model)
+    }
+
     /// Its ports as the vector files carry them ([`super::ports`]).
     pub fn ports(&self) -> Vec<super::ports::Port> {
         super::ports::gyro_loop(&self.plan)

@@ -12,6 +12,11 @@ pub struct Kf {
 }
 
 impl Kf {
+    /// Saturations and wraps per quantization point since it was made ([`Overflows`]).
+    pub fn overflows(&self) -> super::Overflows {
+        super::overflows::kf(&self.model)
+    }
+
     /// Its ports as the vector files carry them ([`super::ports`]).
     pub fn ports(&self) -> Vec<super::ports::Port> {
         super::ports::kf(&self.plan)

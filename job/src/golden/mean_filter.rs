@@ -13,6 +13,11 @@ pub struct MeanFilter {
 }
 
 impl MeanFilter {
+    /// Saturations and wraps per quantization point since it was made ([`Overflows`]).
+    pub fn overflows(&self) -> super::Overflows {
+        Vec::new()
+    }
+
     /// Its ports as the vector files carry them ([`super::ports`]).
     pub fn ports(&self) -> Vec<super::ports::Port> {
         super::ports::mean_filter(&self.plan)

@@ -12,6 +12,7 @@ mod estimator;
 mod gyro_loop;
 mod kf;
 mod mean_filter;
+mod overflows;
 pub mod ports;
 mod sequencer;
 mod system;
@@ -21,6 +22,7 @@ pub use estimator::{slot_from_ports, Estimator, ESTIMATOR_OUTPUTS, ESTIMATOR_SLO
 pub use gyro_loop::{GyroLoop, GYRO_LOOP_OUTPUTS};
 pub use kf::Kf;
 pub use mean_filter::MeanFilter;
+pub use overflows::Overflows;
 pub use sequencer::{slot_codes, Sequencer, SLOT_PORTS};
 pub use system::{System, NO_SYSTEM, SYSTEM_ADC_PORTS, SYSTEM_OUTPUTS};
 pub use top::{Chain, CHAIN_OUTPUTS};

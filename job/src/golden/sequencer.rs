@@ -42,6 +42,11 @@ pub struct Sequencer {
 }
 
 impl Sequencer {
+    /// Saturations and wraps per quantization point since it was made ([`Overflows`]).
+    pub fn overflows(&self) -> super::Overflows {
+        Vec::new()
+    }
+
     /// Its ports as the vector files carry them ([`super::ports`]).
     pub fn ports(&self) -> Vec<super::ports::Port> {
         super::ports::sequencer(self.interval_bits)

@@ -41,6 +41,19 @@ pub struct System {
 }
 
 impl System {
+    /// Saturations and wraps per quantization point since it was made ([`Overflows`]).
+    pub fn overflows(&self) -> super::Overflows {
+        let mut out = Vec::new();
+        for (prefix, gyro) in ["a.", "b."].into_iter().zip(self.model.loops()) {
+            out.extend(super::overflows::prefixed(
+                prefix,
+                super::overflows::gyro_loop(gyro),
+            ));
+        }
+        out.extend(super::overflows::chain(self.model.chain()));
+        out
+    }
+
     /// Its ports as the vector files carry them ([`super::ports`]).
     pub fn ports(&self) -> Vec<super::ports::Port> {
         super::ports::system(&self.loops[0], &self.chain)

@@ -23,6 +23,11 @@ pub struct Chain {
 }
 
 impl Chain {
+    /// Saturations and wraps per quantization point since it was made ([`Overflows`]).
+    pub fn overflows(&self) -> super::Overflows {
+        super::overflows::chain(&self.model)
+    }
+
     /// Its ports as the vector files carry them ([`super::ports`]).
     pub fn ports(&self) -> Vec<super::ports::Port> {
         super::ports::chain(&self.plan)
