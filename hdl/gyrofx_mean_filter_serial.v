@@ -295,6 +295,19 @@ assign y = y_reg;
 assign kept = kept_reg;
 assign y_valid = valid_reg;
 
+`ifndef SYNTHESIS
+// Simulation only (yosys defines SYNTHESIS): a ce while the previous block is still being
+// processed would overwrite the RAM it reads; stop the simulation instead, naming this
+// instance. The next block may start LATENCY clocks after a block's last ce
+// (gyrofx_job::pipeline, the manifest's min_clocks_per_sample).
+always @(posedge clk) begin
+    if (take && state != IDLE) begin
+        $display("FAIL %m: a sample while the previous block is being processed; gyrofx_mean_filter_serial takes the next block's first sample at most every min_clocks_per_sample clocks after a block's last (manifest.json)");
+        $fatal(1, "%m: a sample while busy");
+    end
+end
+`endif
+
 endmodule
 
 `resetall

@@ -351,4 +351,20 @@ begin
     kept <= kept_reg;
     y_valid <= valid_reg;
 
+    -- pragma translate_off
+    -- Simulation only: a ce while the previous block is still being processed would overwrite
+    -- the RAM it reads; stop the simulation instead, naming this instance (the next block may
+    -- start min_clocks_per_sample clocks after a block's last ce, gyrofx_job::pipeline).
+    spacing_check : process (clk)
+    begin
+        if rising_edge(clk) then
+            assert not (take = '1' and state /= IDLE)
+                report spacing_check'path_name & ": a sample while the previous block is being processed; "
+                    & "gyrofx_mean_filter_serial takes the next block's first sample at most every "
+                    & "min_clocks_per_sample clocks after a block's last (manifest.json)"
+                severity failure;
+        end if;
+    end process;
+    -- pragma translate_on
+
 end architecture;

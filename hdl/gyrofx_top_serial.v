@@ -112,6 +112,19 @@ gyrofx_serial_engine #(
     .estimated(estimated), .busy(busy)
 );
 
+`ifndef SYNTHESIS
+// Simulation only (yosys defines SYNTHESIS): a ce while the engine still runs the previous
+// sample's program would be dropped (take is low), and the vectors would lose a sample without
+// a word; stop the simulation instead, naming this instance. gyrofx_job::pipeline gives the
+// spacing (the manifest's min_clocks_per_sample).
+always @(posedge clk) begin
+    if (!rst && ce && busy) begin
+        $display("FAIL %m: a sample while the engine still runs the previous one; gyrofx_top_serial takes one at most every min_clocks_per_sample clocks (manifest.json)");
+        $fatal(1, "%m: a sample while busy");
+    end
+end
+`endif
+
 endmodule
 
 `resetall

@@ -129,4 +129,19 @@ begin
     mode_a <= mode_a_now;
     mode_b <= mode_b_now;
 
+    -- pragma translate_off
+    -- Simulation only: a ce while the engine still runs the previous sample's program would
+    -- be dropped (take is low); stop the simulation instead, naming this instance
+    -- (gyrofx_job::pipeline gives the spacing, the manifest's min_clocks_per_sample).
+    spacing_check : process (clk)
+    begin
+        if rising_edge(clk) then
+            assert not (rst = '0' and ce = '1' and busy = '1')
+                report spacing_check'path_name & ": a sample while the engine still runs the previous one; "
+                    & "gyrofx_top_serial takes one at most every min_clocks_per_sample clocks (manifest.json)"
+                severity failure;
+        end if;
+    end process;
+    -- pragma translate_on
+
 end architecture;

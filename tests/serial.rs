@@ -237,3 +237,76 @@ fn other_windows_formats_and_modes_run_bit_exact_in_the_serial_mean_filter() {
         );
     }
 }
+
+/// The serial variants stop a simulation that feeds them too fast, as the pipelined blocks do
+/// (a simulation-only check in both languages): the serial top's and the serial mean filter's
+/// testbenches, made to wait one clock less than `min_clocks_per_sample` between samples (the
+/// mean filter: between blocks), stop naming the instance in Icarus, Verilator and GHDL instead
+/// of running on to mismatches; untouched, they pass.
+#[test]
+fn the_serial_variants_fed_one_clock_too_soon_stop_the_simulation() {
+    use gyrofx_lab::simulate::{self, Options, Simulator};
+    let dir = tempfile::tempdir().unwrap();
+    let out = generate(
+        dir.path(),
+        "samples = 300\narchitecture = \"serial\"\n[sequencer]\ninterval_length = 60\nblank = 30\n",
+    );
+    let out = std::path::Path::new(&out);
+    let manifest = manifest(out.to_str().unwrap());
+    let cases = [
+        (
+            "top",
+            "gyrofx_top_serial",
+            manifest["chain"]["min_clocks_per_sample"].as_u64().unwrap(),
+            "a sample while the engine still runs the previous one",
+        ),
+        (
+            "mean_filter",
+            "gyrofx_mean_filter_serial",
+            manifest["mean_filter"]["min_clocks_per_sample"]
+                .as_u64()
+                .unwrap(),
+            "a sample while the previous block is being processed",
+        ),
+    ];
+    for (block, module, spacing, message) in cases {
+        let only = Options {
+            blocks: Some(vec![block.to_string()]),
+            ..Options::default()
+        };
+        assert!(simulate::run(out, Simulator::Icarus, &only)
+            .unwrap()
+            .passed());
+        let settle = spacing - 1;
+        for (file, waits, sooner) in [
+            (
+                format!("tb_{module}.v"),
+                format!("repeat ({settle}) @(negedge clk);"),
+                format!("repeat ({}) @(negedge clk);", settle - 1),
+            ),
+            (
+                format!("tb_{module}.vhd"),
+                format!("for settle in 1 to {settle} loop"),
+                format!("for settle in 1 to {} loop", settle - 1),
+            ),
+        ] {
+            let path = out.join(block).join(&file);
+            let text = std::fs::read_to_string(&path).unwrap();
+            assert!(text.contains(&waits), "{file} waits {settle} clocks");
+            std::fs::write(&path, text.replace(&waits, &sooner)).unwrap();
+        }
+        for simulator in [Simulator::Icarus, Simulator::Verilator, Simulator::Ghdl] {
+            let outcome = simulate::run(out, simulator, &only).unwrap();
+            let log = &outcome.blocks[0].log;
+            assert!(!outcome.passed(), "{module} {simulator:?}: {log}");
+            assert!(
+                log.contains(message) && log.contains("dut"),
+                "{module} {simulator:?}: {log}"
+            );
+            assert!(
+                !log.contains("FAIL mismatches="),
+                "{module} {simulator:?} ran on: {log}"
+            );
+        }
+    }
+}
