@@ -16,7 +16,10 @@ use commands::{
 #[command(
     name = "gyrofx",
     version,
-    about = "Bit-accurate fixed-point model, vector and testbench generator for a MEMS-gyro FPGA signal chain"
+    about = "Bit-accurate fixed-point model, vector and testbench generator for a MEMS-gyro FPGA signal chain",
+    // Help wraps at 100 columns on any terminal, as the reference page has it.
+    term_width = 100,
+    max_term_width = 100
 )]
 struct Cli {
     #[command(subcommand)]

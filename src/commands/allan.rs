@@ -12,8 +12,10 @@ use gyrofx_model::analysis::{allan, noise};
 use super::options::SampleRate;
 use super::usage;
 
-/// Allan deviation of rate records (°/s) with 1σ confidence intervals, and the five noise
-/// terms fitted to it.
+/// Allan deviation of rate records and the five noise terms fitted to it.
+///
+/// Rates in °/s; each deviation with its 1σ confidence interval, the noise type per τ, and the
+/// terms (Q, N, B, K, R) in IEEE-952 and Kalibr units.
 #[derive(clap::Args)]
 pub struct Args {
     /// CSV file(s) with a header line; `#` lines are skipped (gyrofx's CSVs work as is).
@@ -219,7 +221,7 @@ struct Series<'a> {
 }
 
 impl Series<'_> {
-    /// The JSON object of `--json` (the README's fields).
+    /// The JSON object of `--json` (the fields the guide's noise-analysis page lists).
     fn json(&self) -> serde_json::Value {
         let points = &self.analysis.points;
         serde_json::json!({

@@ -8,8 +8,9 @@ use gyrofx_model::analysis::ar;
 
 use super::options::CsvColumn;
 
-/// AR(1..p) models of a record by Yule–Walker (Levinson–Durbin), each with its AIC, and the
-/// order AIC picks (paper 003).
+/// AR(1..p) models of a record and the order AIC picks (paper 003).
+///
+/// Fitted by Yule–Walker (Levinson–Durbin): each order's coefficients, σ_a² and AIC.
 // The CSV flags are the shared ones, worded for AR; without a trailing period, as clap shows a
 // one-sentence doc comment.
 #[derive(clap::Args)]

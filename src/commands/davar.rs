@@ -12,8 +12,10 @@ use gyrofx_model::analysis::davar::{coefficients, davar_reporting, disturbances,
 
 use super::options::{CsvColumn, SampleRate};
 
-/// Dynamic Allan deviation: the ADEV of a window sliding along the record, fixed or
-/// PID-adapted (paper 002), with the noise coefficients over time and the disturbances.
+/// Dynamic Allan deviation of a record: noise over time (paper 002).
+///
+/// The ADEV of a window sliding along the record, fixed or PID-adapted, with the noise
+/// coefficients over time and the disturbances found.
 #[derive(clap::Args)]
 pub struct Args {
     #[command(flatten)]

@@ -14,7 +14,9 @@ use gyrofx_lab::explore::{
 use super::options::{count, ConfigSource, OutputFolder};
 use super::usage;
 
-/// Sweep word lengths: for each candidate, the chain's fixed-versus-float error (rms and max,
+/// Sweep word lengths: error, noise share, overflows and FPGA cost per candidate.
+///
+/// Sweeps word lengths: for each candidate, the chain's fixed-versus-float error (rms and max,
 /// in output LSB and °/s), the quantization noise's share of the output's Allan deviation at
 /// τ = 1 s (σ of fixed − float over σ of the float output) and of the sensor's ARW (the error's
 /// σ(1 s)·√1 s, in °/√h, over kf.arw_deg_per_sqrt_h), the chain's overflows on the run's data,

@@ -13,7 +13,9 @@ use super::usage;
 use gyrofx_codegen::output_folder;
 use gyrofx_job::formats::{analyse, fractions_for};
 
-/// Prove the formats: for any input inside the ADC's range, the range of every analysed
+/// Prove the formats: which quantization points can overflow, and the bits that prevent it.
+///
+/// For any input inside the ADC's range, the range of every analysed
 /// quantization point (worst-case peak gain of the linear blocks, interval arithmetic, the
 /// rounding errors' worst case), the integer bits that make overflow impossible, and whether
 /// the configured format has them. `--strict` exits 1 when a configured format can overflow.

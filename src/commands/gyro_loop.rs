@@ -18,7 +18,9 @@ use gyrofx_model::gyro_loop::trace::{switch_trace, TraceSpec};
 use super::options::ConfigSource;
 use super::usage;
 
-/// Run both gyros' closed loops (resonator physics, NCO, PLL, AGC, sense demodulation, CIC,
+/// Run both gyros' closed loops in both modes and print their figures beside SPEC 1.6's.
+///
+/// Runs both gyros' closed loops (resonator physics, NCO, PLL, AGC, sense demodulation, CIC,
 /// 1/SF) in normal and reverse mode at a constant rate and print, per gyro and mode, the
 /// locked drive frequency, drive amplitude, scale factor, bias (the chain's sign convention),
 /// quadrature and settling after a switch beside SPEC 1.6's closed forms, the residual bias

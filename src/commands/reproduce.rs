@@ -11,8 +11,10 @@ use super::usage;
 use gyrofx_codegen::output_folder;
 use gyrofx_lab::reproduce;
 
-/// Run a paper's pipeline on simulated data and print its tables beside gyrofx's, with
-/// the differences explained (markdown): 000, 002, 003, 004.
+/// Reproduce a paper's tables (000, 002, 003, 004) beside gyrofx's.
+///
+/// Runs the paper's pipeline on simulated data and prints its tables beside gyrofx's, with the
+/// differences measured and explained (markdown).
 #[derive(clap::Args)]
 pub struct Args {
     /// The paper: 000, 002, 003 or 004.

@@ -13,7 +13,9 @@ use gyrofx_lab::synth::synthesize;
 
 use super::options::{ConfigSource, OutputFolder};
 
-/// Synthesize the chain with the config's widths in yosys (generic and Xilinx 7-series):
+/// Synthesize the chain and the loop in yosys, and place and route them.
+///
+/// Synthesizes the chain with the config's widths in yosys (generic and Xilinx 7-series):
 /// fails on a latch, an undriven or multiply-driven net or a missing module; writes the
 /// resource report, scripts and logs atomically.
 #[derive(clap::Args)]
