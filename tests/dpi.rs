@@ -416,4 +416,32 @@ fn the_installed_library_builds_a_c_program_through_pkg_config() {
         .unwrap();
     assert!(ran.status.success(), "{}", text(&ran));
     assert!(text(&ran).contains("pipeline kf 4 3"), "{}", text(&ran));
+
+    // The README's and examples/c's program, built the same way: it prints the Rust model's
+    // code for the same sample, and the refusal of a code outside the input format.
+    let example = dir.path().join("kf_step");
+    let built = Command::new("gcc")
+        .args(["-std=c99", "-Wall", "-Werror"])
+        .arg(repository().join("examples/c/kf_step.c"))
+        .args(flags.split_whitespace())
+        .arg("-o")
+        .arg(&example)
+        .output()
+        .unwrap();
+    assert!(built.status.success(), "{}", text(&built));
+    let ran = Command::new(&example)
+        .env("LD_LIBRARY_PATH", prefix.join("lib"))
+        .output()
+        .unwrap();
+    let job = gyrofx_job::job::Job::new(gyrofx_job::config::Config::embedded()).unwrap();
+    let want = gyrofx_job::golden::Kf::new(&job.chain.kf)
+        .step(1000, 0)
+        .unwrap();
+    let log = text(&ran);
+    assert!(ran.status.success(), "{log}");
+    assert!(log.contains(&format!("rate_out = {want}\n")), "{log}");
+    assert!(
+        log.contains("refused: z = 1099511627776 is not a code of"),
+        "{log}"
+    );
 }

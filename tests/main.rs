@@ -6,6 +6,7 @@ mod common;
 mod analysis;
 mod bad_input;
 mod blocks;
+mod docs;
 mod dpi;
 mod end_to_end;
 mod explore;

@@ -13,6 +13,26 @@
 //! `gyrofx_last_error()` then holds the message (the CLI's, naming the port or config field,
 //! the value and what is allowed), valid until the thread's next failing call. Nothing here
 //! panics across the boundary; a handle is used by one thread at a time.
+//!
+//! The calls as C makes them (here from Rust, as the crate's `rlib`):
+//!
+//! ```
+//! use gyrofx_capi::*;
+//!
+//! let plan = gyrofx_plan_default();
+//! let kf = unsafe { gyrofx_kf_new(plan) };
+//! let mut rate_out = 0i64;
+//! assert_eq!(unsafe { gyrofx_kf_step(kf, 1000, 0, &mut rate_out) }, 0);
+//! assert_eq!(unsafe { gyrofx_kf_step(kf, 1 << 40, 0, &mut rate_out) }, -1); // refused
+//! let mut message = [0 as std::ffi::c_char; 128];
+//! unsafe { gyrofx_last_error_copy(message.as_mut_ptr(), message.len() as i32) };
+//! let text = unsafe { std::ffi::CStr::from_ptr(message.as_ptr()) }.to_string_lossy();
+//! assert!(text.starts_with("z = 1099511627776 is not a code of"));
+//! unsafe {
+//!     gyrofx_kf_free(kf);
+//!     gyrofx_plan_free(plan);
+//! }
+//! ```
 
 #![allow(unsafe_code)]
 

@@ -7,6 +7,16 @@
 //! [`vectors`] (one run of the chain, cut into every registered block's [`block::Block`] by
 //! its module in [`blocks`]) → [`writers`] and
 //! [`testbench`] → [`package::Package`], written atomically by [`generate::generate`].
+//!
+//! The blocks a default package holds, as the registry lists them:
+//!
+//! ```
+//! use gyrofx_job::{config::Config, job::Job};
+//!
+//! let job = Job::new(Config::embedded()).unwrap();
+//! let names: Vec<&str> = gyrofx_codegen::blocks::of(&job).map(|block| block.name()).collect();
+//! assert!(names.contains(&"kf") && names.contains(&"gyro_loop"));
+//! ```
 #![warn(missing_docs)]
 
 pub mod block;

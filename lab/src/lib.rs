@@ -9,6 +9,13 @@
 //!
 //! It stands on codegen, the job and the model, and nothing below it knows it exists: the CLI
 //! is its only user.
+//!
+//! Work runs side by side in the one pool, results in item order:
+//!
+//! ```
+//! let squares = gyrofx_lab::pool::map(&[1, 2, 3, 4], 2, |x| x * x);
+//! assert_eq!(squares, [1, 4, 9, 16]);
+//! ```
 #![warn(missing_docs)]
 
 pub mod explore;

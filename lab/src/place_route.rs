@@ -948,7 +948,7 @@ pub fn table(placements: &[Placement]) -> String {
 }
 
 /// The place-and-route page of the synthesis package (`place_and_route.md`): the table and the
-/// critical paths, what the README's hardware table is copied from.
+/// critical paths, what the guide's place-and-route table is copied from.
 pub fn page(placements: &[Placement], provenance_line: &str) -> String {
     format!(
         "{provenance_line}\n# Place and route\n\n{}\nCritical paths:\n\n{}",

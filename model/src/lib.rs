@@ -3,6 +3,20 @@
 //!
 //! Data flows one way: a config is resolved into a *plan* (every node's format, every ROM's
 //! contents), and both the models here and the writers in `gyrofx-codegen` read that plan.
+//!
+//! Every quantization point goes through [`fx`]: a real value or a wider code into a format,
+//! with the RTL's rounding and overflow.
+//!
+//! ```
+//! use gyrofx_model::fx::{from_f64, Format, Overflow, Rounding};
+//!
+//! let format: Format = "s8.4".parse().unwrap(); // signed, 8-bit word, 4 fraction bits
+//! let q = from_f64(1.53, format, Rounding::Nearest, Overflow::Saturate).unwrap();
+//! assert_eq!(q.code, 24); // 1.53 · 16 = 24.48 → 24, i.e. 1.5
+//! assert!(!q.overflowed);
+//! let big = from_f64(100.0, format, Rounding::Nearest, Overflow::Saturate).unwrap();
+//! assert_eq!((big.code, big.overflowed), (127, true)); // saturated, and counted
+//! ```
 #![warn(missing_docs)]
 
 pub mod analysis;

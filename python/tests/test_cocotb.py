@@ -210,3 +210,23 @@ def test_your_own_rtl_one_stage_longer(package, tmp_path):
     passed = run("kf")
     assert passed.returncode == 0, passed.stdout[-3000:] + passed.stderr[-3000:]
     assert passed.stdout.count("PASS n=") == 2, passed.stdout[-3000:]
+
+
+def test_the_cocotb_example_of_the_guide_passes_and_catches_a_flipped_bit(tmp_path):
+    # examples/cocotb_kf: a user's own cocotb test with the model as its scoreboard, on the
+    # KF of a package, through cocotb's Python runner.
+    folder = tmp_path / "pkg"
+    run_cli("generate", "--out", str(folder), "--samples", "500", "--blocks", "kf", "--quiet")
+    example = pathlib.Path(__file__).resolve().parents[2] / "examples" / "cocotb_kf"
+
+    def run(**extra):
+        return subprocess.run(
+            [sys.executable, "-m", "pytest", "-s", "-p", "no:cacheprovider", str(example)],
+            capture_output=True, text=True, env=environment(GYROFX_PACKAGE=str(folder), **extra),
+        )
+
+    passed = run()
+    assert passed.returncode == 0, passed.stdout[-3000:] + passed.stderr[-3000:]
+    assert "PASS n=600" in passed.stdout
+    failed = run(GYROFX_COCOTB_FLIP_EXPECTED="10")
+    assert failed.returncode != 0 and "FAIL mismatches=1 n=600" in failed.stdout, failed.stdout[-3000:]
