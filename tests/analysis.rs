@@ -620,3 +620,73 @@ fn reproduce_paper_004_compares_its_table_2() {
     let log = fails(&["reproduce", "--paper", "004", "--samples", "100"]);
     assert!(log.contains("--samples 100 is too few"), "{log}");
 }
+
+/// A one-column CSV needs no `--column` in any command that reads one column; a file of
+/// several columns, none `rate_dps`, is refused with exit 2 naming them, and nothing written.
+#[test]
+fn a_one_column_record_needs_no_column_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut n: u64 = 42;
+    let mut one = String::from("gyro_z\n");
+    let mut three = String::from("t,gyro_x,gyro_z\n");
+    for k in 0..3000 {
+        n = 16807 * n % 2_147_483_647;
+        let value = n as f64 / 2_147_483_647.0 - 0.5;
+        one.push_str(&format!("{value}\n"));
+        three.push_str(&format!("{k},{},{value}\n", -value));
+    }
+    let one_path = dir.path().join("one.csv");
+    let three_path = dir.path().join("three.csv");
+    std::fs::write(&one_path, one).unwrap();
+    std::fs::write(&three_path, three).unwrap();
+    let (one, three) = (one_path.to_str().unwrap(), three_path.to_str().unwrap());
+    let allan_one = ok(&["allan", "--input", one, "--rate", "100", "--json"]);
+    let allan_named = ok(&[
+        "allan", "--input", three, "--column", "gyro_z", "--rate", "100", "--json",
+    ]);
+    let adev =
+        |text: &str| serde_json::from_str::<serde_json::Value>(text).unwrap()["adev"].clone();
+    assert_eq!(
+        adev(&allan_one),
+        adev(&allan_named),
+        "the same column, the same deviation"
+    );
+    ok(&[
+        "davar", "--input", one, "--rate", "100", "--window", "500", "--step", "500", "--json",
+    ]);
+    ok(&["ar", "--input", one, "--max-order", "2"]);
+    let filtered = dir.path().join("filtered.csv");
+    ok(&[
+        "filter",
+        "--input",
+        one,
+        "--fs",
+        "200",
+        "--output",
+        filtered.to_str().unwrap(),
+    ]);
+    assert!(filtered.is_file());
+    std::fs::remove_file(&filtered).unwrap();
+    for command in [
+        vec!["allan", "--input", three, "--rate", "100"],
+        vec!["ar", "--input", three],
+        vec![
+            "filter",
+            "--input",
+            three,
+            "--fs",
+            "200",
+            "--output",
+            filtered.to_str().unwrap(),
+        ],
+    ] {
+        let output = gyrofx(&command);
+        let log = text(&output);
+        assert_eq!(output.status.code(), Some(2), "{command:?}: {log}");
+        assert!(
+            log.contains("--column is needed: the file has 3 columns (t, gyro_x, gyro_z)"),
+            "{command:?}: {log}"
+        );
+    }
+    assert!(!filtered.exists(), "nothing written");
+}

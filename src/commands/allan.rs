@@ -21,8 +21,9 @@ pub struct Args {
     /// CSV file(s) with a header line; `#` lines are skipped (gyrofx's CSVs work as is).
     #[arg(long, required = true)]
     input: Vec<PathBuf>,
-    /// Column(s) of rates in °/s; each input × column is one series.
-    #[arg(long, default_value = "rate_dps")]
+    /// Column(s) of rates in °/s; each input × column is one series [default: each file's only
+    /// column, else rate_dps].
+    #[arg(long)]
     column: Vec<String>,
     #[command(flatten)]
     rate: SampleRate,
@@ -75,7 +76,12 @@ pub fn run(args: Args) -> Result<ExitCode> {
     let mut results = Vec::new();
     let mut curves = Vec::new();
     for path in &inputs {
-        for column in &columns {
+        let path_columns = if columns.is_empty() {
+            vec![super::options::default_column(path)?]
+        } else {
+            columns.clone()
+        };
+        for column in &path_columns {
             let (values, skipped) = read_series(path, column, grid, json)?;
             let analysis = analyse(&values, rate, kind, grid, path, quiet);
             let series = Series {

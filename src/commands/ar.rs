@@ -37,7 +37,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
         max_order,
         json,
     } = args;
-    let column = &csv.column;
+    let column = &csv.column()?;
     let (values, skipped) = csv.read_with_gaps()?;
     if let Some(note) = super::options::gaps_note(&csv.input, column, skipped) {
         eprintln!("{note}");

@@ -83,13 +83,14 @@ pub fn run(args: Args) -> Result<ExitCode> {
             usage!("{name} {g} is not allowed: a PID gain is a finite number");
         }
     }
+    let column = csv.column()?;
     let (values, skipped) = csv.read_with_gaps()?;
-    if let Some(note) = super::options::gaps_note(&csv.input, &csv.column, skipped) {
+    if let Some(note) = super::options::gaps_note(&csv.input, &column, skipped) {
         eprintln!("{note}");
     }
     // Beyond these the fixed-point sums overflow, or the squares underflow to zero deviations.
     gyrofx_model::analysis::check_magnitudes(&values)
-        .map_err(|e| anyhow::anyhow!("{}, column {}: {e}", csv.input.display(), csv.column))?;
+        .map_err(|e| anyhow::anyhow!("{}, column {column}: {e}", csv.input.display()))?;
     if window < 4 || window > values.len() {
         usage!(
             "--window {window} is not allowed: it must be 4..={} samples (the record's length)",
@@ -134,7 +135,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
     if json {
         let value = serde_json::json!({
             "input": csv.input.display().to_string(),
-            "column": csv.column,
+            "column": column,
             "samples": values.len(),
             "skipped_empty_cells": skipped,
             "rate_hz": rate,

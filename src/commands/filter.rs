@@ -90,7 +90,7 @@ fn filter_provenance(job: &Job, csv: &CsvColumn, fs: f64, bandwidth: Option<f64>
     let mut command = format!(
         "gyrofx filter --input {} --column {} --fs {fs}",
         csv.input.display(),
-        csv.column
+        csv.column().unwrap_or_default()
     );
     if let Some(bw) = bandwidth {
         command.push_str(&format!(" --bandwidth {bw}"));
@@ -181,7 +181,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
     if let (Some((job, provenance, package)), Some(folder)) = (kf_vectors, &vectors) {
         let recording = serde_json::json!({
             "input": csv.input.display().to_string(),
-            "column": csv.column,
+            "column": csv.column()?,
             "sha256": gyrofx_job::hash::file_sha256(&csv.input)?,
             "samples": values.len(),
             "fs_hz": fs,

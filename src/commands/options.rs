@@ -14,7 +14,7 @@ use gyrofx_codegen::generate::{provenance, Output};
 use gyrofx_codegen::output_folder::Replace;
 use gyrofx_codegen::text::Provenance;
 use gyrofx_job::config::{Config, MAX_SAMPLES, MAX_SEED, PRESETS};
-use gyrofx_job::input::{read_column, read_column_with_gaps};
+use gyrofx_job::input::{read_column, read_column_with_gaps, read_header};
 use gyrofx_job::job::Job;
 use gyrofx_model::analysis::{MAX_RATE_HZ, MIN_RATE_HZ};
 
@@ -25,22 +25,48 @@ pub struct CsvColumn {
     /// CSV file with a header line.
     #[arg(long)]
     pub input: PathBuf,
-    /// Column of rates in °/s.
-    #[arg(long, default_value = "rate_dps")]
-    pub column: String,
+    /// Column of rates in °/s [default: the file's only column, else rate_dps].
+    #[arg(long)]
+    pub column: Option<String>,
 }
 
 impl CsvColumn {
+    /// The column read: `--column`, else [`default_column`].
+    pub fn column(&self) -> Result<String> {
+        match &self.column {
+            Some(column) => Ok(column.clone()),
+            None => default_column(&self.input),
+        }
+    }
+
     /// The column's values; an empty cell is an error.
     pub fn read(&self) -> Result<Vec<f64>> {
-        Ok(read_column(&self.input, &self.column)?)
+        Ok(read_column(&self.input, &self.column()?)?)
     }
 
     /// The column's values without its gaps (empty cells, blank rows), and how many rows were
     /// skipped for one.
     pub fn read_with_gaps(&self) -> Result<(Vec<f64>, usize)> {
-        Ok(read_column_with_gaps(&self.input, &self.column)?)
+        Ok(read_column_with_gaps(&self.input, &self.column()?)?)
     }
+}
+
+/// The column a command reads from `path` when `--column` is not given: the file's only
+/// column, else `rate_dps` (gyrofx's own records), else a usage error naming the columns.
+pub fn default_column(path: &std::path::Path) -> Result<String> {
+    let header = read_header(path)?;
+    if let [only] = header.as_slice() {
+        return Ok(only.clone());
+    }
+    if header.iter().any(|name| name == "rate_dps") {
+        return Ok("rate_dps".to_string());
+    }
+    usage!(
+        "{}: --column is needed: the file has {} columns ({}), none named rate_dps",
+        path.display(),
+        header.len(),
+        header.join(", ")
+    )
 }
 
 /// The note that `skipped` rows of `column` in `path` were gaps (an empty cell or a blank row)
