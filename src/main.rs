@@ -8,8 +8,8 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use commands::{
-    allan, ar, davar, design, explore, filter, formats, generate, gyro_loop, init, reproduce,
-    synth, verify,
+    allan, ar, davar, denoise, design, explore, filter, formats, generate, gyro_loop, init,
+    reproduce, synth, verify,
 };
 
 #[derive(Parser)]
@@ -32,6 +32,7 @@ enum Command {
     Allan(allan::Args),
     Ar(ar::Args),
     Davar(davar::Args),
+    Denoise(denoise::Args),
     Init(init::Args),
     Design(design::Args),
     Formats(formats::Args),
@@ -59,6 +60,7 @@ fn main() -> ExitCode {
         Command::Allan(args) => allan::run(args),
         Command::Ar(args) => ar::run(args),
         Command::Davar(args) => davar::run(args),
+        Command::Denoise(args) => denoise::run(args),
         Command::Init(args) => init::run(args),
         Command::Design(args) => design::run(args),
         Command::Formats(args) => formats::run(args),

@@ -690,3 +690,99 @@ fn a_one_column_record_needs_no_column_flag() {
     }
     assert!(!filtered.exists(), "nothing written");
 }
+
+/// `gyrofx denoise`: paper 004's denoising on a user's record. A slow sine in white noise
+/// keeps its sine and loses most of its white noise (the ADEV at the shortest τ falls, at the
+/// longest it stays); one seed gives the same bytes twice; bad settings exit 2 with nothing
+/// written.
+#[test]
+fn denoise_cleans_white_noise_off_a_record_and_refuses_bad_settings() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut n: u64 = 7;
+    let mut record = String::from("gyro_z\n");
+    for k in 0..6000 {
+        // Uniform noise of σ ≈ 0.29 from the NIST LCG over a 0.5 °/s sine of 2000 samples.
+        n = 16807 * n % 2_147_483_647;
+        let noise = n as f64 / 2_147_483_647.0 - 0.5;
+        let sine = 0.5 * (2.0 * std::f64::consts::PI * k as f64 / 2000.0).sin();
+        record.push_str(&format!("{}\n", sine + noise));
+    }
+    let input = dir.path().join("record.csv");
+    std::fs::write(&input, record).unwrap();
+    let input = input.to_str().unwrap();
+    let output = dir.path().join("denoised.csv");
+    let out = output.to_str().unwrap();
+    let settings = [
+        "--rate",
+        "100",
+        "--block",
+        "2000",
+        "--overlap",
+        "200",
+        "--realizations",
+        "10",
+    ];
+    let run = |extra: &[&str]| {
+        let mut args = vec!["denoise", "--input", input, "--output", out, "--json"];
+        args.extend_from_slice(&settings);
+        args.extend_from_slice(extra);
+        ok(&args)
+    };
+    let report: serde_json::Value = serde_json::from_str(&run(&[])).unwrap();
+    let first = std::fs::read(&output).unwrap();
+    let rows = String::from_utf8(first.clone()).unwrap();
+    assert!(rows.starts_with("sample,rate_dps,denoised_dps\n"));
+    assert_eq!(rows.lines().count(), 6001);
+    assert_eq!(report["blocks"], 3);
+    assert_eq!(report["column"], "gyro_z");
+    let adev = |which: &str, k: usize| report[which]["adev"][k].as_f64().unwrap();
+    assert!(adev("after", 0) < 0.2 * adev("before", 0), "{report}");
+    // Where the sine dominates (the largest deviation, τ near a quarter period), it is kept.
+    let count = report["before"]["adev"].as_array().unwrap().len();
+    let peak = (0..count)
+        .max_by(|a, b| adev("before", *a).total_cmp(&adev("before", *b)))
+        .unwrap();
+    assert!(
+        (adev("after", peak) / adev("before", peak) - 1.0).abs() < 0.05,
+        "{report}"
+    );
+    run(&[]);
+    assert_eq!(
+        std::fs::read(&output).unwrap(),
+        first,
+        "one seed, the same bytes"
+    );
+    std::fs::remove_file(&output).unwrap();
+    for (flag, value, message) in [
+        (
+            "--rule",
+            "medium",
+            "--rule medium is not allowed: soft or hard",
+        ),
+        ("--block", "8", "--block 8 is not allowed"),
+        (
+            "--overlap",
+            "5000",
+            "--overlap 5000 is not allowed: it must be below --block",
+        ),
+        ("--realizations", "0", "--realizations 0 is not allowed"),
+        (
+            "--noise-amplitude",
+            "-1",
+            "--noise-amplitude -1 is not allowed",
+        ),
+    ] {
+        let mut args = vec![
+            "denoise", "--input", input, "--output", out, "--rate", "100",
+        ];
+        if flag != "--overlap" {
+            args.extend_from_slice(&["--overlap", "4"]);
+        }
+        args.extend_from_slice(&[flag, value]);
+        let result = gyrofx(&args);
+        let log = text(&result);
+        assert_eq!(result.status.code(), Some(2), "{flag}: {log}");
+        assert!(log.contains(message), "{flag}: {log}");
+        assert!(!output.exists(), "{flag}: nothing written");
+    }
+}

@@ -3,6 +3,7 @@
 pub mod allan;
 pub mod ar;
 pub mod davar;
+pub mod denoise;
 pub mod design;
 pub mod explore;
 pub mod filter;
