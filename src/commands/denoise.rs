@@ -8,7 +8,6 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 
-use gyrofx_codegen::output_folder;
 use gyrofx_model::analysis::allan::{self, Grid, Kind, Point};
 use gyrofx_model::analysis::denoise::{self, BlockReport, Rule};
 use gyrofx_model::analysis::emd::Ensemble;
@@ -158,7 +157,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
             values.len()
         );
     }
-    let mut staged = stage(&args.output)?;
+    let mut staged = super::options::stage_output(&args.output, ".gyrofx-denoise-")?;
     let bar = super::progress::bar(
         1,
         &format!("denoise: {}", args.csv.input.display()),
@@ -203,23 +202,6 @@ pub fn run(args: Args) -> Result<ExitCode> {
         print!("{comparison}");
     }
     Ok(ExitCode::SUCCESS)
-}
-
-/// The staged output file beside `output`, moved into place at the end.
-fn stage(output: &Path) -> Result<tempfile::NamedTempFile> {
-    let folder = match output.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    output_folder::staged_file(folder, ".gyrofx-denoise-", ".csv").map_err(|e| {
-        let reason = e.to_string();
-        let reason = reason.split(" at path ").next().unwrap_or_default();
-        anyhow::anyhow!(
-            "--output {}: cannot create a file in {}: {reason}",
-            output.display(),
-            folder.display()
-        )
-    })
 }
 
 /// `sample,rate_dps,denoised_dps`, one row per sample (shortest round-trip decimals).

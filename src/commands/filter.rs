@@ -9,7 +9,6 @@ use std::io::Write;
 use anyhow::{Context, Result};
 
 use gyrofx_codegen::filter_package::FilterPackage;
-use gyrofx_codegen::output_folder;
 use gyrofx_codegen::text::Provenance;
 use gyrofx_job::config::Config;
 use gyrofx_job::hash::sha256_hex;
@@ -152,7 +151,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
     check_rates(fs, bandwidth)?;
     let output = output.as_path();
     check_outputs(&csv, config.as_deref(), output, vectors.as_deref())?;
-    let mut staged = stage(output)?;
+    let mut staged = super::options::stage_output(output, ".gyrofx-filter-")?;
     let (config, bandwidth_hz, plan) = configured(config.as_deref(), fs, bandwidth)?;
     // The vectors' folder is checked, and their files opened, before the work.
     let mut kf_vectors = match &vectors {
@@ -226,25 +225,6 @@ fn check_outputs(
         check_output("--vectors", folder, true, &inputs)?;
     }
     Ok(())
-}
-
-/// The staged output file, beside `output` (which is checked before the work this way: the
-/// file is moved into place at the end).
-fn stage(output: &Path) -> Result<tempfile::NamedTempFile> {
-    let folder = match output.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    output_folder::staged_file(folder, ".gyrofx-filter-", ".csv").map_err(|e| {
-        // The OS's reason, without the temporary file's name that tempfile adds.
-        let reason = e.to_string();
-        let reason = reason.split(" at path ").next().unwrap_or_default();
-        anyhow::anyhow!(
-            "--output {}: cannot create a file in {}: {reason}",
-            output.display(),
-            folder.display()
-        )
-    })
 }
 
 /// The config (the embedded default, or the file over it: filter takes no --preset) with

@@ -333,3 +333,23 @@ pub fn number(value: f64) -> String {
         format!("{value:e}")
     }
 }
+
+/// A staged file beside `output` (named `<prefix>…`), moved into place when the command ends
+/// well and removed when it drops: `output` is written all or nothing, and its folder is
+/// checked before the work.
+pub fn stage_output(output: &Path, prefix: &str) -> Result<tempfile::NamedTempFile> {
+    let folder = match output.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    gyrofx_codegen::output_folder::staged_file(folder, prefix, ".csv").map_err(|e| {
+        // The OS's reason, without the temporary file's name that tempfile adds.
+        let reason = e.to_string();
+        let reason = reason.split(" at path ").next().unwrap_or_default();
+        anyhow::anyhow!(
+            "--output {}: cannot create a file in {}: {reason}",
+            output.display(),
+            folder.display()
+        )
+    })
+}

@@ -191,52 +191,76 @@ fn the_mean_filter_vectors_cover_every_case_within_the_bound() {
 /// with a cocotb test and a DPI-C testbench, in the package's order.
 #[test]
 fn every_block_with_a_golden_model_has_a_cocotb_test_and_dpi_parts() {
-    let mut config = gyrofx_job::config::Config::embedded();
-    config.samples = 100;
-    let job = Job::new(config).unwrap();
-    let provenance = crate::text::Provenance {
-        version: "test".into(),
-        command: "test".into(),
-        config_sha256: "0".repeat(64),
-    };
-    let roms = RomImages::new(&job, &provenance);
-    let blocks: Vec<_> = super::of(&job).map(|b| b.block(&job, &roms)).collect();
-    let with_test: Vec<&str> = blocks
-        .iter()
-        .filter(|b| b.cocotb_test.is_some())
-        .map(|b| b.name)
-        .collect();
-    assert_eq!(with_test, gyrofx_job::golden::BLOCKS);
-    for block in &blocks {
-        assert_eq!(
-            block.dpi.is_some(),
-            block.cocotb_test.is_some(),
-            "{}",
-            block.name
-        );
-        if let Some(test) = block.cocotb_test {
-            let timing = test
-                .lines()
-                .filter(|line| line.starts_with("TIMING = tb.Timing("))
-                .count();
+    with_default_blocks(|blocks, _| {
+        let with_test: Vec<&str> = blocks
+            .iter()
+            .filter(|b| b.cocotb_test.is_some())
+            .map(|b| b.name)
+            .collect();
+        assert_eq!(with_test, gyrofx_job::golden::BLOCKS);
+        for block in blocks {
             assert_eq!(
-                timing, 1,
-                "{}: one TIMING line for gyrofx to set",
+                block.dpi.is_some(),
+                block.cocotb_test.is_some(),
+                "{}",
                 block.name
             );
-            assert!(
-                !crate::cocotb::test_names(test).is_empty(),
-                "{}: no @cocotb.test()",
-                block.name
-            );
+            if let Some(test) = block.cocotb_test {
+                let timing = test
+                    .lines()
+                    .filter(|line| line.starts_with("TIMING = tb.Timing("))
+                    .count();
+                assert_eq!(
+                    timing, 1,
+                    "{}: one TIMING line for gyrofx to set",
+                    block.name
+                );
+                assert!(
+                    !crate::cocotb::test_names(test).is_empty(),
+                    "{}: no @cocotb.test()",
+                    block.name
+                );
+            }
         }
-    }
+    });
 }
 
 /// The package's cocotb files: the TIMING line from the block's pipeline, `tests.json` naming
 /// every cocotb test, no copy of the shared helpers (they are `gyrofx.cocotb`).
 #[test]
 fn cocotb_tests_get_their_timing_and_are_listed_for_pytest() {
+    with_default_blocks(|blocks, provenance| {
+        let files = crate::cocotb::files(blocks, provenance);
+        let file = |path: &str| {
+            files
+                .iter()
+                .find(|(p, _)| p == path)
+                .map(|(_, text)| text.as_str())
+                .unwrap_or_else(|| panic!("{path} not written"))
+        };
+        assert!(file("cocotb/test_kf.py")
+            .contains("\nTIMING = tb.Timing(latency_clocks=4, min_clocks_per_sample=3)\n"));
+        assert!(file("cocotb/test_estimator.py")
+            .contains("\nTIMING = tb.Timing(latency_clocks=6, min_clocks_per_sample=6)\n"));
+        assert!(files.iter().all(|(p, _)| !p.ends_with("gyrofx_cocotb.py")));
+        let tests: serde_json::Value = serde_json::from_str(file("cocotb/tests.json")).unwrap();
+        let listed = tests["blocks"].as_array().unwrap();
+        assert_eq!(listed.len(), gyrofx_job::golden::BLOCKS.len());
+        let kf = listed.iter().find(|b| b["name"] == "kf").unwrap();
+        assert_eq!(kf["toplevel"], "cocotb_gyrofx_kf");
+        assert_eq!(
+            kf["tests"],
+            serde_json::json!(["random_stimulus", "directed_full_scale"])
+        );
+        assert_eq!(kf["latency_clocks"], 4);
+        for source in tests["sources"].as_array().unwrap() {
+            assert!(source.as_str().unwrap().starts_with("hdl/"));
+        }
+    });
+}
+
+/// The default config's blocks (100 samples), and the provenance they were built with.
+fn with_default_blocks(check: impl FnOnce(&[crate::block::Block], &crate::text::Provenance)) {
     let mut config = gyrofx_job::config::Config::embedded();
     config.samples = 100;
     let job = Job::new(config).unwrap();
@@ -247,30 +271,5 @@ fn cocotb_tests_get_their_timing_and_are_listed_for_pytest() {
     };
     let roms = RomImages::new(&job, &provenance);
     let blocks: Vec<_> = super::of(&job).map(|b| b.block(&job, &roms)).collect();
-    let files = crate::cocotb::files(&blocks, &provenance);
-    let file = |path: &str| {
-        files
-            .iter()
-            .find(|(p, _)| p == path)
-            .map(|(_, text)| text.as_str())
-            .unwrap_or_else(|| panic!("{path} not written"))
-    };
-    assert!(file("cocotb/test_kf.py")
-        .contains("\nTIMING = tb.Timing(latency_clocks=4, min_clocks_per_sample=3)\n"));
-    assert!(file("cocotb/test_estimator.py")
-        .contains("\nTIMING = tb.Timing(latency_clocks=6, min_clocks_per_sample=6)\n"));
-    assert!(files.iter().all(|(p, _)| !p.ends_with("gyrofx_cocotb.py")));
-    let tests: serde_json::Value = serde_json::from_str(file("cocotb/tests.json")).unwrap();
-    let listed = tests["blocks"].as_array().unwrap();
-    assert_eq!(listed.len(), gyrofx_job::golden::BLOCKS.len());
-    let kf = listed.iter().find(|b| b["name"] == "kf").unwrap();
-    assert_eq!(kf["toplevel"], "cocotb_gyrofx_kf");
-    assert_eq!(
-        kf["tests"],
-        serde_json::json!(["random_stimulus", "directed_full_scale"])
-    );
-    assert_eq!(kf["latency_clocks"], 4);
-    for source in tests["sources"].as_array().unwrap() {
-        assert!(source.as_str().unwrap().starts_with("hdl/"));
-    }
+    check(&blocks, &provenance);
 }

@@ -169,30 +169,7 @@ pub fn denoise(
     ensemble: &Ensemble,
     rule: Rule,
 ) -> (Vec<f64>, Vec<BlockReport>) {
-    assert!(block >= 16, "blocks of at least 16 samples");
-    let mut bounds = Vec::new();
-    let mut start = 0;
-    while start < x.len() {
-        let mut end = (start + block).min(x.len());
-        if x.len() - end < block / 2 {
-            end = x.len();
-        }
-        bounds.push((start, end));
-        start = end;
-    }
-    let mut out = Vec::with_capacity(x.len());
-    let mut reports = Vec::new();
-    for (start, end) in bounds {
-        let piece = &x[start..end];
-        if piece.len() < 4 {
-            out.extend_from_slice(piece);
-            continue;
-        }
-        let (clean, report) = threshold(&iceemdan(piece, ensemble), rule);
-        out.extend(clean);
-        reports.push(report);
-    }
-    (out, reports)
+    denoise_overlapped(x, block, 0, ensemble, rule, &mut |_, _| {})
 }
 
 /// Denoises `x` in blocks of `block` samples, each decomposed with up to `overlap` samples of
