@@ -173,6 +173,8 @@ struct Analysis {
     points: Vec<allan::Point>,
     terms: noise::Terms,
     report: noise::Report,
+    /// How well the fitted model follows the curve.
+    fit: noise::FitQuality,
     /// The white-noise density, °/s/√Hz: Welch's median over fs/50..fs/5; none on a record
     /// too short for a segment of 8.
     density: Option<f64>,
@@ -207,10 +209,12 @@ fn analyse(
     bar.finish_and_clear();
     let terms = noise::fit(&points, kind);
     let report = noise::report(&points, &terms, kind);
+    let fit = noise::fit_quality(&points, &terms, kind);
     Analysis {
         points,
         terms,
         report,
+        fit,
         density,
     }
 }
@@ -244,6 +248,7 @@ impl Series<'_> {
             "edf": points.iter().map(|p| p.edf).collect::<Vec<_>>(),
             "noise_alpha": points.iter().map(|p| p.alpha).collect::<Vec<_>>(),
             "noise": self.analysis.report,
+            "fit": self.analysis.fit,
             "noise_density_dps_per_sqrt_hz": self.analysis.density,
         })
     }
@@ -332,6 +337,12 @@ impl std::fmt::Display for Series<'_> {
             opt(report.slope_arw_deg_per_sqrt_h),
             opt(report.slope_rrw_deg_per_h_per_sqrt_h),
             report.slope_bias_instability_deg_per_h
+        )?;
+        let fit = &self.analysis.fit;
+        writeln!(
+            f,
+            "  fit: the model lies outside the 1σ band at {} of {} τ; furthest at τ = {} s, model/measured = {:.3}",
+            fit.outside_band, fit.points, fit.worst_tau_s, fit.worst_model_over_measured
         )
     }
 }

@@ -311,6 +311,51 @@ pub fn report(curve: &[Point], terms: &Terms, kind: Kind) -> Report {
     }
 }
 
+/// How well a fitted model describes the curve it was fitted to: the model's deviation
+/// against each point's 1σ confidence band.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct FitQuality {
+    /// Points of the curve.
+    pub points: usize,
+    /// Points whose band does not hold the model's deviation.
+    pub outside_band: usize,
+    /// τ (s) of the point where the model is furthest from the measured deviation, as a ratio.
+    pub worst_tau_s: f64,
+    /// The model's deviation over the measured one there (1: exact; 1.76: 76 % above).
+    pub worst_model_over_measured: f64,
+}
+
+/// [`FitQuality`] of `terms` on `curve` (of `kind`): the model `Σ c_j basis_j` at each point.
+pub fn fit_quality(curve: &[Point], terms: &Terms, kind: Kind) -> FitQuality {
+    let c = [terms.q, terms.n, terms.b, terms.k, terms.r].map(|e| e.value * e.value);
+    let mut quality = FitQuality {
+        points: curve.len(),
+        outside_band: 0,
+        worst_tau_s: f64::NAN,
+        worst_model_over_measured: 1.0,
+    };
+    let mut worst = 0.0;
+    for p in curve {
+        let model = basis(kind, p.tau_s, p.m)
+            .iter()
+            .zip(&c)
+            .map(|(b, c)| b * c)
+            .sum::<f64>()
+            .sqrt();
+        if !(p.lo..=p.hi).contains(&model) {
+            quality.outside_band += 1;
+        }
+        let ratio = model / p.dev;
+        let distance = ratio.ln().abs();
+        if distance.is_finite() && distance > worst {
+            worst = distance;
+            quality.worst_tau_s = p.tau_s;
+            quality.worst_model_over_measured = ratio;
+        }
+    }
+    quality
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -401,6 +446,25 @@ mod tests {
         assert!((r.arw_deg_per_sqrt_h.value - 1.0).abs() < 0.03, "{r:?}");
         assert!(r.rrw_deg_per_h_per_sqrt_h.value < 2.0, "{r:?}");
         assert!(r.rate_ramp_deg_per_h2.value < 10.0, "{r:?}");
+    }
+
+    #[test]
+    fn fit_quality_finds_a_model_that_misses_the_curve() {
+        let x = record(1.0, 2.0, 0.0, 200_000, 31);
+        let points = curve(Kind::Overlapping, &x, 100.0, Grid::Octave);
+        let terms = fit(&points, Kind::Overlapping);
+        let good = fit_quality(&points, &terms, Kind::Overlapping);
+        assert_eq!(good.points, points.len());
+        assert!(
+            (good.worst_model_over_measured.ln()).abs() < 0.5,
+            "{good:?}"
+        );
+        // The same terms with N doubled: the model sits about twice above the curve.
+        let mut wrong = terms;
+        wrong.n.value *= 2.0;
+        let bad = fit_quality(&points, &wrong, Kind::Overlapping);
+        assert!(bad.outside_band > good.outside_band, "{good:?} {bad:?}");
+        assert!(bad.worst_model_over_measured > 1.8, "{bad:?}");
     }
 }
 
