@@ -30,8 +30,14 @@ fn json_has_the_documented_fields() {
     // How well the fitted model follows the curve: one count per τ.
     let points = v["tau_s"].as_array().unwrap().len() as u64;
     assert_eq!(v["fit"]["points"].as_u64(), Some(points), "{out}");
-    assert!(v["fit"]["outside_band"].as_u64().unwrap() <= points, "{out}");
-    assert!(v["fit"]["worst_model_over_measured"].as_f64().unwrap() > 0.0, "{out}");
+    assert!(
+        v["fit"]["outside_band"].as_u64().unwrap() <= points,
+        "{out}"
+    );
+    assert!(
+        v["fit"]["worst_model_over_measured"].as_f64().unwrap() > 0.0,
+        "{out}"
+    );
     for key in [
         "quantization_urad",
         "arw_deg_per_sqrt_h",

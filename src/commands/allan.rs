@@ -173,8 +173,10 @@ struct Analysis {
     points: Vec<allan::Point>,
     terms: noise::Terms,
     report: noise::Report,
-    /// How well the fitted model follows the curve.
+    /// How well the fitted model follows the points it was fitted to.
     fit: noise::FitQuality,
+    /// The τ (s) below which the sensor's filtering bends the curve, kept out of the fit.
+    filtered_below_tau_s: Option<f64>,
     /// The white-noise density, °/s/√Hz: Welch's median over fs/50..fs/5; none on a record
     /// too short for a segment of 8.
     density: Option<f64>,
@@ -207,14 +209,16 @@ fn analyse(
         (points, density.join().expect("the spectrum does not panic"))
     });
     bar.finish_and_clear();
-    let terms = noise::fit(&points, kind);
+    // The terms come from the points past the sensor's own filtering at the shortest τ.
+    let (terms, filtered, fit) = noise::identify(&points, kind);
+    let filtered_below_tau_s = (filtered > 0).then(|| points[filtered].tau_s);
     let report = noise::report(&points, &terms, kind);
-    let fit = noise::fit_quality(&points, &terms, kind);
     Analysis {
         points,
         terms,
         report,
         fit,
+        filtered_below_tau_s,
         density,
     }
 }
@@ -249,6 +253,7 @@ impl Series<'_> {
             "noise_alpha": points.iter().map(|p| p.alpha).collect::<Vec<_>>(),
             "noise": self.analysis.report,
             "fit": self.analysis.fit,
+            "filtered_below_tau_s": self.analysis.filtered_below_tau_s,
             "noise_density_dps_per_sqrt_hz": self.analysis.density,
         })
     }
@@ -339,9 +344,15 @@ impl std::fmt::Display for Series<'_> {
             report.slope_bias_instability_deg_per_h
         )?;
         let fit = &self.analysis.fit;
+        if let Some(tau) = self.analysis.filtered_below_tau_s {
+            writeln!(
+                f,
+                "  the sensor's filtering bends the curve below τ = {tau} s (slope above −0.45): those points are kept out of the fit"
+            )?;
+        }
         writeln!(
             f,
-            "  fit: the model lies outside the 1σ band at {} of {} τ; furthest at τ = {} s, model/measured = {:.3}",
+            "  fit: the model lies outside the 1σ band at {} of {} fitted τ; furthest at τ = {} s, model/measured = {:.3}",
             fit.outside_band, fit.points, fit.worst_tau_s, fit.worst_model_over_measured
         )
     }

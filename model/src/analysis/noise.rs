@@ -311,6 +311,44 @@ pub fn report(curve: &[Point], terms: &Terms, kind: Kind) -> Report {
     }
 }
 
+/// Slope of the deviation above which a leading stretch of the curve counts as bent by the
+/// sensor's own low-pass filtering (white FM's is −½; quantization's −1 is steeper still).
+pub const FILTERED_SLOPE: f64 = -0.45;
+
+/// How many of the curve's shortest τ the sensor's own filtering bends: a low-pass filter
+/// (anti-aliasing, a digital LPF before the output register) takes power out of the shortest
+/// averaging times, so there the deviation falls slower than white noise's τ^−½. The leading
+/// points are counted while the slope to the next one is shallower than [`FILTERED_SLOPE`],
+/// plus one more (the bend fades over about an octave: a first-order filter of time constant
+/// `T` still lowers the deviation by a few % at `τ = 10 T`), and only if the curve then falls
+/// at white noise's slope (within ±0.1) between the next two points: a curve that never does
+/// (bias instability from the start) is left whole. At most half the curve is counted.
+pub fn filtered_points(curve: &[Point]) -> usize {
+    let slope = |a: &Point, b: &Point| (b.dev / a.dev).ln() / (b.tau_s / a.tau_s).ln();
+    let slopes: Vec<f64> = curve.windows(2).map(|w| slope(&w[0], &w[1])).collect();
+    let bent = slopes
+        .iter()
+        .take_while(|s| s.is_finite() && **s > FILTERED_SLOPE)
+        .count();
+    let white_follows = slopes.get(bent).is_some_and(|s| (s + 0.5).abs() <= 0.1);
+    if bent > 0 && white_follows && bent < curve.len() / 2 {
+        bent + 1
+    } else {
+        0
+    }
+}
+
+/// What `gyrofx allan` reports of a curve: the terms fitted to the points past the sensor's
+/// filtering ([`filtered_points`]), the number of leading points left out, and how well the
+/// model follows the points it was fitted to.
+pub fn identify(curve: &[Point], kind: Kind) -> (Terms, usize, FitQuality) {
+    let skip = filtered_points(curve);
+    let fitted = &curve[skip..];
+    let terms = fit(fitted, kind);
+    let quality = fit_quality(fitted, &terms, kind);
+    (terms, skip, quality)
+}
+
 /// How well a fitted model describes the curve it was fitted to: the model's deviation
 /// against each point's 1σ confidence band.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -465,6 +503,46 @@ mod tests {
         let bad = fit_quality(&points, &wrong, Kind::Overlapping);
         assert!(bad.outside_band > good.outside_band, "{good:?} {bad:?}");
         assert!(bad.worst_model_over_measured > 1.8, "{bad:?}");
+    }
+
+    #[test]
+    fn a_low_passed_record_keeps_its_white_noise_term() {
+        // White rate noise of N = 0.5 °/√s at 1 kHz through a first-order low-pass filter
+        // (time constant 5 samples): the shortest τ fall below the white line.
+        let mut g =
+            crate::stimulus::Gaussian::new(9, crate::stimulus::Stream::DecompositionNoise(90));
+        let fs: f64 = 1000.0;
+        let n_true = 0.5;
+        let white = g.samples(400_000, n_true * fs.sqrt());
+        let mut state = 0.0;
+        let filtered: Vec<f64> = white
+            .iter()
+            .map(|x| {
+                state += (x - state) / 5.0;
+                state
+            })
+            .collect();
+        let points = curve(Kind::Overlapping, &filtered, fs, Grid::Octave);
+        let skip = filtered_points(&points);
+        assert!(skip >= 2, "{skip}");
+        let (terms, identified_skip, quality) = identify(&points, Kind::Overlapping);
+        assert_eq!(identified_skip, skip);
+        let all = fit(&points, Kind::Overlapping);
+        let error = |n: f64| (n / n_true - 1.0).abs();
+        assert!(error(terms.n.value) < 0.05, "{:?}", terms.n);
+        assert!(
+            error(all.n.value) > 2.0 * error(terms.n.value),
+            "{:?} vs {:?}",
+            all.n,
+            terms.n
+        );
+        assert!(
+            quality.worst_model_over_measured.ln().abs() < 0.2,
+            "{quality:?}"
+        );
+        // Unfiltered white noise: nothing left out.
+        let points = curve(Kind::Overlapping, &white, fs, Grid::Octave);
+        assert_eq!(filtered_points(&points), 0);
     }
 }
 
