@@ -38,6 +38,20 @@ fn json_has_the_documented_fields() {
         v["fit"]["worst_model_over_measured"].as_f64().unwrap() > 0.0,
         "{out}"
     );
+    // White noise: the curve shows N; B is not shown and gets an upper bound instead.
+    assert_eq!(v["identified"]["arw_deg_per_sqrt_h"], true, "{out}");
+    assert!(v["upper_bound"]["arw_deg_per_sqrt_h"].is_null(), "{out}");
+    assert_eq!(
+        v["identified"]["bias_instability_deg_per_h"], false,
+        "{out}"
+    );
+    assert!(
+        v["upper_bound"]["bias_instability_deg_per_h"]
+            .as_f64()
+            .unwrap()
+            > 0.0,
+        "{out}"
+    );
     for key in [
         "quantization_urad",
         "arw_deg_per_sqrt_h",

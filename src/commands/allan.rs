@@ -168,6 +168,20 @@ fn read_series(
     Ok((values, skipped))
 }
 
+/// The terms in the order of [`noise::Identification`]: JSON name, the factor from the fit's
+/// units to the report's, and the report's unit.
+const TERMS: [(&str, f64, &str); 5] = [
+    (
+        "quantization_urad",
+        std::f64::consts::PI / 180.0 * 1e6,
+        "µrad",
+    ),
+    ("arw_deg_per_sqrt_h", 60.0, "°/√h"),
+    ("bias_instability_deg_per_h", 3600.0, "°/h"),
+    ("rrw_deg_per_h_per_sqrt_h", 216_000.0, "°/h/√h"),
+    ("rate_ramp_deg_per_h2", 3600.0 * 3600.0, "°/h²"),
+];
+
 /// What the analysis gives of one series.
 struct Analysis {
     points: Vec<allan::Point>,
@@ -177,6 +191,8 @@ struct Analysis {
     fit: noise::FitQuality,
     /// The τ (s) below which the sensor's filtering bends the curve, kept out of the fit.
     filtered_below_tau_s: Option<f64>,
+    /// Which terms the curve shows; upper bounds of the others.
+    identification: noise::Identification,
     /// The white-noise density, °/s/√Hz: Welch's median over fs/50..fs/5; none on a record
     /// too short for a segment of 8.
     density: Option<f64>,
@@ -213,12 +229,14 @@ fn analyse(
     let (terms, filtered, fit) = noise::identify(&points, kind);
     let filtered_below_tau_s = (filtered > 0).then(|| points[filtered].tau_s);
     let report = noise::report(&points, &terms, kind);
+    let identification = noise::identification(&points[filtered..], &terms, kind);
     Analysis {
         points,
         terms,
         report,
         fit,
         filtered_below_tau_s,
+        identification,
         density,
     }
 }
@@ -254,6 +272,18 @@ impl Series<'_> {
             "noise": self.analysis.report,
             "fit": self.analysis.fit,
             "filtered_below_tau_s": self.analysis.filtered_below_tau_s,
+            "identified": TERMS
+                .iter()
+                .zip(self.analysis.identification.identified)
+                .map(|((name, _, _), shown)| (name.to_string(), serde_json::json!(shown)))
+                .collect::<serde_json::Map<_, _>>(),
+            "upper_bound": TERMS
+                .iter()
+                .zip(self.analysis.identification.upper_bound)
+                .map(|((name, scale, _), bound)| {
+                    (name.to_string(), serde_json::json!((bound * scale).is_finite().then_some(bound * scale)))
+                })
+                .collect::<serde_json::Map<_, _>>(),
             "noise_density_dps_per_sqrt_hz": self.analysis.density,
         })
     }
@@ -289,10 +319,20 @@ impl std::fmt::Display for Series<'_> {
                 p.tau_s, p.dev, p.lo, p.hi, p.alpha, p.edf
             )?;
         }
+        let id = &self.analysis.identification;
         let line = |f: &mut std::fmt::Formatter<'_>, name: &str, e: noise::Estimate, unit: &str| {
+            let index = TERMS.iter().position(|(_, _, u)| *u == unit).unwrap_or(0);
+            let bound = id.upper_bound[index] * TERMS[index].1;
+            let note = if id.identified[index] {
+                String::new()
+            } else if bound.is_finite() {
+                format!("  not shown by the curve: at most {bound:.5e} {unit}")
+            } else {
+                "  not shown by the curve".to_string()
+            };
             writeln!(
                 f,
-                "  {name:<28} {:>12.5e} [{:.5e}, {:.5e}] {unit}",
+                "  {name:<28} {:>12.5e} [{:.5e}, {:.5e}] {unit}{note}",
                 e.value, e.lo, e.hi
             )
         };

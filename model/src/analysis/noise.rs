@@ -338,6 +338,55 @@ pub fn filtered_points(curve: &[Point]) -> usize {
     }
 }
 
+/// Share of the model's variance a term must carry at one fitted τ at least to count as
+/// identified by the curve.
+pub const IDENTIFIED_SHARE: f64 = 0.5;
+
+/// Which terms the curve shows, in the order Q, N, B, K, R.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Identification {
+    /// The term is positive and carries at least [`IDENTIFIED_SHARE`] of the model's variance
+    /// at some fitted τ: the curve shows it.
+    pub identified: [bool; 5],
+    /// For a term the curve does not show, the largest value no fitted point's 1σ band rules
+    /// out (the term alone under each point's upper bound), in the terms' units; NaN for an
+    /// identified term or one the kind cannot see.
+    pub upper_bound: [f64; 5],
+}
+
+/// [`Identification`] of `terms` fitted to `curve` (of `kind`).
+pub fn identification(curve: &[Point], terms: &Terms, kind: Kind) -> Identification {
+    let values = [terms.q, terms.n, terms.b, terms.k, terms.r].map(|e| e.value);
+    let c = values.map(|v| if v.is_finite() { v * v } else { 0.0 });
+    let mut share = [0.0f64; 5];
+    let mut bound = [f64::INFINITY; 5];
+    for p in curve {
+        let b = basis(kind, p.tau_s, p.m);
+        let total: f64 = b.iter().zip(&c).map(|(b, c)| b * c).sum();
+        for j in 0..5 {
+            if total > 0.0 {
+                share[j] = share[j].max(b[j] * c[j] / total);
+            }
+            if b[j] > 0.0 {
+                bound[j] = bound[j].min(p.hi * p.hi / b[j]);
+            }
+        }
+    }
+    let identified: [bool; 5] =
+        std::array::from_fn(|j| values[j] > 0.0 && share[j] >= IDENTIFIED_SHARE);
+    let upper_bound = std::array::from_fn(|j| {
+        if identified[j] || !values[j].is_finite() || !bound[j].is_finite() {
+            f64::NAN
+        } else {
+            bound[j].sqrt()
+        }
+    });
+    Identification {
+        identified,
+        upper_bound,
+    }
+}
+
 /// What `gyrofx allan` reports of a curve: the terms fitted to the points past the sensor's
 /// filtering ([`filtered_points`]), the number of leading points left out, and how well the
 /// model follows the points it was fitted to.
@@ -543,6 +592,32 @@ mod tests {
         // Unfiltered white noise: nothing left out.
         let points = curve(Kind::Overlapping, &white, fs, Grid::Octave);
         assert_eq!(filtered_points(&points), 0);
+    }
+
+    #[test]
+    fn white_noise_identifies_n_only_and_bounds_the_rest() {
+        let mut g =
+            crate::stimulus::Gaussian::new(11, crate::stimulus::Stream::DecompositionNoise(91));
+        let fs: f64 = 100.0;
+        let x = g.samples(100_000, 0.2 * fs.sqrt());
+        let points = curve(Kind::Overlapping, &x, fs, Grid::Octave);
+        let terms = fit(&points, Kind::Overlapping);
+        let id = identification(&points, &terms, Kind::Overlapping);
+        assert!(id.identified[1], "{id:?}");
+        assert!(id.upper_bound[1].is_nan());
+        // B is not shown: its bound is at most the curve's floor over 0.664.
+        assert!(!id.identified[2], "{id:?}");
+        let floor = points.iter().map(|p| p.hi).fold(f64::INFINITY, f64::min);
+        assert!(
+            id.upper_bound[2] > 0.0 && id.upper_bound[2] <= floor / FLICKER_FLOOR * 1.000001,
+            "{id:?}"
+        );
+        // A record with B: B identified.
+        let x = record(0.5, 20.0, 0.0, 400_000, 33);
+        let points = curve(Kind::Overlapping, &x, 100.0, Grid::Octave);
+        let terms = fit(&points, Kind::Overlapping);
+        let id = identification(&points, &terms, Kind::Overlapping);
+        assert!(id.identified[1], "{id:?} {terms:?}");
     }
 }
 
