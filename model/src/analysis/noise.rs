@@ -415,10 +415,11 @@ pub struct FitQuality {
 /// [`FitQuality`] of `terms` on `curve` (of `kind`): the model `Σ c_j basis_j` at each point.
 pub fn fit_quality(curve: &[Point], terms: &Terms, kind: Kind) -> FitQuality {
     let c = [terms.q, terms.n, terms.b, terms.k, terms.r].map(|e| e.value * e.value);
+    // An exact model (a constant record: both 0) stays at the first τ, ratio 1.
     let mut quality = FitQuality {
         points: curve.len(),
         outside_band: 0,
-        worst_tau_s: f64::NAN,
+        worst_tau_s: curve.first().map_or(f64::NAN, |p| p.tau_s),
         worst_model_over_measured: 1.0,
     };
     let mut worst = 0.0;
@@ -432,9 +433,11 @@ pub fn fit_quality(curve: &[Point], terms: &Terms, kind: Kind) -> FitQuality {
         if !(p.lo..=p.hi).contains(&model) {
             quality.outside_band += 1;
         }
+        // A model of 0 under a measured deviation is as far off as can be (ratio 0); 0/0 is
+        // no information.
         let ratio = model / p.dev;
         let distance = ratio.ln().abs();
-        if distance.is_finite() && distance > worst {
+        if !distance.is_nan() && distance > worst {
             worst = distance;
             quality.worst_tau_s = p.tau_s;
             quality.worst_model_over_measured = ratio;
