@@ -191,11 +191,11 @@ impl Kf {
     /// a dict of counts, e.g. `{"x1": 0, "x2": 0, "rate_out": 3}` for the KF; empty for a block
     /// that cannot overflow.
     fn overflow_counts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        crate::blocks::overflow_dict(py, self.ports.overflows())
+        overflow_dict(py, self.ports.overflows())
     }
 
     fn __repr__(&self) -> String {
-        crate::blocks::block_repr("Kf", &self.ports.ports())
+        block_repr("Kf", &self.ports.ports())
     }
 
     /// Its ports as the vector files carry them (after `rst`; inputs, then outputs): a list of
@@ -443,11 +443,11 @@ impl Sequencer {
     /// a dict of counts, e.g. `{"x1": 0, "x2": 0, "rate_out": 3}` for the KF; empty for a block
     /// that cannot overflow.
     fn overflow_counts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        crate::blocks::overflow_dict(py, self.ports.overflows())
+        overflow_dict(py, self.ports.overflows())
     }
 
     fn __repr__(&self) -> String {
-        crate::blocks::block_repr("Sequencer", &self.ports.ports())
+        block_repr("Sequencer", &self.ports.ports())
     }
 
     /// Its ports as the vector files carry them (after `rst`; inputs, then outputs): a list of
@@ -527,11 +527,11 @@ impl Estimator {
     /// a dict of counts, e.g. `{"x1": 0, "x2": 0, "rate_out": 3}` for the KF; empty for a block
     /// that cannot overflow.
     fn overflow_counts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        crate::blocks::overflow_dict(py, self.ports.overflows())
+        overflow_dict(py, self.ports.overflows())
     }
 
     fn __repr__(&self) -> String {
-        crate::blocks::block_repr("Estimator", &self.ports.ports())
+        block_repr("Estimator", &self.ports.ports())
     }
 
     /// Its ports as the vector files carry them (after `rst`; inputs, then outputs): a list of
@@ -759,11 +759,11 @@ impl MeanFilter {
     /// a dict of counts, e.g. `{"x1": 0, "x2": 0, "rate_out": 3}` for the KF; empty for a block
     /// that cannot overflow.
     fn overflow_counts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        crate::blocks::overflow_dict(py, self.ports.overflows())
+        overflow_dict(py, self.ports.overflows())
     }
 
     fn __repr__(&self) -> String {
-        crate::blocks::block_repr("MeanFilter", &self.ports.ports())
+        block_repr("MeanFilter", &self.ports.ports())
     }
 
     /// Its ports as the vector files carry them (after `rst`; inputs, then outputs): a list of
@@ -903,11 +903,11 @@ impl Chain {
     /// a dict of counts, e.g. `{"x1": 0, "x2": 0, "rate_out": 3}` for the KF; empty for a block
     /// that cannot overflow.
     fn overflow_counts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        crate::blocks::overflow_dict(py, self.ports.overflows())
+        overflow_dict(py, self.ports.overflows())
     }
 
     fn __repr__(&self) -> String {
-        crate::blocks::block_repr("Chain", &self.ports.ports())
+        block_repr("Chain", &self.ports.ports())
     }
 
     /// Its ports as the vector files carry them (after `rst`; inputs, then outputs): a list of

@@ -1,4 +1,5 @@
-//! Real values to codes and back, in any format, with the CLI's rounding and overflow names.
+//! Real values to codes and back, in any format: the kernels behind `gyrofx.quantize`,
+//! `gyrofx.to_real` and `Format` (the Python-facing functions are in `format`).
 
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
@@ -7,7 +8,6 @@ use gyrofx_job::golden::check_code;
 use gyrofx_model::fx::{from_f64, Format, Overflow, Rounding};
 
 use crate::blocks::Codes;
-use crate::format::{FormatArg, OverflowArg, RoundingArg};
 use crate::refused;
 
 /// Parses a format string (`s18.14`, `u12.12`) whose codes fit `int64`.
@@ -39,37 +39,6 @@ fn real_record<'py>(values: &Bound<'py, PyAny>) -> PyResult<PyReadonlyArray1<'py
     array.extract()
 }
 
-/// Quantizes real values to codes of `fmt` (a `Format` or its string).
-///
-/// `rounding` is a `Rounding` or one of floor, ceil, zero, nearest, round, convergent, and
-/// `overflow` an `Overflow` or saturate, wrap (the config's names). NaN and ±inf are refused
-/// with their index. With `counts=True` it returns `(codes, overflowed)`: how many values did
-/// not fit the format (saturated or wrapped).
-#[pyfunction]
-#[pyo3(signature = (values, fmt, rounding = RoundingArg::Text("nearest".into()), overflow = OverflowArg::Text("saturate".into()), *, counts = false),
-       text_signature = "(values, fmt, rounding='nearest', overflow='saturate', *, counts=False)")]
-pub(crate) fn quantize<'py>(
-    py: Python<'py>,
-    values: Bound<'py, PyAny>,
-    fmt: FormatArg,
-    rounding: RoundingArg,
-    overflow: OverflowArg,
-    counts: bool,
-) -> PyResult<Bound<'py, PyAny>> {
-    let (codes, overflowed) = quantize_values(
-        py,
-        &values,
-        fmt.format()?,
-        rounding.mode()?,
-        overflow.mode()?,
-    )?;
-    if counts {
-        Ok((codes, overflowed).into_pyobject(py)?.into_any())
-    } else {
-        Ok(codes.into_any())
-    }
-}
-
 /// `values` quantized to `format`, and how many did not fit it.
 pub(crate) fn quantize_values<'py>(
     py: Python<'py>,
@@ -91,18 +60,8 @@ pub(crate) fn quantize_values<'py>(
     Ok((codes.into_pyarray(py), overflowed))
 }
 
-/// The real values (`code · 2^-frac`) of codes of `fmt` (a `Format` or its string); a code
-/// outside the format is refused with its index.
-#[pyfunction]
-pub(crate) fn to_real<'py>(
-    py: Python<'py>,
-    codes: Codes<'py>,
-    fmt: FormatArg,
-) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    codes_to_real(py, codes, fmt.format()?)
-}
-
-/// [`to_real`] on a parsed format.
+/// The real values of `codes` in `format` (`gyrofx.to_real`); a code outside the format is
+/// refused with its index.
 pub(crate) fn codes_to_real<'py>(
     py: Python<'py>,
     codes: Codes<'py>,

@@ -1,7 +1,8 @@
 //! `Format`, `Rounding` and `Overflow` for Python: a format as an object (width, fraction, code
 //! range, LSB, to and from real values) and the quantizer's modes as enums. Everywhere a
 //! format, a rounding or an overflow mode is taken, the config's strings (`"s24.14"`,
-//! `"nearest"`, `"saturate"`) are accepted too.
+//! `"nearest"`, `"saturate"`) are accepted too. `gyrofx.quantize` and `gyrofx.to_real` live
+//! here, on the kernels of `codes`.
 
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -130,6 +131,48 @@ impl Format {
     fn __hash__(&self, py: Python<'_>) -> PyResult<isize> {
         PyString::new(py, &self.inner.to_string()).hash()
     }
+}
+
+/// Quantizes real values to codes of `fmt` (a `Format` or its string).
+///
+/// `rounding` is a `Rounding` or one of floor, ceil, zero, nearest, round, convergent, and
+/// `overflow` an `Overflow` or saturate, wrap (the config's names). NaN and ±inf are refused
+/// with their index. With `counts=True` it returns `(codes, overflowed)`: how many values did
+/// not fit the format (saturated or wrapped).
+#[pyfunction]
+#[pyo3(signature = (values, fmt, rounding = RoundingArg::Text("nearest".into()), overflow = OverflowArg::Text("saturate".into()), *, counts = false),
+       text_signature = "(values, fmt, rounding='nearest', overflow='saturate', *, counts=False)")]
+pub(crate) fn quantize<'py>(
+    py: Python<'py>,
+    values: Bound<'py, PyAny>,
+    fmt: FormatArg,
+    rounding: RoundingArg,
+    overflow: OverflowArg,
+    counts: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (codes, overflowed) = codes::quantize_values(
+        py,
+        &values,
+        fmt.format()?,
+        rounding.mode()?,
+        overflow.mode()?,
+    )?;
+    if counts {
+        Ok((codes, overflowed).into_pyobject(py)?.into_any())
+    } else {
+        Ok(codes.into_any())
+    }
+}
+
+/// The real values (`code · 2^-frac`) of codes of `fmt` (a `Format` or its string); a code
+/// outside the format is refused with its index.
+#[pyfunction]
+pub(crate) fn to_real<'py>(
+    py: Python<'py>,
+    codes: Codes<'py>,
+    fmt: FormatArg,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    codes::codes_to_real(py, codes, fmt.format()?)
 }
 
 /// A format as an argument: a `Format` or its string.

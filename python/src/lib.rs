@@ -51,7 +51,7 @@ fn _gyrofx(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<format::Format>()?;
     module.add_class::<format::Rounding>()?;
     module.add_class::<format::Overflow>()?;
-    module.add_function(wrap_pyfunction!(codes::quantize, module)?)?;
-    module.add_function(wrap_pyfunction!(codes::to_real, module)?)?;
+    module.add_function(wrap_pyfunction!(format::quantize, module)?)?;
+    module.add_function(wrap_pyfunction!(format::to_real, module)?)?;
     Ok(())
 }
