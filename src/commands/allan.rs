@@ -168,18 +168,14 @@ fn read_series(
     Ok((values, skipped))
 }
 
-/// The terms in the order of [`noise::Identification`]: JSON name, the factor from the fit's
-/// units to the report's, and the report's unit.
-const TERMS: [(&str, f64, &str); 5] = [
-    (
-        "quantization_urad",
-        std::f64::consts::PI / 180.0 * 1e6,
-        "µrad",
-    ),
-    ("arw_deg_per_sqrt_h", 60.0, "°/√h"),
-    ("bias_instability_deg_per_h", 3600.0, "°/h"),
-    ("rrw_deg_per_h_per_sqrt_h", 216_000.0, "°/h/√h"),
-    ("rate_ramp_deg_per_h2", 3600.0 * 3600.0, "°/h²"),
+/// The terms in the order of [`noise::Identification`] and [`noise::REPORT_SCALE`]: the name
+/// printed, the JSON key and the unit.
+const TERMS: [(&str, &str, &str); 5] = [
+    ("quantization Q", "quantization_urad", "µrad"),
+    ("angle random walk N", "arw_deg_per_sqrt_h", "°/√h"),
+    ("bias instability B", "bias_instability_deg_per_h", "°/h"),
+    ("rate random walk K", "rrw_deg_per_h_per_sqrt_h", "°/h/√h"),
+    ("rate ramp R", "rate_ramp_deg_per_h2", "°/h²"),
 ];
 
 /// What the analysis gives of one series.
@@ -226,17 +222,17 @@ fn analyse(
     });
     bar.finish_and_clear();
     // The terms come from the points past the sensor's own filtering at the shortest τ.
-    let (terms, filtered, fit) = noise::identify(&points, kind);
+    let identified = noise::identify(&points, kind);
+    let filtered = identified.filtered;
     let filtered_below_tau_s = (filtered > 0).then(|| points[filtered].tau_s);
-    let report = noise::report(&points, &terms, kind);
-    let identification = noise::identification(&points[filtered..], &terms, kind);
+    let report = noise::report(&points, &identified.terms, kind);
     Analysis {
         points,
-        terms,
+        terms: identified.terms,
         report,
-        fit,
+        fit: identified.fit,
         filtered_below_tau_s,
-        identification,
+        identification: identified.identification,
         density,
     }
 }
@@ -275,12 +271,13 @@ impl Series<'_> {
             "identified": TERMS
                 .iter()
                 .zip(self.analysis.identification.identified)
-                .map(|((name, _, _), shown)| (name.to_string(), serde_json::json!(shown)))
+                .map(|((_, key, _), shown)| (key.to_string(), serde_json::json!(shown)))
                 .collect::<serde_json::Map<_, _>>(),
             "upper_bound": TERMS
                 .iter()
                 .zip(self.analysis.identification.upper_bound)
-                .map(|((name, scale, _), bound)| {
+                .zip(noise::REPORT_SCALE)
+                .map(|(((_, name, _), bound), scale)| {
                     (name.to_string(), serde_json::json!((bound * scale).is_finite().then_some(bound * scale)))
                 })
                 .collect::<serde_json::Map<_, _>>(),
@@ -319,10 +316,30 @@ impl std::fmt::Display for Series<'_> {
                 p.tau_s, p.dev, p.lo, p.hi, p.alpha, p.edf
             )?;
         }
+        writeln!(
+            f,
+            "noise terms (weighted non-negative fit of the {} variance's model, ±1 standard error):",
+            format!("{kind:?}").to_lowercase()
+        )?;
         let id = &self.analysis.identification;
-        let line = |f: &mut std::fmt::Formatter<'_>, name: &str, e: noise::Estimate, unit: &str| {
-            let index = TERMS.iter().position(|(_, _, u)| *u == unit).unwrap_or(0);
-            let bound = id.upper_bound[index] * TERMS[index].1;
+        let estimates = [
+            report.quantization_urad,
+            report.arw_deg_per_sqrt_h,
+            report.bias_instability_deg_per_h,
+            report.rrw_deg_per_h_per_sqrt_h,
+            report.rate_ramp_deg_per_h2,
+        ];
+        for (index, ((name, _, unit), e)) in TERMS.iter().zip(estimates).enumerate() {
+            if e.value.is_nan() {
+                // Only the Hadamard variance's rate ramp.
+                writeln!(
+                    f,
+                    "  {name:<28} {:>12} (the Hadamard variance cancels a rate ramp)",
+                    "-"
+                )?;
+                continue;
+            }
+            let bound = id.upper_bound[index] * noise::REPORT_SCALE[index];
             let note = if id.identified[index] {
                 String::new()
             } else if bound.is_finite() {
@@ -334,35 +351,7 @@ impl std::fmt::Display for Series<'_> {
                 f,
                 "  {name:<28} {:>12.5e} [{:.5e}, {:.5e}] {unit}{note}",
                 e.value, e.lo, e.hi
-            )
-        };
-        writeln!(
-            f,
-            "noise terms (weighted non-negative fit of the {} variance's model, ±1 standard error):",
-            format!("{kind:?}").to_lowercase()
-        )?;
-        line(f, "quantization Q", report.quantization_urad, "µrad")?;
-        line(f, "angle random walk N", report.arw_deg_per_sqrt_h, "°/√h")?;
-        line(
-            f,
-            "bias instability B",
-            report.bias_instability_deg_per_h,
-            "°/h",
-        )?;
-        line(
-            f,
-            "rate random walk K",
-            report.rrw_deg_per_h_per_sqrt_h,
-            "°/h/√h",
-        )?;
-        if report.rate_ramp_deg_per_h2.value.is_nan() {
-            writeln!(
-                f,
-                "  {:<28} {:>12} (the Hadamard variance cancels a rate ramp)",
-                "rate ramp R", "-"
             )?;
-        } else {
-            line(f, "rate ramp R", report.rate_ramp_deg_per_h2, "°/h²")?;
         }
         writeln!(
             f,

@@ -282,6 +282,16 @@ fn slope_reading(curve: &[Point], slope: f64, at_tau: f64) -> Option<f64> {
     Some((mean + slope * at_tau.ln()).exp())
 }
 
+/// Factors from the fit's units (°, °/√s, °/s, °/s/√s, °/s²) to the report's (µrad, °/√h, °/h,
+/// °/h/√h, °/h²), in the order Q, N, B, K, R.
+pub const REPORT_SCALE: [f64; 5] = [
+    std::f64::consts::PI / 180.0 * 1e6,
+    60.0,
+    3600.0,
+    216_000.0,
+    3600.0 * 3600.0,
+];
+
 /// The fit and the slope readings in IEEE-952 and Kalibr units, for a curve of `kind`: the
 /// readings divide out the kind's response to white FM (at τ = 1 s), random-walk FM and flicker
 /// FM (the asymptotic ratios of [`basis`]).
@@ -297,11 +307,11 @@ pub fn report(curve: &[Point], terms: &Terms, kind: Kind) -> Report {
     let (white, flicker, random_walk): (f64, f64, f64) =
         (white.sqrt(), flicker.sqrt(), random_walk.sqrt());
     Report {
-        quantization_urad: terms.q.scaled(radians * 1e6),
-        arw_deg_per_sqrt_h: terms.n.scaled(60.0),
-        bias_instability_deg_per_h: terms.b.scaled(3600.0),
-        rrw_deg_per_h_per_sqrt_h: terms.k.scaled(216_000.0),
-        rate_ramp_deg_per_h2: terms.r.scaled(3600.0 * 3600.0),
+        quantization_urad: terms.q.scaled(REPORT_SCALE[0]),
+        arw_deg_per_sqrt_h: terms.n.scaled(REPORT_SCALE[1]),
+        bias_instability_deg_per_h: terms.b.scaled(REPORT_SCALE[2]),
+        rrw_deg_per_h_per_sqrt_h: terms.k.scaled(REPORT_SCALE[3]),
+        rate_ramp_deg_per_h2: terms.r.scaled(REPORT_SCALE[4]),
         kalibr_noise_density_rad_per_s_per_sqrt_hz: terms.n.value * radians,
         kalibr_random_walk_rad_per_s2_per_sqrt_hz: terms.k.value * radians,
         slope_arw_deg_per_sqrt_h: slope_reading(curve, -0.5, 1.0).map(|n| n / white * 60.0),
@@ -387,15 +397,31 @@ pub fn identification(curve: &[Point], terms: &Terms, kind: Kind) -> Identificat
     }
 }
 
-/// What `gyrofx allan` reports of a curve: the terms fitted to the points past the sensor's
-/// filtering ([`filtered_points`]), the number of leading points left out, and how well the
-/// model follows the points it was fitted to.
-pub fn identify(curve: &[Point], kind: Kind) -> (Terms, usize, FitQuality) {
-    let skip = filtered_points(curve);
-    let fitted = &curve[skip..];
+/// What [`identify`] makes of a curve.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Identified {
+    /// The terms fitted to the points past the sensor's filtering.
+    pub terms: Terms,
+    /// Leading points left out ([`filtered_points`]).
+    pub filtered: usize,
+    /// How well the model follows the points it was fitted to.
+    pub fit: FitQuality,
+    /// Which terms those points show, and bounds of the others.
+    pub identification: Identification,
+}
+
+/// What `gyrofx allan` reports of a curve: the fit to the points past the sensor's own
+/// filtering, how well it follows them, and which terms they show.
+pub fn identify(curve: &[Point], kind: Kind) -> Identified {
+    let filtered = filtered_points(curve);
+    let fitted = &curve[filtered..];
     let terms = fit(fitted, kind);
-    let quality = fit_quality(fitted, &terms, kind);
-    (terms, skip, quality)
+    Identified {
+        terms,
+        filtered,
+        fit: fit_quality(fitted, &terms, kind),
+        identification: identification(fitted, &terms, kind),
+    }
 }
 
 /// How well a fitted model describes the curve it was fitted to: the model's deviation
@@ -577,8 +603,9 @@ mod tests {
         let points = curve(Kind::Overlapping, &filtered, fs, Grid::Octave);
         let skip = filtered_points(&points);
         assert!(skip >= 2, "{skip}");
-        let (terms, identified_skip, quality) = identify(&points, Kind::Overlapping);
-        assert_eq!(identified_skip, skip);
+        let identified = identify(&points, Kind::Overlapping);
+        let (terms, quality) = (identified.terms, identified.fit);
+        assert_eq!(identified.filtered, skip);
         let all = fit(&points, Kind::Overlapping);
         let error = |n: f64| (n / n_true - 1.0).abs();
         assert!(error(terms.n.value) < 0.05, "{:?}", terms.n);
