@@ -810,4 +810,33 @@ fn denoise_cleans_white_noise_off_a_record_and_refuses_bad_settings() {
         assert!(log.contains(message), "{flag}: {log}");
         assert!(!output.exists(), "{flag}: nothing written");
     }
+    // A file of someone else's at --output is refused and kept, for denoise and filter alike;
+    // --force replaces it. (The command's own earlier output is replaced without it, above.)
+    std::fs::write(&output, "my notes\n").unwrap();
+    for command in [
+        vec![
+            "denoise",
+            "--input",
+            input,
+            "--output",
+            out,
+            "--rate",
+            "100",
+            "--overlap",
+            "4",
+        ],
+        vec!["filter", "--input", input, "--output", out, "--fs", "100"],
+    ] {
+        let result = gyrofx(&command);
+        let log = text(&result);
+        assert_eq!(result.status.code(), Some(2), "{command:?}: {log}");
+        assert!(log.contains("exists and gyrofx did not write it"), "{log}");
+        assert_eq!(std::fs::read_to_string(&output).unwrap(), "my notes\n");
+    }
+    let mut forced = vec!["denoise", "--input", input, "--output", out, "--force"];
+    forced.extend_from_slice(&settings);
+    ok(&forced);
+    assert!(std::fs::read_to_string(&output)
+        .unwrap()
+        .starts_with("sample,rate_dps,denoised_dps\n"));
 }

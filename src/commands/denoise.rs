@@ -61,7 +61,13 @@ pub struct Args {
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
+    /// Replace an existing --output file even when gyrofx did not write it.
+    #[arg(long)]
+    force: bool,
 }
+
+/// The output CSV's first line: how an earlier output of `denoise` is known.
+const HEADER: &str = "sample,rate_dps,denoised_dps";
 
 /// The checked settings of a run.
 struct Settings {
@@ -138,6 +144,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
     let column = args.csv.column()?;
     let inputs = [("--input", Some(args.csv.input.as_path()))];
     check_output("--output", &args.output, false, &inputs)?;
+    super::options::check_replaceable(&args.output, HEADER, args.force)?;
     if let Some(path) = &args.plot {
         super::options::check_plot(
             path,
@@ -207,7 +214,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
 /// `sample,rate_dps,denoised_dps`, one row per sample (shortest round-trip decimals).
 fn write_csv(file: &mut std::fs::File, input: &[f64], denoised: &[f64]) -> std::io::Result<()> {
     let mut out = BufWriter::new(file);
-    writeln!(out, "sample,rate_dps,denoised_dps")?;
+    writeln!(out, "{HEADER}")?;
     let mut a = ryu::Buffer::new();
     let mut b = ryu::Buffer::new();
     for (k, (x, y)) in input.iter().zip(denoised).enumerate() {

@@ -45,8 +45,8 @@ pub struct Args {
     /// recording's SHA-256.
     #[arg(long)]
     vectors: Option<PathBuf>,
-    /// Replace the --vectors folder even when gyrofx did not write it.
-    #[arg(long, requires = "vectors")]
+    /// Replace an existing --output file or --vectors folder even when gyrofx did not write it.
+    #[arg(long)]
     force: bool,
 }
 
@@ -85,11 +85,16 @@ fn format_rows(rows: &[Row], first: usize, plan: &gyrofx_model::kf::Plan) -> Vec
 }
 
 /// The command that rewrites the vectors (as the files' generated-by line gives it).
-fn filter_provenance(job: &Job, csv: &CsvColumn, fs: f64, bandwidth: Option<f64>) -> Provenance {
+fn filter_provenance(
+    job: &Job,
+    csv: &CsvColumn,
+    column: &str,
+    fs: f64,
+    bandwidth: Option<f64>,
+) -> Provenance {
     let mut command = format!(
-        "gyrofx filter --input {} --column {} --fs {fs}",
+        "gyrofx filter --input {} --column {column} --fs {fs}",
         csv.input.display(),
-        csv.column().unwrap_or_default()
     );
     if let Some(bw) = bandwidth {
         command.push_str(&format!(" --bandwidth {bw}"));
@@ -135,6 +140,9 @@ fn flag_error(error: gyrofx_codegen::Error, fs: f64, bandwidth: Option<f64>) -> 
     }
 }
 
+/// The output CSV's first line: how an earlier output of `filter` is known.
+const HEADER: &str = "sample,z_dps,z_code,rate_code,rate_dps,float_rate_dps";
+
 /// Writes the CSV atomically (one row per sample: the input, its code, the fixed-point and the
 /// float rate) and prints a summary with the saturation and overflow counts.
 pub fn run(args: Args) -> Result<ExitCode> {
@@ -149,15 +157,17 @@ pub fn run(args: Args) -> Result<ExitCode> {
         force,
     } = args;
     check_rates(fs, bandwidth)?;
+    let column = csv.column()?;
     let output = output.as_path();
     check_outputs(&csv, config.as_deref(), output, vectors.as_deref())?;
+    super::options::check_replaceable(output, HEADER, force)?;
     let mut staged = super::options::stage_output(output, ".gyrofx-filter-")?;
     let (config, bandwidth_hz, plan) = configured(config.as_deref(), fs, bandwidth)?;
     // The vectors' folder is checked, and their files opened, before the work.
     let mut kf_vectors = match &vectors {
         Some(folder) => {
             let job = gyrofx_codegen::blocks::checked_job(config)?;
-            let provenance = filter_provenance(&job, &csv, fs, bandwidth);
+            let provenance = filter_provenance(&job, &csv, &column, fs, bandwidth);
             let package =
                 FilterPackage::create(folder, &job, &provenance, super::options::replace(force))?;
             Some((job, provenance, package))
@@ -180,7 +190,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
     if let (Some((job, provenance, package)), Some(folder)) = (kf_vectors, &vectors) {
         let recording = serde_json::json!({
             "input": csv.input.display().to_string(),
-            "column": csv.column()?,
+            "column": column,
             "sha256": gyrofx_job::hash::file_sha256(&csv.input)?,
             "samples": values.len(),
             "fs_hz": fs,
@@ -306,7 +316,8 @@ fn filter(
         let (send, receive) = std::sync::mpsc::sync_channel::<Vec<u8>>(2 * cores);
         // The parts are large: written as they are, not copied through a buffer.
         let writer = scope.spawn(move || -> std::io::Result<()> {
-            file.write_all(b"sample,z_dps,z_code,rate_code,rate_dps,float_rate_dps\n")?;
+            file.write_all(HEADER.as_bytes())?;
+            file.write_all(b"\n")?;
             for part in receive {
                 file.write_all(&part)?;
             }

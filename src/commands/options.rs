@@ -353,3 +353,36 @@ pub fn stage_output(output: &Path, prefix: &str) -> Result<tempfile::NamedTempFi
         )
     })
 }
+
+/// Refuses, before any work, an existing `--output` file gyrofx did not write: one whose first
+/// line is not `header` (the line the command writes first), unless `force`. A missing file,
+/// or the command's own earlier output, may be replaced.
+pub fn check_replaceable(output: &Path, header: &str, force: bool) -> Result<()> {
+    use std::io::Read as _;
+    if force {
+        return Ok(());
+    }
+    let meta = match std::fs::symlink_metadata(output) {
+        Ok(meta) => meta,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => anyhow::bail!("--output {}: {e}", output.display()),
+    };
+    if !meta.is_file() {
+        usage!(
+            "--output {} exists and is not a regular file: choose another --output",
+            output.display()
+        );
+    }
+    let mut start = vec![0u8; header.len() + 1];
+    let read = std::fs::File::open(output)
+        .and_then(|mut file| file.read(&mut start))
+        .map_err(|e| anyhow::anyhow!("--output {}: {e}", output.display()))?;
+    if start[..read] == *format!("{header}\n").as_bytes() {
+        return Ok(());
+    }
+    usage!(
+        "--output {} exists and gyrofx did not write it (its first line is not {header}): choose \
+         another --output, or give --force to replace it",
+        output.display()
+    )
+}

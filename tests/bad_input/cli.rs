@@ -413,12 +413,6 @@ fn output_paths_are_checked_before_the_work_and_no_flag_is_ignored() {
     for (args, needle) in [
         (vec!["formats", "--force"], "--write"),
         (
-            vec![
-                "filter", "--input", &csv, "--fs", "100", "--output", out, "--force",
-            ],
-            "--vectors",
-        ),
-        (
             vec!["generate", "--out", out, "--recording-units", "rad/s"],
             "--recording",
         ),
