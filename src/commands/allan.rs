@@ -318,7 +318,7 @@ impl std::fmt::Display for Series<'_> {
         }
         writeln!(
             f,
-            "noise terms (weighted non-negative fit of the {} variance's model, ±1 standard error):",
+            "noise terms (weighted non-negative fit of the {} variance's model; ±1σ intervals that count the correlation between τ):",
             format!("{kind:?}").to_lowercase()
         )?;
         let id = &self.analysis.identification;
