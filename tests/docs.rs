@@ -3,6 +3,8 @@
 //! help line fits 100 columns, every guide page is in the summary and every relative link in
 //! the README and the guide resolves, the README stays short, and the licence files exist.
 
+mod api_reference;
+
 use std::path::{Path, PathBuf};
 
 use crate::common::*;
