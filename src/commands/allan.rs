@@ -185,7 +185,8 @@ struct Analysis {
     report: noise::Report,
     /// How well the fitted model follows the points it was fitted to.
     fit: noise::FitQuality,
-    /// The τ (s) below which the sensor's filtering bends the curve, kept out of the fit.
+    /// The τ (s) below which the curve does not follow the five terms (the sensor's filtering,
+    /// a tone), kept out of the fit.
     filtered_below_tau_s: Option<f64>,
     /// Which terms the curve shows; upper bounds of the others.
     identification: noise::Identification,
@@ -376,14 +377,22 @@ impl std::fmt::Display for Series<'_> {
         if let Some(tau) = self.analysis.filtered_below_tau_s {
             writeln!(
                 f,
-                "  the sensor's filtering bends the curve below τ = {tau} s (slope above −0.45): those points are kept out of the fit"
+                "  below τ = {tau} s the curve does not follow the five terms (the sensor's filtering bends it, or a tone): those points are kept out of the fit"
             )?;
         }
         writeln!(
             f,
             "  fit: the model lies outside the 1σ band at {} of {} fitted τ; furthest at τ = {} s, model/measured = {:.3}",
             fit.outside_band, fit.points, fit.worst_tau_s, fit.worst_model_over_measured
-        )
+        )?;
+        if fit.model_error > 0.0 {
+            writeln!(
+                f,
+                "  the points scatter about the model by {:.1} % of their variance beyond their own χ² spread: the weights and the intervals include it",
+                100.0 * fit.model_error
+            )?;
+        }
+        Ok(())
     }
 }
 

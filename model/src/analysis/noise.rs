@@ -15,6 +15,12 @@
 //! `(AᵀWA)⁻¹ AᵀWΣWA (AᵀWA)⁻¹` with the estimates' correlation in `Σ` ([`estimate_correlation`],
 //! from the fitted model), whose intervals cover about 68 % (a Monte Carlo test holds them).
 //!
+//! Real curves are not exactly five power laws: where the points scatter about the best model
+//! by more than their χ² spread, each point's variance gets a relative model error ε (chosen
+//! so that χ² equals its degrees of freedom, Paule and Mandel's consensus estimate), so that
+//! the shortest τ, with EDFs of 10⁵, do not decide the long-τ terms ([`fit`]); and
+//! [`identify`] leaves out leading τ that the terms do not describe.
+//!
 //! A term is only identifiable where it dominates the curve over a few octaves: with RRW
 //! below the flicker floor until the last octaves (few terms, small EDF), K and R trade off
 //! there (a record with B = 10 °/h and K = 30 °/h/√h gave K 39 % low and a spurious R).
@@ -222,46 +228,59 @@ fn fit_allowed(curve: &[Point], kind: Kind, allowed: [bool; 5]) -> Terms {
     // units would overflow (σ ≈ 1e-71 °/s), and the sandwich squares them again.
     let scale = curve.iter().map(|p| p.dev * p.dev).fold(0.0, f64::max);
     let variances: Vec<f64> = curve.iter().map(|p| p.dev * p.dev / scale).collect();
-    let weight =
-        |p: &Point, variance: f64| p.edf / (2.0 * variance * variance).max(f64::MIN_POSITIVE);
-    let mut weights: Vec<f64> = curve
-        .iter()
-        .zip(&variances)
-        .map(|(p, v)| weight(p, *v))
-        .collect();
+    let edf: Vec<f64> = curve.iter().map(|p| p.edf).collect();
     let free: u32 = (0..count).filter(|j| allowed[*j]).map(|j| 1 << j).sum();
-    let mut best = best_subset(&bases, &variances, &weights, free);
-    for _ in 0..REWEIGHTINGS {
-        let Some(candidate) = &best else { break };
-        let modelled: Vec<f64> = bases
-            .iter()
-            .map(|b| {
-                candidate
-                    .active
-                    .iter()
-                    .zip(candidate.c.iter())
-                    .map(|(j, c)| b[*j] * c)
-                    .sum()
-            })
-            .collect();
-        if modelled.iter().any(|v: &f64| v.is_nan() || *v <= 0.0) {
-            break;
+    let problem = Problem {
+        bases: &bases,
+        variances: &variances,
+        edf: &edf,
+        free,
+    };
+    let mut fitted = problem.reweighted(0.0);
+    // The model's error beyond the points' own: where the points scatter about the best model
+    // by more than their χ² spread allows (χ² above its degrees of freedom), each point's
+    // variance gets a relative error ε, chosen so that χ² equals its degrees of freedom (Paule
+    // and Mandel's consensus estimate). Without it the shortest τ, with EDFs of 10⁵, hold the
+    // fit to the exact shape of a curve the five terms do not quite describe, and a real
+    // record's long-τ terms came out as whatever balanced that (B 0 beside K 225 °/h/√h).
+    let mut model_error = 0.0;
+    if let Some((chi2, dof)) = fitted.as_ref().map(|f| f.chi2_and_dof(&problem)) {
+        if dof > 0.0 && chi2 > dof {
+            model_error = relative_model_error(|epsilon| {
+                problem.reweighted(epsilon * epsilon).map_or(0.0, |f| {
+                    let (chi2, dof) = f.chi2_and_dof(&problem);
+                    chi2 - dof
+                })
+            });
+            fitted = problem.reweighted(model_error * model_error);
         }
-        weights = curve
-            .iter()
-            .zip(&modelled)
-            .map(|(p, v)| weight(p, *v))
-            .collect();
-        best = best_subset(&bases, &variances, &weights, free);
     }
-    if let Some(Candidate {
-        active,
-        c,
-        covariance,
-        ..
-    }) = best
+    if let Some(Fitted {
+        candidate:
+            Candidate {
+                active,
+                c,
+                covariance,
+                ..
+            },
+        weights,
+        sampling,
+        modelled,
+    }) = fitted
     {
-        let covariance = sandwich(curve, kind, &weights, &active, &c, &covariance);
+        let extra: Vec<f64> = modelled.iter().map(|v| (model_error * v).powi(2)).collect();
+        let covariance = sandwich(
+            curve,
+            kind,
+            &Variances {
+                weights: &weights,
+                sampling: &sampling,
+                extra: &extra,
+            },
+            &active,
+            &c,
+            &covariance,
+        );
         for (k, j) in active.iter().enumerate() {
             let sigma = covariance[(k, k)].max(0.0).sqrt();
             terms[*j] = Estimate {
@@ -272,6 +291,111 @@ fn fit_allowed(curve: &[Point], kind: Kind, allowed: [bool; 5]) -> Terms {
         }
     }
     finish(terms)
+}
+
+/// The relative error `ε` (0..=1) at which `excess(ε)` (a `χ²` less its degrees of freedom,
+/// falling as `ε` grows) reaches 0, by bisection; 1 if it never does.
+fn relative_model_error(excess: impl Fn(f64) -> f64) -> f64 {
+    let (mut lo, mut hi) = (0.0f64, 1.0f64);
+    for _ in 0..50 {
+        let mid = 0.5 * (lo + hi);
+        if excess(mid) > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    hi
+}
+
+/// One curve to fit, in the fit's scaled units.
+struct Problem<'a> {
+    /// Each point's basis row.
+    bases: &'a [[f64; 5]],
+    /// Each point's measured variance.
+    variances: &'a [f64],
+    /// Each point's equivalent degrees of freedom.
+    edf: &'a [f64],
+    /// The terms free to be fitted (a bit each).
+    free: u32,
+}
+
+/// A fit with the weights it was made with.
+struct Fitted {
+    candidate: Candidate,
+    /// `1/(sampling + extra)` per point.
+    weights: Vec<f64>,
+    /// Each point's χ² variance about the model, `2v²/edf`.
+    sampling: Vec<f64>,
+    /// The model's variance at each point.
+    modelled: Vec<f64>,
+}
+
+impl Problem<'_> {
+    /// The model variance of `candidate` at each point.
+    fn modelled(&self, candidate: &Candidate) -> Vec<f64> {
+        self.bases
+            .iter()
+            .map(|b| {
+                candidate
+                    .active
+                    .iter()
+                    .zip(candidate.c.iter())
+                    .map(|(j, c)| b[*j] * c)
+                    .sum()
+            })
+            .collect()
+    }
+
+    /// The fit with each point weighted by `1/(2v²/edf + ε² v²)`, `v` first the measured
+    /// variance and then, [`REWEIGHTINGS`] times, the previous fit's model.
+    fn reweighted(&self, epsilon2: f64) -> Option<Fitted> {
+        let weigh = |v: &[f64]| -> (Vec<f64>, Vec<f64>) {
+            v.iter()
+                .zip(self.edf)
+                .map(|(v, edf)| {
+                    let sampling = 2.0 * v * v / edf;
+                    let weight = 1.0 / (sampling + epsilon2 * v * v).max(f64::MIN_POSITIVE);
+                    (sampling, weight)
+                })
+                .unzip()
+        };
+        let (mut sampling, mut weights) = weigh(self.variances);
+        let mut candidate = best_subset(self.bases, self.variances, &weights, self.free)?;
+        let mut modelled = self.modelled(&candidate);
+        for _ in 0..REWEIGHTINGS {
+            if modelled.iter().any(|v| v.is_nan() || *v <= 0.0) {
+                break;
+            }
+            (sampling, weights) = weigh(&modelled);
+            let Some(next) = best_subset(self.bases, self.variances, &weights, self.free) else {
+                break;
+            };
+            candidate = next;
+            modelled = self.modelled(&candidate);
+        }
+        Some(Fitted {
+            candidate,
+            weights,
+            sampling,
+            modelled,
+        })
+    }
+}
+
+impl Fitted {
+    /// The weighted residual `χ²` and its degrees of freedom (points less active terms).
+    fn chi2_and_dof(&self, problem: &Problem<'_>) -> (f64, f64) {
+        let chi2 = problem
+            .variances
+            .iter()
+            .zip(&self.modelled)
+            .zip(&self.weights)
+            .map(|((y, m), w)| w * (y - m) * (y - m))
+            .sum();
+        let dof = problem.variances.len() as f64 - self.candidate.active.len() as f64;
+        (chi2, dof)
+    }
 }
 
 /// The non-negative weighted least-squares solution over the terms in the bit mask `free`:
@@ -337,10 +461,19 @@ const SANDWICH_POINTS: usize = 64;
 /// counted: `(AᵀWA)⁻¹ AᵀWΣWA (AᵀWA)⁻¹`, `Σ` from each point's variance `1/w` and
 /// [`estimate_correlation`] under the fitted model, `weights` the fit's `W`. `weighted_inverse` is `(AᵀWA)⁻¹` of the
 /// whole curve; on a curve thinned to [`SANDWICH_POINTS`] both factors are the thinned curve's.
+/// Each point's variance about the model, in two parts, and the weight the fit gave it.
+struct Variances<'a> {
+    weights: &'a [f64],
+    /// The estimate's own (χ²) variance: correlated between points.
+    sampling: &'a [f64],
+    /// The model's error: independent between points.
+    extra: &'a [f64],
+}
+
 fn sandwich(
     curve: &[Point],
     kind: Kind,
-    weights: &[f64],
+    variances: &Variances<'_>,
     active: &[usize],
     c: &DVector<f64>,
     weighted_inverse: &DMatrix<f64>,
@@ -372,7 +505,7 @@ fn sandwich(
             let p = &curve[i];
             let b = basis(kind, p.tau_s, p.m);
             (
-                weights[i],
+                variances.weights[i],
                 DVector::from_iterator(k, active.iter().map(|j| b[*j])),
             )
         })
@@ -389,12 +522,15 @@ fn sandwich(
             None => return weighted_inverse.clone(),
         }
     };
+    // AᵀWΣWA, Σ_xy = ρ_xy √(S_x S_y) + δ_xy E_x.
     let mut middle = DMatrix::<f64>::zeros(k, k);
     for (x, (wx, ax)) in rows.iter().enumerate() {
+        let (sx, ex) = (variances.sampling[picks[x]], variances.extra[picks[x]]);
         for (y, (wy, ay)) in rows.iter().enumerate() {
-            let r = rho[(x, y)];
-            if r != 0.0 {
-                middle += ax * ay.transpose() * (r * (wx * wy).sqrt());
+            let sy = variances.sampling[picks[y]];
+            let covariance = rho[(x, y)] * (sx * sy).sqrt() + if x == y { ex } else { 0.0 };
+            if covariance != 0.0 {
+                middle += ax * ay.transpose() * (wx * wy * covariance);
             }
         }
     }
@@ -539,7 +675,8 @@ pub fn identification(curve: &[Point], terms: &Terms, kind: Kind) -> Identificat
 pub struct Identified {
     /// The terms fitted to the points past the sensor's filtering.
     pub terms: Terms,
-    /// Leading points left out ([`filtered_points`]).
+    /// Leading points left out: the low-pass bend ([`filtered_points`]) and any shortest τ
+    /// past it that the five terms do not describe (see [`identify`]).
     pub filtered: usize,
     /// How well the model follows the points it was fitted to.
     pub fit: FitQuality,
@@ -548,18 +685,44 @@ pub struct Identified {
 }
 
 /// What `gyrofx allan` reports of a curve: the fit to the points past the sensor's own
-/// filtering, how well it follows them, and which terms they show.
+/// filtering (and past any shortest τ the five terms do not describe), how well it follows
+/// them, and which terms they show.
 pub fn identify(curve: &[Point], kind: Kind) -> Identified {
-    let filtered = filtered_points(curve);
+    let bent = filtered_points(curve);
+    let at = |cut: usize| {
+        let fitted = &curve[cut..];
+        let terms = fit(fitted, kind);
+        (terms, fit_quality(fitted, &terms, kind))
+    };
+    // Past the low-pass bend, the shortest τ may still not follow the five terms (a tone at a
+    // fraction of the rate holds the deviation flat for an octave, then drops it at slope −1):
+    // leading points are left out while that lowers the model's error by more than
+    // [`MODEL_ERROR_TOLERANCE`] against the best cut, at most a third of the curve.
+    let last = (curve.len() / 3).max(bent);
+    let fits: Vec<(Terms, FitQuality)> = (bent..=last).map(at).collect();
+    let least = fits
+        .iter()
+        .map(|(_, q)| q.model_error)
+        .fold(f64::INFINITY, f64::min);
+    let chosen = fits
+        .iter()
+        .position(|(_, q)| q.model_error <= least + MODEL_ERROR_TOLERANCE)
+        .unwrap_or(0);
+    let filtered = bent + chosen;
+    let (terms, fit) = fits[chosen];
     let fitted = &curve[filtered..];
-    let terms = fit(fitted, kind);
     Identified {
         terms,
         filtered,
-        fit: fit_quality(fitted, &terms, kind),
+        fit,
         identification: identification(fitted, &terms, kind),
     }
 }
+
+/// How much more relative model error ([`FitQuality::model_error`]) a fit over more of the
+/// curve's shortest τ may have than the best cut and still be kept: the spread of the error
+/// over records the model describes (on simulated records it stays below 0.02).
+pub const MODEL_ERROR_TOLERANCE: f64 = 0.02;
 
 /// How well a fitted model describes the curve it was fitted to: the model's deviation
 /// against each point's 1σ confidence band.
@@ -573,6 +736,10 @@ pub struct FitQuality {
     pub worst_tau_s: f64,
     /// The model's deviation over the measured one there (1: exact; 1.76: 76 % above).
     pub worst_model_over_measured: f64,
+    /// How far the points scatter about the model beyond their own χ² spread, as a relative
+    /// error of each point's variance (0: within it; 0.05: 5 %): the `ε` at which
+    /// `Σ (σ̂² − σ²)² / (2σ⁴/edf + ε²σ⁴)` equals the points less the fitted terms.
+    pub model_error: f64,
 }
 
 /// [`FitQuality`] of `terms` on `curve` (of `kind`): the model `Σ c_j basis_j` at each point.
@@ -584,6 +751,7 @@ pub fn fit_quality(curve: &[Point], terms: &Terms, kind: Kind) -> FitQuality {
         outside_band: 0,
         worst_tau_s: curve.first().map_or(f64::NAN, |p| p.tau_s),
         worst_model_over_measured: 1.0,
+        model_error: 0.0,
     };
     let mut worst = 0.0;
     for p in curve {
@@ -605,6 +773,30 @@ pub fn fit_quality(curve: &[Point], terms: &Terms, kind: Kind) -> FitQuality {
             quality.worst_tau_s = p.tau_s;
             quality.worst_model_over_measured = ratio;
         }
+    }
+    // The model's variance and the χ² spread about it, per point.
+    let rows: Vec<(f64, f64, f64)> = curve
+        .iter()
+        .map(|p| {
+            let model: f64 = basis(kind, p.tau_s, p.m)
+                .iter()
+                .zip(&c)
+                .map(|(b, c)| b * c)
+                .sum();
+            (p.dev * p.dev, model, 2.0 * model * model / p.edf)
+        })
+        .collect();
+    let terms_fitted = c.iter().filter(|c| **c > 0.0).count();
+    let dof = curve.len() as f64 - terms_fitted as f64;
+    let excess = |epsilon: f64| {
+        let chi2: f64 = rows
+            .iter()
+            .map(|(y, m, s)| (y - m) * (y - m) / (s + epsilon * epsilon * m * m))
+            .sum();
+        chi2 - dof
+    };
+    if dof > 0.0 && rows.iter().all(|(_, m, _)| *m > 0.0) && excess(0.0) > 0.0 {
+        quality.model_error = relative_model_error(excess);
     }
     quality
 }
@@ -776,6 +968,42 @@ mod tests {
         assert_eq!(filtered_points(&points), 0);
     }
 
+    /// A record shaped like the ADIS16405 records of `SMAC-Group/imudata` (100 Hz, ARW about
+    /// 2.5 °/√h, B 30-45 °/h, RRW up to 150 °/h/√h, a 0.05 °/s LSB, a short averaging filter
+    /// before the output, and on the z axes a tone at a quarter of the rate that holds the
+    /// deviation flat from 0.01 to 0.02 s): the fit finds N and B with the model's error
+    /// counted. Fitted with the shortest τ's EDFs of 10⁵ holding it to a shape the five terms
+    /// do not have, such records gave B = 0 beside a large K.
+    #[test]
+    fn a_record_shaped_like_a_mems_imu_gives_its_terms() {
+        let lsb = 0.05;
+        for seed in [41, 42, 43] {
+            let raw = record_in_band(2.5, 35.0, 100.0, 1 << 19, seed, (0.02, 20_000.0));
+            // A 4-tap moving average (the sensor's Bartlett filter shortened), then the LSB.
+            let filtered: Vec<f64> = (0..raw.len())
+                .map(|i| {
+                    let taps = &raw[i.saturating_sub(3)..=i];
+                    let mean = taps.iter().sum::<f64>() / taps.len() as f64;
+                    let tone = 0.35 * [1.0, 1.0, -1.0, -1.0][i % 4];
+                    ((mean + tone) / lsb).round() * lsb
+                })
+                .collect();
+            let points = curve(Kind::Overlapping, &filtered, 100.0, Grid::Octave);
+            let id = identify(&points, Kind::Overlapping);
+            let r = report(&points, &id.terms, Kind::Overlapping);
+            let n = r.arw_deg_per_sqrt_h.value;
+            let b = r.bias_instability_deg_per_h.value;
+            assert!((n / 2.5 - 1.0).abs() < 0.05, "seed {seed}: N {n}: {r:?}");
+            assert!((b / 35.0 - 1.0).abs() < 0.3, "seed {seed}: B {b}: {r:?}");
+            assert!(
+                id.identification.identified[1] && id.identification.identified[2],
+                "seed {seed}: {:?} {r:?} {:?}",
+                id.identification,
+                id.fit
+            );
+        }
+    }
+
     #[test]
     fn white_noise_identifies_n_only_and_bounds_the_rest() {
         let mut g =
@@ -890,6 +1118,10 @@ mod coverage {
         covered: usize,
         identified: usize,
         records: usize,
+        /// Leading points left out, summed over the records.
+        left_out: usize,
+        /// The largest model error of a record.
+        model_error: f64,
     }
 
     /// Identifies `records` simulated records of the terms `truth` (N, B, K in report units)
@@ -900,6 +1132,8 @@ mod coverage {
             covered: 0,
             identified: 0,
             records: 0,
+            left_out: 0,
+            model_error: 0.0,
         });
         for seed in 0..records {
             let y = record(truth[0], truth[1], truth[2], samples, 1000 + seed);
@@ -925,6 +1159,8 @@ mod coverage {
                     )
                 };
                 outcome[i].records += 1;
+                outcome[i].left_out += id.filtered;
+                outcome[i].model_error = outcome[i].model_error.max(id.fit.model_error);
                 outcome[i].identified += usize::from(shown);
                 outcome[i].covered += usize::from(lo <= truth[i] && truth[i] <= hi);
             }
@@ -947,11 +1183,13 @@ mod coverage {
             for (i, o) in outcome.iter().enumerate().filter(|(_, o)| o.records > 0) {
                 let rate = o.covered as f64 / o.records as f64;
                 println!(
-                    "{label}, {samples} samples: {} = {}: covered in {:.0} % of records, identified in {}",
+                    "{label}, {samples} samples: {} = {}: covered in {:.0} % of records, identified in {}; points left out {}, model error at most {:.3}",
                     names[i],
                     truth[i],
                     100.0 * rate,
-                    o.identified
+                    o.identified,
+                    o.left_out,
+                    o.model_error
                 );
                 assert!(
                     (0.55..=0.82).contains(&rate),
