@@ -696,10 +696,20 @@ pub fn identify(curve: &[Point], kind: Kind) -> Identified {
     };
     // Past the low-pass bend, the shortest τ may still not follow the five terms (a tone at a
     // fraction of the rate holds the deviation flat for an octave, then drops it at slope −1):
-    // leading points are left out while that lowers the model's error by more than
+    // leading octaves are left out while that lowers the model's error by more than
     // [`MODEL_ERROR_TOLERANCE`] against the best cut, at most a third of the curve.
     let last = (curve.len() / 3).max(bent);
-    let fits: Vec<(Terms, FitQuality)> = (bent..=last).map(at).collect();
+    // Cuts an octave apart (at most CUT_OCTAVES of them), whatever the grid's density.
+    let start = curve.get(bent).map_or(0.0, |p| p.tau_s);
+    let mut cuts: Vec<usize> = (0..=CUT_OCTAVES)
+        .map(|octave| {
+            let tau = start * f64::from(1u32 << octave);
+            bent + curve[bent..].iter().take_while(|p| p.tau_s < tau).count()
+        })
+        .filter(|cut| *cut <= last)
+        .collect();
+    cuts.dedup();
+    let fits: Vec<(Terms, FitQuality)> = cuts.iter().map(|cut| at(*cut)).collect();
     let least = fits
         .iter()
         .map(|(_, q)| q.model_error)
@@ -708,7 +718,7 @@ pub fn identify(curve: &[Point], kind: Kind) -> Identified {
         .iter()
         .position(|(_, q)| q.model_error <= least + MODEL_ERROR_TOLERANCE)
         .unwrap_or(0);
-    let filtered = bent + chosen;
+    let filtered = cuts[chosen];
     let (terms, fit) = fits[chosen];
     let fitted = &curve[filtered..];
     Identified {
@@ -718,6 +728,9 @@ pub fn identify(curve: &[Point], kind: Kind) -> Identified {
         identification: identification(fitted, &terms, kind),
     }
 }
+
+/// Octaves past the low-pass bend that [`identify`] tries leaving out, at most.
+const CUT_OCTAVES: u32 = 6;
 
 /// How much more relative model error ([`FitQuality::model_error`]) a fit over more of the
 /// curve's shortest τ may have than the best cut and still be kept: the spread of the error
