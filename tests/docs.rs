@@ -4,6 +4,7 @@
 //! the README and the guide resolves, the README stays short, and the licence files exist.
 
 mod api_reference;
+mod manifest_schema;
 
 use std::path::{Path, PathBuf};
 
