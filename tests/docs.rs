@@ -2,8 +2,11 @@
 //! generated from it (a stale page fails here; `GYROFX_UPDATE_DOCS=1` rewrites them), every
 //! help line fits 100 columns, every guide page is in the summary and every relative link in
 //! the README and the guide resolves, the README stays short, and the licence files exist.
+//! The figures the guide quotes are held to the code in [`figures`]; the API references and
+//! the manifest schema are generated in [`api_reference`] and [`manifest_schema`].
 
 mod api_reference;
+mod figures;
 mod manifest_schema;
 
 use std::path::{Path, PathBuf};

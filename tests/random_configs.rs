@@ -8,7 +8,7 @@
 //! whatever the config, and of what the configs vary only the rounding and overflow reach its
 //! datapath (the seed changes just the noise it sees): it runs once for each pair the run
 //! draws (in the first config that draws it), not once per config.
-//! The wide sweep, offline (the guide's bit-exactness page gives the figures of the last one):
+//! The wide sweep, offline (the guide's benchmarks page gives the figures of the last one):
 //! `GYROFX_RANDOM_CONFIGS=<per test> GYROFX_RANDOM_SAMPLES=100000
 //! GYROFX_RANDOM_SIMULATORS=iverilog,verilator,ghdl cargo test --release --test main random_configs::`
 

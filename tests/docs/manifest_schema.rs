@@ -170,7 +170,9 @@ fn schema_page(manifest: &Value) -> String {
     page
 }
 
-fn golden_manifest() -> Value {
+/// The golden package's manifest (`vectors/manifest.json`: the default config's package, which
+/// `tests/golden.rs` holds to what `generate` writes).
+pub(super) fn golden_manifest() -> Value {
     let text = std::fs::read(repository().join("vectors/manifest.json")).unwrap();
     serde_json::from_slice(&text).unwrap()
 }
