@@ -13,7 +13,9 @@
 #
 # Builds the library (cargo build --release -p gyrofx-capi) unless --from names a folder that
 # holds libgyrofx_capi.a (and .so) already. A file already at a destination is refused unless
-# --force: the script replaces only what you say it may.
+# --force: the script replaces only what you say it may. Every file is written beside its
+# destination first and renamed into place only when all are written, so an error or a signal
+# leaves the prefix as it was (the staged copies removed, the folders it made removed when empty).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 usage() { echo "usage: scripts/install-capi.sh PREFIX [--from DIR] [--force]" >&2; exit 2; }
@@ -48,10 +50,40 @@ if [ "$force" -eq 0 ]; then
         fi
     done
 fi
+made=()
+for folder in "$prefix" "$prefix/lib" "$prefix/lib/pkgconfig" "$prefix/include"; do
+    [ -d "$folder" ] || made+=("$folder")
+done
+staged=()
+finished=0
+cleanup() {
+    for file in "${staged[@]}"; do rm -f "$file"; done
+    if [ "$finished" -eq 0 ]; then
+        for ((i = ${#made[@]} - 1; i >= 0; i--)); do rmdir "${made[$i]}" 2>/dev/null || true; done
+    fi
+}
+trap cleanup EXIT
+trap 'exit 130' INT TERM
 mkdir -p "$prefix/lib/pkgconfig" "$prefix/include"
-install -m 644 "$from/libgyrofx_capi.a" "$prefix/lib/libgyrofx_capi.a"
-[ -f "$from/libgyrofx_capi.so" ] && install -m 755 "$from/libgyrofx_capi.so" "$prefix/lib/libgyrofx_capi.so"
-install -m 644 capi/include/gyrofx.h "$prefix/include/gyrofx.h"
-sed -e "s|@PREFIX@|$prefix|" -e "s|@VERSION@|$version|" capi/gyrofx_capi.pc.in \
-    > "$prefix/lib/pkgconfig/gyrofx_capi.pc"
+# stage SOURCE MODE DESTINATION: the file written as DESTINATION.gyrofx-install.<pid>.
+stage() {
+    local copy="$3.gyrofx-install.$$"
+    staged+=("$copy")
+    install -m "$2" "$1" "$copy"
+}
+stage "$from/libgyrofx_capi.a" 644 "$prefix/lib/libgyrofx_capi.a"
+[ -f "$from/libgyrofx_capi.so" ] && stage "$from/libgyrofx_capi.so" 755 "$prefix/lib/libgyrofx_capi.so"
+stage capi/include/gyrofx.h 644 "$prefix/include/gyrofx.h"
+pc="$(mktemp)"
+staged+=("$pc")
+sed -e "s|@PREFIX@|$prefix|" -e "s|@VERSION@|$version|" capi/gyrofx_capi.pc.in > "$pc"
+stage "$pc" 644 "$prefix/lib/pkgconfig/gyrofx_capi.pc"
+if [ -n "${GYROFX_INSTALL_FAIL_BEFORE_RENAME:-}" ]; then
+    echo "FAIL: stopped before the renames (GYROFX_INSTALL_FAIL_BEFORE_RENAME, for the tests)" >&2
+    exit 1
+fi
+for file in "${files[@]}"; do
+    mv -f "$prefix/$file.gyrofx-install.$$" "$prefix/$file"
+done
+finished=1
 echo "installed gyrofx_capi $version under $prefix"

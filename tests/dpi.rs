@@ -368,8 +368,9 @@ fn every_dpi_import_is_the_c_headers_function_in_dpi_types() {
 }
 
 /// `scripts/install-capi.sh` installs the library, the header and a pkg-config file under a
-/// prefix; `pkg-config` then gives the flags that build `check_api.c` against the installed
-/// copy, which runs. A second install over it is refused without `--force`.
+/// prefix, all or nothing (a run stopped before its renames leaves no file and no folder);
+/// `pkg-config` then gives the flags that build `check_api.c` against the installed copy,
+/// which runs. A second install over it is refused without `--force`.
 #[test]
 fn the_installed_library_builds_a_c_program_through_pkg_config() {
     let dir = tempfile::tempdir().unwrap();
@@ -381,6 +382,16 @@ fn the_installed_library_builds_a_c_program_through_pkg_config() {
         command.arg(&prefix).arg("--from").arg(&from).args(extra);
         text(&command.output().unwrap())
     };
+    // A run stopped after staging every file leaves nothing behind: no file, no folder.
+    let mut failing = Command::new(&script);
+    failing
+        .arg(&prefix)
+        .arg("--from")
+        .arg(&from)
+        .env("GYROFX_INSTALL_FAIL_BEFORE_RENAME", "1");
+    let failed = failing.output().unwrap();
+    assert!(!failed.status.success(), "{}", text(&failed));
+    assert!(!prefix.exists(), "{}: {}", prefix.display(), text(&failed));
     let log = install(&[]);
     assert!(log.contains("installed gyrofx_capi"), "{log}");
     assert!(prefix.join("include/gyrofx.h").is_file());
