@@ -164,6 +164,20 @@ impl ModeFigures {
             * (self.k_xy * libm::cos(self.phase_error)
                 - self.drive_angular_frequency * damping * libm::sin(self.phase_error))
     }
+
+    /// The phase error (rad, in (−π, π]) that a mode's zero-rate outputs imply: with
+    /// `A = k_xy` and `C = w d_xy`, `Q + iI = (q0/|Z|)(A + iC) e^{iφ}` at `Ω = 0`, so
+    /// `φ = arg(Q + iI) − arg(A + iC)`. `in_phase` and `quadrature` are in one unit (m, or both
+    /// divided by one scale factor, as the loop's rate and quadrature outputs are): their
+    /// common gain cancels. This is how the phase a loop realizes is read from its outputs
+    /// (issue 32), whatever phase this mode's figures were made with.
+    pub fn phase_from_outputs(&self, in_phase: f64, quadrature: f64) -> f64 {
+        let mechanical = libm::atan2(self.drive_angular_frequency * self.d_xy, self.k_xy);
+        let angle = libm::atan2(in_phase, quadrature) - mechanical;
+        // Wrapped to (−π, π].
+        let turns = libm::ceil((angle - PI) / (2.0 * PI));
+        angle - 2.0 * PI * turns
+    }
 }
 
 /// Both modes and what mode reversal leaves of the bias.
@@ -212,6 +226,30 @@ mod tests {
     use super::*;
 
     const DEG: f64 = RAD_PER_DEG;
+
+    /// The zero-rate outputs at a phase error give that phase back, in both modes, for any
+    /// common gain on them; another mode's figures (made at another phase) read it the same.
+    #[test]
+    fn the_phase_is_read_back_from_the_zero_rate_outputs() {
+        for phase_deg in [-3.0, -0.5, 0.0, 0.999, 1.0, 2.5] {
+            let mut params = ResonatorParams::paper_004();
+            params.phase_error_deg = phase_deg;
+            params.phase_error_reverse_deg = -phase_deg / 2.0;
+            let reading = Reversal::new(&ResonatorParams::paper_004());
+            for (mode, want) in [(Mode::Normal, phase_deg), (Mode::Reverse, -phase_deg / 2.0)] {
+                let f = ModeFigures::new(&params, mode);
+                let reader = match mode {
+                    Mode::Normal => reading.normal,
+                    Mode::Reverse => reading.reverse,
+                };
+                for gain in [1.0, 1e10, 1.0 / f.scale_factor] {
+                    let got =
+                        reader.phase_from_outputs(gain * f.in_phase(0.0), gain * f.quadrature(0.0));
+                    close(got / DEG, want, 1e-9, "phase read back (°)");
+                }
+            }
+        }
+    }
 
     fn close(got: f64, want: f64, tolerance: f64, what: &str) {
         assert!(
