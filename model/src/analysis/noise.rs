@@ -75,6 +75,9 @@ pub struct Terms {
     pub k: Estimate,
     /// Rate ramp, °/s².
     pub r: Estimate,
+    /// The relative model error the fit weighted each point with (0: the points scatter
+    /// within their χ² spread; see [`fit`]).
+    pub model_error: f64,
 }
 
 /// The terms in IEEE-952 units (Q µrad, N °/√h, B °/h, K °/h/√h, R °/h²) and Kalibr units.
@@ -191,11 +194,6 @@ const REWEIGHTINGS: usize = 3;
 /// # Panics
 /// On an empty curve.
 pub fn fit(curve: &[Point], kind: Kind) -> Terms {
-    fit_allowed(curve, kind, [true; 5])
-}
-
-/// [`fit`] with only the `allowed` terms free (the others held at 0).
-fn fit_allowed(curve: &[Point], kind: Kind, allowed: [bool; 5]) -> Terms {
     assert!(!curve.is_empty(), "an Allan curve to fit");
     let zero = Estimate {
         value: 0.0,
@@ -212,16 +210,17 @@ fn fit_allowed(curve: &[Point], kind: Kind, allowed: [bool; 5]) -> Terms {
     for term in terms.iter_mut().skip(count) {
         *term = unseen;
     }
-    let finish = |t: [Estimate; 5]| Terms {
+    let finish = |t: [Estimate; 5], model_error: f64| Terms {
         q: t[0],
         n: t[1],
         b: t[2],
         k: t[3],
         r: t[4],
+        model_error,
     };
     if curve.iter().all(|p| p.dev == 0.0) {
         // A constant record: no noise, and weights 1/σ⁴ that would divide by zero.
-        return finish(terms);
+        return finish(terms, 0.0);
     }
     let bases: Vec<[f64; 5]> = curve.iter().map(|p| basis(kind, p.tau_s, p.m)).collect();
     // The fit works on variances over the curve's largest: weights 1/σ⁴ of a record in tiny
@@ -229,7 +228,7 @@ fn fit_allowed(curve: &[Point], kind: Kind, allowed: [bool; 5]) -> Terms {
     let scale = curve.iter().map(|p| p.dev * p.dev).fold(0.0, f64::max);
     let variances: Vec<f64> = curve.iter().map(|p| p.dev * p.dev / scale).collect();
     let edf: Vec<f64> = curve.iter().map(|p| p.edf).collect();
-    let free: u32 = (0..count).filter(|j| allowed[*j]).map(|j| 1 << j).sum();
+    let free: u32 = (1 << count) - 1;
     let problem = Problem {
         bases: &bases,
         variances: &variances,
@@ -290,7 +289,7 @@ fn fit_allowed(curve: &[Point], kind: Kind, allowed: [bool; 5]) -> Terms {
             };
         }
     }
-    finish(terms)
+    finish(terms, model_error)
 }
 
 /// The relative error `ε` (0..=1) at which `excess(ε)` (a `χ²` less its degrees of freedom,
@@ -750,8 +749,9 @@ pub struct FitQuality {
     /// The model's deviation over the measured one there (1: exact; 1.76: 76 % above).
     pub worst_model_over_measured: f64,
     /// How far the points scatter about the model beyond their own χ² spread, as a relative
-    /// error of each point's variance (0: within it; 0.05: 5 %): the `ε` at which
-    /// `Σ (σ̂² − σ²)² / (2σ⁴/edf + ε²σ⁴)` equals the points less the fitted terms.
+    /// error of each point's variance (0: within it; 0.05: 5 %): the `ε` the fit weighted with
+    /// ([`Terms::model_error`]), at which `Σ (σ̂² − σ²)² / (2σ⁴/edf + ε²σ⁴)` equals the points
+    /// less the fitted terms.
     pub model_error: f64,
 }
 
@@ -764,7 +764,7 @@ pub fn fit_quality(curve: &[Point], terms: &Terms, kind: Kind) -> FitQuality {
         outside_band: 0,
         worst_tau_s: curve.first().map_or(f64::NAN, |p| p.tau_s),
         worst_model_over_measured: 1.0,
-        model_error: 0.0,
+        model_error: terms.model_error,
     };
     let mut worst = 0.0;
     for p in curve {
@@ -786,30 +786,6 @@ pub fn fit_quality(curve: &[Point], terms: &Terms, kind: Kind) -> FitQuality {
             quality.worst_tau_s = p.tau_s;
             quality.worst_model_over_measured = ratio;
         }
-    }
-    // The model's variance and the χ² spread about it, per point.
-    let rows: Vec<(f64, f64, f64)> = curve
-        .iter()
-        .map(|p| {
-            let model: f64 = basis(kind, p.tau_s, p.m)
-                .iter()
-                .zip(&c)
-                .map(|(b, c)| b * c)
-                .sum();
-            (p.dev * p.dev, model, 2.0 * model * model / p.edf)
-        })
-        .collect();
-    let terms_fitted = c.iter().filter(|c| **c > 0.0).count();
-    let dof = curve.len() as f64 - terms_fitted as f64;
-    let excess = |epsilon: f64| {
-        let chi2: f64 = rows
-            .iter()
-            .map(|(y, m, s)| (y - m) * (y - m) / (s + epsilon * epsilon * m * m))
-            .sum();
-        chi2 - dof
-    };
-    if dof > 0.0 && rows.iter().all(|(_, m, _)| *m > 0.0) && excess(0.0) > 0.0 {
-        quality.model_error = relative_model_error(excess);
     }
     quality
 }
