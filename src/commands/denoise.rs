@@ -119,16 +119,18 @@ fn settings(args: &Args) -> Result<Settings> {
     })
 }
 
-/// One record's deviation and fitted terms.
+/// One record's deviation and identified terms.
 struct Deviation {
     points: Vec<Point>,
     terms: Terms,
     report: noise::Report,
 }
 
+/// The same identification as `gyrofx allan` gives on the file (filtered shortest τ left out,
+/// the model's error counted), so that the before and after figures read as `allan`'s do.
 fn deviation(values: &[f64], rate: f64) -> Deviation {
     let points = allan::curve(Kind::Overlapping, values, rate, Grid::Octave);
-    let terms = noise::fit(&points, Kind::Overlapping);
+    let terms = noise::identify(&points, Kind::Overlapping).terms;
     let report = noise::report(&points, &terms, Kind::Overlapping);
     Deviation {
         points,
