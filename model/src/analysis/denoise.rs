@@ -248,14 +248,26 @@ mod tests {
         assert!((robust_sigma(&noise) / 0.5 - 1.0).abs() < 0.03);
     }
 
+    /// A sine of amplitude 2 and `period` samples, and the same under white noise of σ 0.5.
+    fn noisy_sine(n: usize, period: f64, seed: u64, stream: u32) -> (Vec<f64>, Vec<f64>) {
+        let clean: Vec<f64> = (0..n)
+            .map(|k| 2.0 * libm::sin(2.0 * std::f64::consts::PI * k as f64 / period))
+            .collect();
+        let mut g = Gaussian::new(seed, Stream::DecompositionNoise(stream));
+        let noisy = clean.iter().map(|c| c + 0.5 * g.sample()).collect();
+        (clean, noisy)
+    }
+
+    /// RMS of `x − clean`.
+    fn rms_error(x: &[f64], clean: &[f64]) -> f64 {
+        let sum: f64 = x.iter().zip(clean).map(|(a, b)| (a - b) * (a - b)).sum();
+        (sum / x.len() as f64).sqrt()
+    }
+
     #[test]
     fn thresholds_off_give_back_the_input_and_denoising_cleans_a_noisy_sine() {
         let n = 2048;
-        let clean: Vec<f64> = (0..n)
-            .map(|k| 2.0 * libm::sin(2.0 * std::f64::consts::PI * k as f64 / 512.0))
-            .collect();
-        let mut g = Gaussian::new(6, Stream::DecompositionNoise(79));
-        let noisy: Vec<f64> = clean.iter().map(|c| c + 0.5 * g.sample()).collect();
+        let (clean, noisy) = noisy_sine(n, 512.0, 6, 79);
         let ensemble = Ensemble {
             realizations: 20,
             ..Ensemble::default()
@@ -265,14 +277,7 @@ mod tests {
         for (a, b) in decomposition.reconstruct().iter().zip(&noisy) {
             assert!((a - b).abs() < 1e-9);
         }
-        let error = |x: &[f64]| -> f64 {
-            (x.iter()
-                .zip(&clean)
-                .map(|(a, b)| (a - b) * (a - b))
-                .sum::<f64>()
-                / n as f64)
-                .sqrt()
-        };
+        let error = |x: &[f64]| rms_error(x, &clean);
         for rule in [Rule::Soft, Rule::Hard] {
             let (denoised, reports) = denoise(&noisy, n, &ensemble, rule);
             assert_eq!(reports.len(), 1);
@@ -293,23 +298,12 @@ mod tests {
     #[test]
     fn overlapped_blocks_keep_the_length_and_clean_a_sine_across_block_edges() {
         let n = 3000;
-        let clean: Vec<f64> = (0..n)
-            .map(|k| 2.0 * libm::sin(2.0 * std::f64::consts::PI * k as f64 / 400.0))
-            .collect();
-        let mut g = Gaussian::new(8, Stream::DecompositionNoise(81));
-        let noisy: Vec<f64> = clean.iter().map(|c| c + 0.5 * g.sample()).collect();
+        let (clean, noisy) = noisy_sine(n, 400.0, 8, 81);
         let ensemble = Ensemble {
             realizations: 10,
             ..Ensemble::default()
         };
-        let rms = |x: &[f64]| -> f64 {
-            (x.iter()
-                .zip(&clean)
-                .map(|(a, b)| (a - b) * (a - b))
-                .sum::<f64>()
-                / n as f64)
-                .sqrt()
-        };
+        let rms = |x: &[f64]| rms_error(x, &clean);
         let mut calls = Vec::new();
         let (out, reports) =
             denoise_overlapped(&noisy, 1000, 200, &ensemble, Rule::Soft, &mut |d, t| {
@@ -324,8 +318,24 @@ mod tests {
             rms(&noisy),
             rms(&out)
         );
-        // Without overlap it is the block denoiser.
+        // The context is what the overlap is for: around the block edges (±50 samples of 1000
+        // and 2000) the overlapped output is closer to the sine than blocks cut without it.
         let (plain, _) = denoise_overlapped(&noisy, 1000, 0, &ensemble, Rule::Soft, &mut |_, _| {});
-        assert_eq!(plain, denoise(&noisy, 1000, &ensemble, Rule::Soft).0);
+        let edges = |x: &[f64]| -> f64 {
+            let near: Vec<usize> = [1000usize, 2000]
+                .iter()
+                .flat_map(|e| e - 50..e + 50)
+                .collect();
+            let x: Vec<f64> = near.iter().map(|&i| x[i]).collect();
+            let c: Vec<f64> = near.iter().map(|&i| clean[i]).collect();
+            rms_error(&x, &c)
+        };
+        // Measured: 0.08 against 0.35.
+        assert!(
+            edges(&out) < 0.5 * edges(&plain),
+            "{} vs {}",
+            edges(&out),
+            edges(&plain)
+        );
     }
 }
