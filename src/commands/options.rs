@@ -373,11 +373,12 @@ pub fn check_replaceable(output: &Path, header: &str, force: bool) -> Result<()>
             output.display()
         );
     }
-    let mut start = vec![0u8; header.len() + 1];
-    let read = std::fs::File::open(output)
-        .and_then(|mut file| file.read(&mut start))
+    // read_to_end over a `take`: one `read` may return fewer bytes than the header has.
+    let mut start = Vec::with_capacity(header.len() + 1);
+    std::fs::File::open(output)
+        .and_then(|file| file.take(header.len() as u64 + 1).read_to_end(&mut start))
         .map_err(|e| anyhow::anyhow!("--output {}: {e}", output.display()))?;
-    if start[..read] == *format!("{header}\n").as_bytes() {
+    if start == format!("{header}\n").as_bytes() {
         return Ok(());
     }
     usage!(
