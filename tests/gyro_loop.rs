@@ -26,7 +26,14 @@ fn the_default_gyros_match_the_closed_forms_in_both_modes() {
         for (mode, bias) in [("normal", 20.376), ("reverse", -20.395)] {
             let m = &gyro[mode];
             let (measured, predicted) = figure(m, "bias_dps");
-            assert!((predicted - bias).abs() < 1e-3, "{mode}: {predicted}");
+            // Predicted at the realized phase, which the loop moves by about 0.001°
+            // (2.9 mdps) from the configured 1° of the closed form's 20.376 / −20.395.
+            assert!((predicted - bias).abs() < 6e-3, "{mode}: {predicted}");
+            let (phase, derived) = figure(m, "reference_phase_deg");
+            assert!(
+                (phase - 1.0).abs() < 3e-3 && (phase - derived).abs() < 5e-4,
+                "{mode}: {phase} {derived}"
+            );
             assert!(
                 (measured / predicted - 1.0).abs() < 0.01,
                 "{mode}: {measured}"
@@ -40,8 +47,16 @@ fn the_default_gyros_match_the_closed_forms_in_both_modes() {
             let (settling, _) = figure(m, "rate_settling_ms");
             assert!(settling > 50.0 && settling < 150.0, "{mode}: {settling} ms");
         }
-        let (_, residual) = figure(gyro, "residual_bias_dps");
-        assert!((residual + 0.0094).abs() < 2e-4, "{residual}");
+        // (B − B′)/2 is −9.4 mdps at the configured phases; the realized ones make it
+        // −12.7 predicted, and the loop's must be within 5 % of that (issue 32).
+        let configured = gyro["residual_configured_phase_dps"].as_f64().unwrap();
+        assert!((configured + 0.0094).abs() < 2e-4, "{configured}");
+        let (measured, predicted) = figure(gyro, "residual_bias_dps");
+        assert!((predicted + 0.0127).abs() < 2e-4, "{predicted}");
+        assert!(
+            (measured / predicted - 1.0).abs() < 0.05,
+            "{measured} vs {predicted}"
+        );
     }
 }
 

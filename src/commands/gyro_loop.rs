@@ -211,17 +211,21 @@ fn print_table(figures: &[GyroFigures]) {
     for gyro in figures {
         let modes: [&ModeCharacterization; 2] = [&gyro.figures.normal, &gyro.figures.reverse];
         for mode in modes {
-            let rows: [(&str, &Figure, f64); 7] = [
+            let rows: [(&str, &Figure, f64); 8] = [
                 ("drive_frequency_hz", &mode.drive_frequency_hz, 1.0),
                 ("drive_amplitude_um", &mode.drive_amplitude_m, 1e6),
                 ("scale_factor", &mode.scale_factor, 1.0),
                 ("bias_dps", &mode.bias_dps, 1.0),
                 ("quadrature_dps", &mode.quadrature_dps, 1.0),
+                ("reference_phase_deg", &mode.reference_phase_deg, 1.0),
                 ("settling_ms", &mode.settling_ms, 1.0),
                 ("rate_settling_ms", &mode.rate_settling_ms, 1.0),
             ];
             for (name, figure, unit) in rows {
                 print_row(gyro.gyro, mode.mode, name, figure, unit);
+                if name == "reference_phase_deg" {
+                    print_phase_parts(gyro.gyro, mode);
+                }
             }
             print_saturations(gyro.gyro, mode);
         }
@@ -232,7 +236,28 @@ fn print_table(figures: &[GyroFigures]) {
             &gyro.figures.residual_bias_dps,
             1.0,
         );
+        let configured = Figure {
+            measured: gyro.figures.residual_bias_dps.measured,
+            predicted: gyro.figures.residual_configured_phase_dps,
+        };
+        print_row(gyro.gyro, "both", "residual_configured", &configured, 1.0);
     }
+}
+
+/// How the derived reference phase of `mode` is made up: the configured phase and the parts
+/// the loop adds (`gyrofx_model::gyro_loop::realized_phase`), deg.
+fn print_phase_parts(gyro: &str, mode: &ModeCharacterization) {
+    let parts = &mode.realized_phase;
+    println!(
+        "{gyro:<5} {:<8} {:<19} configured {:+.6}, locked frequency {:+.6}, PLL modulation {:+.6}, offset word {:+.1e}; sense gain {:.6}",
+        mode.mode,
+        "phase_parts_deg",
+        parts.configured_deg,
+        parts.locked_frequency_deg,
+        parts.pll_modulation_deg,
+        parts.offset_word_deg,
+        parts.gain
+    );
 }
 
 /// The nodes of `mode`'s fixed loop that saturated or wrapped, with their counts: while its

@@ -77,6 +77,25 @@ fn resonator_biases(config: &gyrofx_job::config::Config) -> Result<Vec<Resonator
     })
 }
 
+/// The realized phases of both modes as the report words them: read from the zero-rate
+/// outputs beside the derived ones, or only derived where the outputs saturated (gu2019's
+/// `s24.18` output clips the 166 °/s quadrature at 32 °/s, which would read as a 26° phase).
+fn realized_phases(figures: &Characterization) -> String {
+    let [normal, reverse] = [&figures.normal, &figures.reverse];
+    let derived = format!(
+        "{:+.5}° / {:+.5}°",
+        normal.reference_phase_deg.predicted, reverse.reference_phase_deg.predicted
+    );
+    if normal.saturations.total() + reverse.saturations.total() > 0 {
+        format!("{derived} (normal / reverse, derived from its plan; its quadrature output saturates in this preset, so they cannot be read from its outputs)")
+    } else {
+        format!(
+            "{:+.5}° / {:+.5}° (normal / reverse, read from its zero-rate outputs; {derived} derived from its plan)",
+            normal.reference_phase_deg.measured, reverse.reference_phase_deg.measured
+        )
+    }
+}
+
 /// Averages of `block` consecutive samples.
 fn block_means(x: &[f64], block: usize) -> Vec<f64> {
     x.chunks_exact(block)
@@ -288,7 +307,7 @@ impl Paper004 {
                 "| {g} | damping coupling `d_xy/(2m)` | {d0:+.6} | {d1:+.6} | {dd:+.2e} |\n\
                  | {g} | quadrature leak `k_xy tan φ/(2mw)` | {l0:+.6} | {l1:+.6} | {ll:+.2e} |\n\
                  | {g} | drive frequency (Hz), measured | {f0:.5} | {f1:.5} | |\n\
-                 | {g} | bias, measured (closed form) | {b0:+.5} ({p0:+.5}) | {b1:+.5} ({p1:+.5}) | {rm:+.4e} ({rp:+.4e}) |\n",
+                 | {g} | bias, measured (predicted at the realized phases) | {b0:+.5} ({p0:+.5}) | {b1:+.5} ({p1:+.5}) | {rm:+.4e} ({rp:+.4e}) |\n",
                 g = r.gyro,
                 d0 = damping[0],
                 d1 = damping[1],
@@ -318,17 +337,28 @@ impl Paper004 {
                  - **Left:** the quadrature leak. `k_xy tan φ/(2mw)` differs between the modes \
                  through the drive frequency (`w` {:.3} Hz, `w′` {:.3} Hz: {:.2} % apart) and \
                  through `φ ≠ φ′` when the phase errors differ; with φ = φ′ = 1° the residual \
-                 is the frequency term alone, {:+.2e} °/s predicted and {:+.2e} °/s measured on \
-                 the closed loop (the difference is the loop's own phase offsets). A phase \
-                 error that drifts between modes leaks `k_xy/(2mw) · Δφ` (about {:.2} °/s per \
-                 degree here) straight into the calibrated output.\n",
+                 is the frequency term alone, {:+.2e} °/s at the configured phases.\n\
+                 - **The loop's own phase offsets:** the closed loop realizes {}, mostly \
+                 through the sense phase at the coupled resonance the drive locks on \
+                 ({:+.5}° / {:+.5}°). With the realized phases the residual is \
+                 {:+.3e} °/s predicted and {:+.3e} °/s measured: the offsets make {:.0} % of it. \
+                 A phase error that drifts between modes leaks `k_xy/(2mw) · Δφ` (about {:.2} °/s \
+                 per degree here) straight into the calibrated output.\n",
                 n.bias_damping * deg,
                 n.drive_frequency_hz(),
                 v.drive_frequency_hz(),
                 100.0 * (n.drive_frequency_hz() - v.drive_frequency_hz()).abs()
                     / n.drive_frequency_hz(),
+                r.figures.residual_configured_phase_dps,
+                realized_phases(&r.figures),
+                r.figures.normal.realized_phase.locked_frequency_deg,
+                r.figures.reverse.realized_phase.locked_frequency_deg,
                 r.figures.residual_bias_dps.predicted,
                 r.figures.residual_bias_dps.measured,
+                100.0
+                    * (r.figures.residual_bias_dps.measured
+                        - r.figures.residual_configured_phase_dps)
+                    / r.figures.residual_bias_dps.measured,
                 n.bias_sensitivity_to_phase(),
             );
         }

@@ -7,7 +7,8 @@
 //! From rest in normal mode: `startup_ms` to lock, then each figure is the mean of
 //! `average_samples` chain samples at `Ω = 0` and, after `rate_settle_ms`, at `Ω = rate_dps`.
 //! Then a switch to reverse mode at `Ω = 0`, traced in windows of `window_samples` ADC
-//! samples for `switch_ms`, reverse mode's figures the same way, and a switch back to
+//! samples for `switch_ms` (and run on until the formerly driven axis has rung down to 1e-6
+//! °/s, when its time constant asks for longer), reverse mode's figures the same way, and a switch back to
 //! normal mode, traced likewise (normal mode's settling).
 //!
 //! - `scale_factor`: `(S(Ω) − S(0)) / Ω`, output °/s per input °/s (predicted 1: the loop
@@ -27,12 +28,20 @@
 //!   final value; predicted `τ_old ln(A/0.01 °/s)`: the formerly driven axis rings down with
 //!   its mode's `τ_old` from `A = q0 / SF` (°/s, about 2e4), plus the CIC's and compensator's
 //!   group delay (`N (R − 1)/2` ADC samples and `(T − 1)/2` chain samples, 17.5 ms).
-//! - `residual_bias_dps`: `(S + S′)/2` at `Ω = 0`; predicted `(B − B′)/2`.
+//! - `bias_dps` and `residual_bias_dps` are predicted with the phase the loop realizes
+//!   ([`super::realized_phase`]): `g B(φ_r)` per mode and `(S + S′)/2 = (g B(φ_r) − g′ B′(φ_r′))/2`
+//!   at `Ω = 0`; `residual_configured_phase_dps` is `(B − B′)/2` at the configured phases.
+//! - `reference_phase_deg`: the phase the loop realizes, read from the zero-rate outputs
+//!   ([`ModeFigures::phase_from_outputs_at`] of `σ S(0)` and the quadrature at the locked
+//!   frequency); predicted the
+//!   derived `φ_r`. `configured_phase_deg` is the config's `φ` (or `φ′`).
 
 use serde::Serialize;
 
 use super::closed::{ClosedLoop, LoopUnderTest};
 use super::gyro::{mode_index, LoopOverflows, Plan};
+use super::realized_phase::{self, RealizedPhase};
+pub use crate::resonator::coupled_resonance_hz;
 use crate::resonator::{Mode, ModeFigures, ParamError, PhysicsSettings, ResonatorParams};
 
 /// A measured figure beside its closed-form prediction.
@@ -59,6 +68,13 @@ pub struct ModeCharacterization {
     pub bias_dps: Figure,
     /// Quadrature channel at zero rate, °/s.
     pub quadrature_dps: Figure,
+    /// The sense reference's phase error the loop realizes, deg: read from the zero-rate
+    /// outputs, predicted by [`super::realized_phase::derive`].
+    pub reference_phase_deg: Figure,
+    /// The phase error the config asks for, deg.
+    pub configured_phase_deg: f64,
+    /// The derivation's parts (deg) and the sense gain.
+    pub realized_phase: RealizedPhase,
     /// From a switch into this mode to lock and amplitude within 0.1 %, ms.
     pub settling_ms: Figure,
     /// From a switch into this mode until the rate is within 0.01 °/s of its final value, ms.
@@ -78,8 +94,10 @@ pub struct Characterization {
     pub normal: ModeCharacterization,
     /// Reverse mode.
     pub reverse: ModeCharacterization,
-    /// `(S + S′)/2` at zero rate, °/s.
+    /// `(S + S′)/2` at zero rate, °/s; predicted with the realized phases.
     pub residual_bias_dps: Figure,
+    /// `(B − B′)/2` of the closed forms at the configured phases, °/s.
+    pub residual_configured_phase_dps: f64,
 }
 
 /// How [`characterize`] runs.
@@ -121,39 +139,23 @@ impl Default for Procedure {
     }
 }
 
+/// What may be left, °/s, of the formerly driven axis's ring-down when a mode's figures are
+/// measured after a switch. The ringing beats with the new drive at the mode split and reads
+/// as a phase: 300 ms after a switch from a Q-400 axis at 6.5 kHz it moved the realized phase
+/// by 0.005° (issue 32).
+const RING_DOWN_LEFT_DPS: f64 = 1e-9;
 /// Rate 0.01 °/s: the output settling criterion.
 const RATE_SETTLED_DPS: f64 = 0.01;
 /// Amplitude within 0.1 %.
 const AMPLITUDE_SETTLED: f64 = 1e-3;
 
-/// The coupled drive resonance of `mode` at `Ω = 0`, Hz: where `Re(Z_aa − Z_as²/Z_ss) = 0`
-/// with `Z_ij = k_ij − m w² δ_ij + i w d_ij` (bisection within ±5 % of `sqrt(k_aa/m)`).
-pub fn coupled_resonance_hz(params: &ResonatorParams, mode: Mode) -> f64 {
-    let mats = params.matrices();
-    let m = params.mass_kg;
-    let [a, s] = super::gyro::axes(mode);
-    let real_part = |w: f64| {
-        let (zaa_re, zaa_im) = (mats.k[a][a] - m * w * w, w * mats.d[a][a]);
-        let (zss_re, zss_im) = (mats.k[s][s] - m * w * w, w * mats.d[s][s]);
-        let (c_re, c_im) = (mats.k[0][1], w * mats.d[0][1]);
-        // Z_as² / Z_ss.
-        let (n_re, n_im) = (c_re * c_re - c_im * c_im, 2.0 * c_re * c_im);
-        let den = zss_re * zss_re + zss_im * zss_im;
-        let q_re = (n_re * zss_re + n_im * zss_im) / den;
-        let _ = zaa_im;
-        zaa_re - q_re
-    };
-    let w0 = (mats.k[a][a] / m).sqrt();
-    let (mut lo, mut hi) = (0.95 * w0, 1.05 * w0);
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if real_part(mid) > 0.0 {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    0.5 * (lo + hi) / (2.0 * std::f64::consts::PI)
+/// From a switch into `mode` until the formerly driven axis has rung down from the drive
+/// amplitude (`q0/SF`, °/s) to [`RING_DOWN_LEFT_DPS`], with its time constant, ms.
+fn ring_down_ms(plan: &Plan, mode: Mode) -> f64 {
+    let f = plan.mode(mode).figures;
+    let other = plan.modes[1 - mode_index(mode)].figures;
+    let ring_start = f.drive_amplitude / f.scale_factor_m_per_dps();
+    1e3 * other.ring_down_time_constant * libm::log(ring_start / RING_DOWN_LEFT_DPS)
 }
 
 struct Means {
@@ -318,6 +320,9 @@ pub fn characterize_reporting<L: LoopUnderTest>(
     let normal = measure(&mut closed, Mode::Normal);
     ledger.book(closed.gyro.overflows(), Mode::Normal, true);
     let to_reverse = trace_switch(&mut closed, Mode::Reverse, procedure, fs);
+    for _ in 0..samples((ring_down_ms(plan, Mode::Reverse) - procedure.switch_ms).max(0.0)) {
+        closed.step_chain(0.0, Mode::Reverse);
+    }
     ledger.book(closed.gyro.overflows(), Mode::Reverse, false);
     let reverse = measure(&mut closed, Mode::Reverse);
     ledger.book(closed.gyro.overflows(), Mode::Reverse, true);
@@ -340,6 +345,7 @@ pub fn characterize_reporting<L: LoopUnderTest>(
         let sigma = f.sigma();
         let ring_start = f.drive_amplitude / f.scale_factor_m_per_dps();
         let (saturations, transient_saturations) = ledger.of(mode);
+        let realized = realized_phase::derive(plan, params, mode);
         ModeCharacterization {
             mode: match mode {
                 Mode::Normal => "normal",
@@ -359,12 +365,24 @@ pub fn characterize_reporting<L: LoopUnderTest>(
             },
             bias_dps: Figure {
                 measured: zero.rate,
-                predicted: sigma * f.bias_dps(),
+                predicted: sigma * realized.bias_dps(params, mode),
             },
             quadrature_dps: Figure {
                 measured: zero.quadrature,
                 predicted: (f.quadrature(0.0) / f.scale_factor).to_degrees(),
             },
+            reference_phase_deg: Figure {
+                measured: f
+                    .phase_from_outputs_at(
+                        sigma * zero.rate,
+                        zero.quadrature,
+                        2.0 * std::f64::consts::PI * zero.frequency,
+                    )
+                    .to_degrees(),
+                predicted: realized.derived_deg(),
+            },
+            configured_phase_deg: realized.configured_deg,
+            realized_phase: realized,
             settling_ms: Figure {
                 measured: settled,
                 predicted: 1e3 * libm::log(1.0 / AMPLITUDE_SETTLED)
@@ -390,7 +408,8 @@ pub fn characterize_reporting<L: LoopUnderTest>(
         reverse: reverse_report,
         residual_bias_dps: Figure {
             measured: (normal.0.rate + reverse.0.rate) / 2.0,
-            predicted: (figures[0].bias_dps() - figures[1].bias_dps()) / 2.0,
+            predicted: realized_phase::predicted_residual_dps(plan, params),
         },
+        residual_configured_phase_dps: (figures[0].bias_dps() - figures[1].bias_dps()) / 2.0,
     })
 }

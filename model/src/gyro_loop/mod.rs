@@ -45,6 +45,7 @@ pub mod figures;
 pub mod gyro;
 pub mod nco;
 pub mod pi;
+pub mod realized_phase;
 pub mod trace;
 
 /// A refused spec: each variant names the block, the field or coefficient, its value and what

@@ -172,12 +172,55 @@ impl ModeFigures {
     /// common gain cancels. This is how the phase a loop realizes is read from its outputs
     /// (issue 32), whatever phase this mode's figures were made with.
     pub fn phase_from_outputs(&self, in_phase: f64, quadrature: f64) -> f64 {
-        let mechanical = libm::atan2(self.drive_angular_frequency * self.d_xy, self.k_xy);
+        self.phase_from_outputs_at(in_phase, quadrature, self.drive_angular_frequency)
+    }
+
+    /// [`Self::phase_from_outputs`] for a drive at `angular_frequency` (rad/s) instead of
+    /// `w`: a loop locks on the coupled resonance, where `C = w_L d_xy`.
+    pub fn phase_from_outputs_at(
+        &self,
+        in_phase: f64,
+        quadrature: f64,
+        angular_frequency: f64,
+    ) -> f64 {
+        let mechanical = libm::atan2(angular_frequency * self.d_xy, self.k_xy);
         let angle = libm::atan2(in_phase, quadrature) - mechanical;
         // Wrapped to (−π, π].
         let turns = libm::ceil((angle - PI) / (2.0 * PI));
         angle - 2.0 * PI * turns
     }
+}
+
+/// The coupled drive resonance of `mode` at `Ω = 0`, Hz: where `Re(Z_aa − Z_as²/Z_ss) = 0`
+/// with `Z_ij = k_ij − m w² δ_ij + i w d_ij` (bisection within ±5 % of `sqrt(k_aa/m)`).
+pub fn coupled_resonance_hz(params: &ResonatorParams, mode: Mode) -> f64 {
+    let mats = params.matrices();
+    let m = params.mass_kg;
+    let (a, s) = match mode {
+        Mode::Normal => (0, 1),
+        Mode::Reverse => (1, 0),
+    };
+    let real_part = |w: f64| {
+        let zaa_re = mats.k[a][a] - m * w * w;
+        let (zss_re, zss_im) = (mats.k[s][s] - m * w * w, w * mats.d[s][s]);
+        let (c_re, c_im) = (mats.k[0][1], w * mats.d[0][1]);
+        // Z_as² / Z_ss.
+        let (n_re, n_im) = (c_re * c_re - c_im * c_im, 2.0 * c_re * c_im);
+        let den = zss_re * zss_re + zss_im * zss_im;
+        let q_re = (n_re * zss_re + n_im * zss_im) / den;
+        zaa_re - q_re
+    };
+    let w0 = (mats.k[a][a] / m).sqrt();
+    let (mut lo, mut hi) = (0.95 * w0, 1.05 * w0);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if real_part(mid) > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi) / (2.0 * std::f64::consts::PI)
 }
 
 /// Both modes and what mode reversal leaves of the bias.

@@ -104,7 +104,7 @@ pub mod params;
 pub mod physics;
 pub mod settings;
 
-pub use closed_form::{ModeFigures, Reversal};
+pub use closed_form::{coupled_resonance_hz, ModeFigures, Reversal};
 pub use params::{Matrices, ParamError, ResonatorParams};
 pub use physics::{Resonator, BOLTZMANN_J_PER_K};
 pub use settings::{GaussMarkov, PhysicsSettings};

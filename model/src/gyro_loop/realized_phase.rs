@@ -1,0 +1,161 @@
+//! The sense-reference phase a gyro's closed loop realizes, derived from its plan (issue 32).
+//!
+//! The plan designs each mode's sense offset `δ_S = −¼ − ψ(f_nom)/2π` (cycles) so that the
+//! sense reference lags the Coriolis component by exactly the configured phase error `φ`
+//! (SPEC §1.6). The fixed loop realizes a slightly different phase `φ_r`, and since every
+//! degree of phase leaks `dB/dφ = k_xy/(2 m w cos² φ)` of quadrature into the bias (2.9 °/s
+//! per degree at the defaults), thousandths of a degree between the modes are what the
+//! reversal residual `(B − B′)/2` is made of. Three terms move it, each derived here:
+//!
+//! 1. **The locked frequency.** The drive PLL locks at the coupled resonance `f_L` (where the
+//!    driven axis's effective impedance is imaginary, [`coupled_resonance_hz`]), not at
+//!    `f_nom = sqrt(k_aa/m)/2π`; the sense axis's phase `ψ(f) = arg(k_ss − m w² + i w d_ss)`
+//!    there differs from the design's by `ψ(f_L) − ψ(f_nom)` (−0.0011° normal, +0.0014°
+//!    reverse at the defaults, ±0.02° at a 2° stiffness angle). It is why the modes differ.
+//! 2. **The PLL's proportional path.** The drive demodulator's `Q` carries a ripple at `2f`
+//!    (`Im(a_set H(Ω) e^{2iθ})`, `H = α / (1 − (1 − α) e^{−iΩ})`, `α = 2^−k`, `Ω = 4π f/fs`);
+//!    `kp` passes it to the frequency word, registered, and the accumulator integrates it: the
+//!    NCO's phase is modulated by `Im(P e^{2iθ})` with
+//!    `P = 2π kp a_set H e^{−2iΩ} / (1 − e^{−iΩ}) = |P| e^{iγ}`. A signal at phase `β`
+//!    demodulated by that reference reads `β − (|P|/2) sin(2β − γ)` at a gain
+//!    `1 + (|P|/2) cos(2β − γ)`. The PLL nulls the drive's reading (`β = 0`), so the sense
+//!    signal, at `β_s = 2π δ_S + arg(k_xy + i w d_xy) + φ − π/2` against the NCO, reads
+//!    `−(|P|/2)[sin(2β_s − γ) + sin γ]` beside its design phase (±0.00015° at the defaults),
+//!    and the AGC, holding the drive's reading, leaves the sense gain
+//!    `1 + (|P|/2)[cos(2β_s − γ) − cos γ]`.
+//! 3. **The offset word.** `δ_S` is rounded to the NCO's `P` phase bits: the reference leads by
+//!    `word·2^−P − frac(δ_S)` cycles more than designed (2e-8° at 32 bits, 6e-4° at 18).
+//!
+//! So `φ_r = φ − [ψ(f_L) − ψ(f_nom)] − (|P|/2)[sin(2β_s − γ) + sin γ] − 360°·(word·2^−P − frac δ_S)`,
+//! and the sense gain is `g = |Z_ss(f_nom)| / |Z_ss(f_L)| · [1 + (|P|/2)(cos(2β_s − γ) − cos γ)]`.
+//! The bias the loop outputs is then `g·B(φ_r)` (to first order; [`RealizedPhase::bias_dps`]
+//! keeps the ratios that matter where the bias is large) and the residual is
+//! `(g B(φ_r) − g′ B′(φ_r′))/2`.
+//! The loop's latency and the DAC offset act only through `f_L` (below 5e-5°).
+//!
+//! What is left is the NCO's phase truncation to `A + 2` bits, which the derivation does not
+//! model: it moves the fixed loop's realized phase by up to about 0.002° at `A = 10` (a few
+//! hundredths of a ROM bin, depending on where the locked frequency falls against the bins),
+//! 5e-5° at `A = 14`; [`super::figures`] measures it as the gap between the measured and the
+//! derived phase, and `gyrofx formats` shows what it costs.
+
+use std::f64::consts::PI;
+
+use serde::Serialize;
+
+use super::gyro::{axes, Plan};
+use crate::resonator::{coupled_resonance_hz, Mode, ModeFigures, ResonatorParams};
+
+/// One mode's realized reference phase, derived from the plan, with its parts. Phases in
+/// degrees, positive when the reference lags the Coriolis component more (as `φ`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct RealizedPhase {
+    /// The configured phase error `φ` (or `φ′`), deg.
+    pub configured_deg: f64,
+    /// `f_L`, the coupled resonance the drive locks on, Hz.
+    pub locked_frequency_hz: f64,
+    /// `−[ψ(f_L) − ψ(f_nom)]`: the sense axis's phase at the locked frequency against the
+    /// design's, deg.
+    pub locked_frequency_deg: f64,
+    /// `−(|P|/2)[sin(2β_s − γ) + sin γ]`: the PLL's `2f` phase modulation, deg.
+    pub pll_modulation_deg: f64,
+    /// `−360°·(word·2^−P − frac δ_S)`: the offset word's rounding, deg.
+    pub offset_word_deg: f64,
+    /// The sense gain against the design's: `|Z_ss(f_nom)|/|Z_ss(f_L)|` times the modulation's
+    /// gain (1 − 5e-5 at the defaults).
+    pub gain: f64,
+}
+
+impl RealizedPhase {
+    /// `φ_r`, deg: the configured phase plus the three derived parts.
+    pub fn derived_deg(&self) -> f64 {
+        self.configured_deg
+            + self.locked_frequency_deg
+            + self.pll_modulation_deg
+            + self.offset_word_deg
+    }
+
+    /// The bias the loop outputs in this mode, °/s (`B`'s sign, not the chain's), for
+    /// `params`. The sense signal is `(q0/|Z_ss(f_L)|)(k_xy + i w_L d_xy) e^{iφ_r}` against the
+    /// reference, and the loop divides its in-phase part by the design's scale factor
+    /// `2 m w q0 cos φ / |Z_ss(f_nom)|`, so the output is
+    /// `g [k_xy sin φ_r + w_L d_xy cos φ_r] / (2 m w cos φ)`: `g B(φ_r)` but for the ratios
+    /// `w_L / w` and `cos φ_r / cos φ`, which matter where the bias is large (2e-5 of a 505 °/s
+    /// bias is 10 mdps).
+    pub fn bias_dps(&self, params: &ResonatorParams, mode: Mode) -> f64 {
+        let mats = params.matrices();
+        let design = ModeFigures::new(params, mode);
+        let w_locked = 2.0 * PI * self.locked_frequency_hz;
+        let phase = self.derived_deg().to_radians();
+        let coupling = mats.k[0][1] * libm::sin(phase) + w_locked * mats.d[0][1] * libm::cos(phase);
+        let rate = coupling
+            / (2.0
+                * params.mass_kg
+                * design.drive_angular_frequency
+                * libm::cos(design.phase_error));
+        self.gain * rate.to_degrees()
+    }
+}
+
+/// The sense axis's impedance `Z_ss(f) = k_ss − m w² + i w d_ss` of `mode` at `f_hz`, as
+/// `(|Z|, arg Z)` in N/m and rad.
+fn sense_impedance(params: &ResonatorParams, mode: Mode, f_hz: f64) -> (f64, f64) {
+    let mats = params.matrices();
+    let s = axes(mode)[1];
+    let w = 2.0 * PI * f_hz;
+    let (re, im) = (mats.k[s][s] - params.mass_kg * w * w, w * mats.d[s][s]);
+    (libm::hypot(re, im), libm::atan2(im, re))
+}
+
+/// `|P|` and `γ = arg P` of the PLL's phase modulation at the locked frequency `f_hz` (see
+/// the [module doc](self)).
+fn pll_modulation(plan: &Plan, setpoint: f64, f_hz: f64) -> (f64, f64) {
+    let omega = 4.0 * PI * f_hz / plan.adc_rate_hz;
+    let alpha = crate::fx::pow2(-(plan.settings.demod_lowpass_shift as i32));
+    // H = α / (1 − (1 − α) e^{−iΩ}).
+    let (h_re, h_im) = (
+        1.0 - (1.0 - alpha) * libm::cos(omega),
+        (1.0 - alpha) * libm::sin(omega),
+    );
+    let (h_abs, h_arg) = (alpha / libm::hypot(h_re, h_im), -libm::atan2(h_im, h_re));
+    // 1 − e^{−iΩ}: the accumulator's integration of the registered word.
+    let (d_re, d_im) = (1.0 - libm::cos(omega), libm::sin(omega));
+    let magnitude = 2.0 * PI * plan.pll.kp.quantized() * setpoint * h_abs / libm::hypot(d_re, d_im);
+    (magnitude, h_arg - 2.0 * omega - libm::atan2(d_im, d_re))
+}
+
+/// The realized reference phase of `mode` in the loop `plan` closes around `params`, derived
+/// (see the [module doc](self)). `plan` must be the plan made for `params`.
+pub fn derive(plan: &Plan, params: &ResonatorParams, mode: Mode) -> RealizedPhase {
+    let m = plan.mode(mode);
+    let f = &m.figures;
+    let f_locked = coupled_resonance_hz(params, mode);
+    let (z_nominal, psi_nominal) = sense_impedance(params, mode, m.nominal_frequency_hz);
+    let (z_locked, psi_locked) = sense_impedance(params, mode, f_locked);
+
+    let (p_abs, gamma) = pll_modulation(plan, m.setpoint, f_locked);
+    let mats = params.matrices();
+    let mechanical = libm::atan2(f.drive_angular_frequency * mats.d[0][1], mats.k[0][1]);
+    let beta = 2.0 * PI * m.sense_offset + mechanical + f.phase_error - PI / 2.0;
+    let modulation_phase = -(p_abs / 2.0) * (libm::sin(2.0 * beta - gamma) + libm::sin(gamma));
+    let modulation_gain = 1.0 + (p_abs / 2.0) * (libm::cos(2.0 * beta - gamma) - libm::cos(gamma));
+
+    let word = m.sense_offset_word as f64 * crate::fx::pow2(-(plan.nco.phase.width as i32));
+    let exact = m.sense_offset - libm::floor(m.sense_offset);
+    RealizedPhase {
+        configured_deg: f.phase_error.to_degrees(),
+        locked_frequency_hz: f_locked,
+        locked_frequency_deg: -(psi_locked - psi_nominal).to_degrees(),
+        pll_modulation_deg: modulation_phase.to_degrees(),
+        offset_word_deg: -360.0 * (word - exact),
+        gain: z_nominal / z_locked * modulation_gain,
+    }
+}
+
+/// The reversal residual `(g B(φ_r) − g′ B′(φ_r′))/2` (°/s) the derivation predicts for the
+/// loop `plan` closes around `params`.
+pub fn predicted_residual_dps(plan: &Plan, params: &ResonatorParams) -> f64 {
+    let [normal, reverse] =
+        [Mode::Normal, Mode::Reverse].map(|mode| derive(plan, params, mode).bias_dps(params, mode));
+    (normal - reverse) / 2.0
+}
