@@ -78,6 +78,14 @@ fn the_config_sets_each_gyros_structure_and_bad_values_are_refused() {
     assert!((b - a - 2.9).abs() < 0.1, "B moved {} °/s", b - a);
     assert!((b / b_predicted - 1.0).abs() < 0.01);
 
+    // The optional keys the default config shows commented out are accepted.
+    let optional = write_config(
+        dir.path(),
+        "optional.toml",
+        "[loop]\nscale_coefficient_format = \"s24.6\"\nphase_trim = false\n",
+    );
+    ok(&["loop", "--config", &optional]);
+
     let bad = write_config(dir.path(), "bad.toml", "[resonator_a]\nq_drive = -1.0\n");
     let err = fails(&["loop", "--config", &bad]);
     assert!(err.contains("resonator_a.q_drive = -1"), "{err}");
@@ -174,4 +182,61 @@ fn loop_plots_the_switch_as_png_or_svg() {
         "{log}"
     );
     assert!(!bad.exists());
+}
+
+/// `[loop] phase_trim = true` (issue 32): only the per-mode sense offsets change (the
+/// parameters the RTL already takes), the loop then realizes the configured 1° (where it
+/// realizes 0.99914° / 1.00126° untrimmed), and the trimmed loop's vectors hold bit for bit in
+/// Icarus, Verilator and GHDL.
+#[test]
+fn the_phase_trim_changes_only_the_sense_offsets_and_is_bit_exact_in_every_simulator() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = write_config(dir.path(), "trim.toml", "[loop]\nphase_trim = true\n");
+    let figures: serde_json::Value =
+        serde_json::from_str(&ok(&["loop", "--json", "--config", &config])).unwrap();
+    for mode in ["normal", "reverse"] {
+        let (phase, derived) = figure(&figures[0][mode], "reference_phase_deg");
+        assert!((derived - 1.0).abs() < 1e-6, "{mode}: derived {derived}");
+        assert!((phase - 1.0).abs() < 3e-4, "{mode}: realized {phase}");
+    }
+
+    let package = dir.path().join("pkg");
+    let out = package.to_str().unwrap();
+    ok(&[
+        "generate",
+        "--out",
+        out,
+        "--config",
+        &config,
+        "--blocks",
+        "gyro_loop",
+    ]);
+    let params = |root: &std::path::Path| {
+        std::fs::read_to_string(root.join("gyro_loop/gyro_loop_params.vh")).unwrap()
+    };
+    let golden = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("vectors");
+    let (trimmed, untrimmed) = (params(&package), params(&golden));
+    let differing: Vec<&str> = trimmed
+        .lines()
+        .zip(untrimmed.lines())
+        // The header line names the config: not a parameter.
+        .filter(|(t, u)| t != u && !t.starts_with("//"))
+        .map(|(t, _)| t.split_whitespace().nth(2).unwrap_or(t))
+        .collect();
+    assert_eq!(
+        differing,
+        ["P_SENSE_OFFSET_N", "P_SENSE_OFFSET_R"],
+        "{trimmed}"
+    );
+
+    let log = ok(&[
+        "verify",
+        "--out",
+        out,
+        "--sim",
+        "iverilog,verilator,ghdl",
+        "--blocks",
+        "gyro_loop",
+    ]);
+    assert_eq!(log.matches("PASS n=").count(), 3, "{log}");
 }

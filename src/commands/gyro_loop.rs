@@ -249,13 +249,18 @@ fn print_table(figures: &[GyroFigures]) {
 fn print_phase_parts(gyro: &str, mode: &ModeCharacterization) {
     let parts = &mode.realized_phase;
     println!(
-        "{gyro:<5} {:<8} {:<19} configured {:+.6}, locked frequency {:+.6}, PLL modulation {:+.6}, offset word {:+.1e}; sense gain {:.6}",
+        "{gyro:<5} {:<8} {:<19} configured {:+.6}, locked frequency {:+.6}, PLL modulation {:+.6}, offset word {:+.1e}{}; sense gain {:.6}",
         mode.mode,
         "phase_parts_deg",
         parts.configured_deg,
         parts.locked_frequency_deg,
         parts.pll_modulation_deg,
         parts.offset_word_deg,
+        if parts.trim_deg == 0.0 {
+            String::new()
+        } else {
+            format!(", trim {:+.6}", parts.trim_deg)
+        },
         parts.gain
     );
 }

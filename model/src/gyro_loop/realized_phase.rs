@@ -33,6 +33,11 @@
 //! `(g B(φ_r) − g′ B′(φ_r′))/2`.
 //! The loop's latency and the DAC offset act only through `f_L` (below 5e-5°).
 //!
+//! With `[loop] phase_trim = true` the plan advances `δ_S` by the first two terms
+//! ([`super::gyro::trimmed_sense_offset`]), so that the loop realizes the configured phase up to
+//! the offset word's rounding; [`RealizedPhase::trim_deg`] is that advance. Only the per-mode
+//! offset words (`SENSE_OFFSET_N`/`_R` of `gyrofx_gyro_loop`) change: the RTL is the same.
+//!
 //! What is left is the NCO's phase truncation to `A + 2` bits, which the derivation does not
 //! model: it moves the fixed loop's realized phase by up to about 0.002° at `A = 10` (a few
 //! hundredths of a ROM bin, depending on where the locked frequency falls against the bins),
@@ -43,8 +48,8 @@ use std::f64::consts::PI;
 
 use serde::Serialize;
 
-use super::gyro::{axes, Plan};
-use crate::resonator::{coupled_resonance_hz, Mode, ModeFigures, ResonatorParams};
+use super::gyro::{phase_shifts, PhaseInputs, Plan};
+use crate::resonator::{Mode, ModeFigures, ResonatorParams};
 
 /// One mode's realized reference phase, derived from the plan, with its parts. Phases in
 /// degrees, positive when the reference lags the Coriolis component more (as `φ`).
@@ -61,18 +66,21 @@ pub struct RealizedPhase {
     pub pll_modulation_deg: f64,
     /// `−360°·(word·2^−P − frac δ_S)`: the offset word's rounding, deg.
     pub offset_word_deg: f64,
+    /// `−360°·trim`: what `[loop] phase_trim` took off (0 without it), deg.
+    pub trim_deg: f64,
     /// The sense gain against the design's: `|Z_ss(f_nom)|/|Z_ss(f_L)|` times the modulation's
     /// gain (1 − 5e-5 at the defaults).
     pub gain: f64,
 }
 
 impl RealizedPhase {
-    /// `φ_r`, deg: the configured phase plus the three derived parts.
+    /// `φ_r`, deg: the configured phase plus the derived parts and the trim.
     pub fn derived_deg(&self) -> f64 {
         self.configured_deg
             + self.locked_frequency_deg
             + self.pll_modulation_deg
             + self.offset_word_deg
+            + self.trim_deg
     }
 
     /// The bias the loop outputs in this mode, °/s (`B`'s sign, not the chain's), for
@@ -97,58 +105,34 @@ impl RealizedPhase {
     }
 }
 
-/// The sense axis's impedance `Z_ss(f) = k_ss − m w² + i w d_ss` of `mode` at `f_hz`, as
-/// `(|Z|, arg Z)` in N/m and rad.
-fn sense_impedance(params: &ResonatorParams, mode: Mode, f_hz: f64) -> (f64, f64) {
-    let mats = params.matrices();
-    let s = axes(mode)[1];
-    let w = 2.0 * PI * f_hz;
-    let (re, im) = (mats.k[s][s] - params.mass_kg * w * w, w * mats.d[s][s]);
-    (libm::hypot(re, im), libm::atan2(im, re))
-}
-
-/// `|P|` and `γ = arg P` of the PLL's phase modulation at the locked frequency `f_hz` (see
-/// the [module doc](self)).
-fn pll_modulation(plan: &Plan, setpoint: f64, f_hz: f64) -> (f64, f64) {
-    let omega = 4.0 * PI * f_hz / plan.adc_rate_hz;
-    let alpha = crate::fx::pow2(-(plan.settings.demod_lowpass_shift as i32));
-    // H = α / (1 − (1 − α) e^{−iΩ}).
-    let (h_re, h_im) = (
-        1.0 - (1.0 - alpha) * libm::cos(omega),
-        (1.0 - alpha) * libm::sin(omega),
-    );
-    let (h_abs, h_arg) = (alpha / libm::hypot(h_re, h_im), -libm::atan2(h_im, h_re));
-    // 1 − e^{−iΩ}: the accumulator's integration of the registered word.
-    let (d_re, d_im) = (1.0 - libm::cos(omega), libm::sin(omega));
-    let magnitude = 2.0 * PI * plan.pll.kp.quantized() * setpoint * h_abs / libm::hypot(d_re, d_im);
-    (magnitude, h_arg - 2.0 * omega - libm::atan2(d_im, d_re))
-}
-
 /// The realized reference phase of `mode` in the loop `plan` closes around `params`, derived
 /// (see the [module doc](self)). `plan` must be the plan made for `params`.
 pub fn derive(plan: &Plan, params: &ResonatorParams, mode: Mode) -> RealizedPhase {
     let m = plan.mode(mode);
-    let f = &m.figures;
-    let f_locked = coupled_resonance_hz(params, mode);
-    let (z_nominal, psi_nominal) = sense_impedance(params, mode, m.nominal_frequency_hz);
-    let (z_locked, psi_locked) = sense_impedance(params, mode, f_locked);
-
-    let (p_abs, gamma) = pll_modulation(plan, m.setpoint, f_locked);
-    let mats = params.matrices();
-    let mechanical = libm::atan2(f.drive_angular_frequency * mats.d[0][1], mats.k[0][1]);
-    let beta = 2.0 * PI * m.sense_offset + mechanical + f.phase_error - PI / 2.0;
-    let modulation_phase = -(p_abs / 2.0) * (libm::sin(2.0 * beta - gamma) + libm::sin(gamma));
-    let modulation_gain = 1.0 + (p_abs / 2.0) * (libm::cos(2.0 * beta - gamma) - libm::cos(gamma));
-
+    let shifts = phase_shifts(params, mode, &phase_inputs(plan, mode));
     let word = m.sense_offset_word as f64 * crate::fx::pow2(-(plan.nco.phase.width as i32));
     let exact = m.sense_offset - libm::floor(m.sense_offset);
     RealizedPhase {
-        configured_deg: f.phase_error.to_degrees(),
-        locked_frequency_hz: f_locked,
-        locked_frequency_deg: -(psi_locked - psi_nominal).to_degrees(),
-        pll_modulation_deg: modulation_phase.to_degrees(),
+        configured_deg: m.figures.phase_error.to_degrees(),
+        locked_frequency_hz: shifts.locked_frequency_hz,
+        locked_frequency_deg: shifts.locked_frequency_deg,
+        pll_modulation_deg: shifts.pll_modulation_deg,
         offset_word_deg: -360.0 * (word - exact),
-        gain: z_nominal / z_locked * modulation_gain,
+        trim_deg: -360.0 * m.sense_offset_trim,
+        gain: shifts.gain,
+    }
+}
+
+/// What [`phase_shifts`] needs of `plan`'s `mode`.
+fn phase_inputs(plan: &Plan, mode: Mode) -> PhaseInputs {
+    let m = plan.mode(mode);
+    PhaseInputs {
+        nominal_frequency_hz: m.nominal_frequency_hz,
+        sense_offset: m.sense_offset,
+        pll_kp: plan.pll.kp.quantized(),
+        setpoint: m.setpoint,
+        demod_lowpass_shift: plan.settings.demod_lowpass_shift,
+        adc_rate_hz: plan.adc_rate_hz,
     }
 }
 

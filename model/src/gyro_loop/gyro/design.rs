@@ -4,7 +4,7 @@
 use std::f64::consts::PI;
 
 use crate::gyro_loop::Coefficient;
-use crate::resonator::{Mode, ModeFigures};
+use crate::resonator::{coupled_resonance_hz, Mode, ModeFigures, ResonatorParams};
 
 /// The float values the design produced (before quantization), for the float twin and the
 /// report.
@@ -52,6 +52,8 @@ pub struct ModePlan {
     pub sense_offset: f64,
     /// Word of `δ_S`.
     pub sense_offset_word: u64,
+    /// What `[loop] phase_trim` added to `δ_S`, cycles (0 without it).
+    pub sense_offset_trim: f64,
     /// `a_s′ g_CIC`: FS units at the CIC output per °/s.
     pub sense_gain_per_dps: f64,
     /// `c_rate = σ / (a_s′ g_CIC)`, °/s per FS unit.
@@ -93,4 +95,98 @@ pub(super) fn dac_offset(delay: f64, frequency: f64, shift: u32, ripple_ratio: f
         delta = target - r * libm::sin(eta - 2.0 * delta);
     }
     delta / (2.0 * PI)
+}
+
+/// What the realized sense-reference phase of a mode depends on besides the structure (see
+/// `gyro_loop::realized_phase` for the derivation).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PhaseInputs {
+    /// `f_nom`, the frequency `δ_S` is designed at, Hz.
+    pub nominal_frequency_hz: f64,
+    /// `δ_S`, cycles (as designed, before rounding).
+    pub sense_offset: f64,
+    /// The PLL's quantized `kp`, cycles/sample per FS unit.
+    pub pll_kp: f64,
+    /// `a_set`, FS units.
+    pub setpoint: f64,
+    /// The demodulators' low-pass shift `k`.
+    pub demod_lowpass_shift: u32,
+    /// `fs`, Hz.
+    pub adc_rate_hz: f64,
+}
+
+/// The shifts of a mode's realized phase that the design can know: at the coupled resonance
+/// `f_L` the drive locks on, the sense axis's phase moves by `ψ(f_L) − ψ(f_nom)` and the PLL's
+/// proportional path modulates the NCO. Phases in degrees, positive when the reference lags
+/// the Coriolis component more.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PhaseShifts {
+    /// `f_L`, Hz.
+    pub locked_frequency_hz: f64,
+    /// `−[ψ(f_L) − ψ(f_nom)]`, deg.
+    pub locked_frequency_deg: f64,
+    /// `−(|P|/2)[sin(2β_s − γ) + sin γ]`, deg.
+    pub pll_modulation_deg: f64,
+    /// `|Z_ss(f_nom)|/|Z_ss(f_L)| · [1 + (|P|/2)(cos(2β_s − γ) − cos γ)]`.
+    pub gain: f64,
+}
+
+/// The sense axis's impedance `Z_ss(f) = k_ss − m w² + i w d_ss` of `mode` at `f_hz`, as
+/// `(|Z|, arg Z)` in N/m and rad.
+fn sense_impedance(params: &ResonatorParams, mode: Mode, f_hz: f64) -> (f64, f64) {
+    let mats = params.matrices();
+    let s = super::axes(mode)[1];
+    let w = 2.0 * PI * f_hz;
+    let (re, im) = (mats.k[s][s] - params.mass_kg * w * w, w * mats.d[s][s]);
+    (libm::hypot(re, im), libm::atan2(im, re))
+}
+
+/// `|P|` and `γ = arg P` of the PLL's `2f` phase modulation at `f_hz`:
+/// `P = 2π kp a_set H e^{−2iΩ} / (1 − e^{−iΩ})`, `H = α / (1 − (1 − α) e^{−iΩ})`, `Ω = 4π f/fs`.
+fn pll_modulation(inputs: &PhaseInputs, f_hz: f64) -> (f64, f64) {
+    let omega = 4.0 * PI * f_hz / inputs.adc_rate_hz;
+    let alpha = crate::fx::pow2(-(inputs.demod_lowpass_shift as i32));
+    let (h_re, h_im) = (
+        1.0 - (1.0 - alpha) * libm::cos(omega),
+        (1.0 - alpha) * libm::sin(omega),
+    );
+    let (h_abs, h_arg) = (alpha / libm::hypot(h_re, h_im), -libm::atan2(h_im, h_re));
+    // 1 − e^{−iΩ}: the accumulator's integration of the registered word.
+    let (d_re, d_im) = (1.0 - libm::cos(omega), libm::sin(omega));
+    let magnitude = 2.0 * PI * inputs.pll_kp * inputs.setpoint * h_abs / libm::hypot(d_re, d_im);
+    (magnitude, h_arg - 2.0 * omega - libm::atan2(d_im, d_re))
+}
+
+/// The [`PhaseShifts`] of `mode` of `params` under `inputs`.
+pub fn phase_shifts(params: &ResonatorParams, mode: Mode, inputs: &PhaseInputs) -> PhaseShifts {
+    let f = ModeFigures::new(params, mode);
+    let f_locked = coupled_resonance_hz(params, mode);
+    let (z_nominal, psi_nominal) = sense_impedance(params, mode, inputs.nominal_frequency_hz);
+    let (z_locked, psi_locked) = sense_impedance(params, mode, f_locked);
+    let (p_abs, gamma) = pll_modulation(inputs, f_locked);
+    let mats = params.matrices();
+    let mechanical = libm::atan2(f.drive_angular_frequency * mats.d[0][1], mats.k[0][1]);
+    // The sense signal's phase against the NCO's sine.
+    let beta = 2.0 * PI * inputs.sense_offset + mechanical + f.phase_error - PI / 2.0;
+    let modulation_phase = -(p_abs / 2.0) * (libm::sin(2.0 * beta - gamma) + libm::sin(gamma));
+    let modulation_gain = 1.0 + (p_abs / 2.0) * (libm::cos(2.0 * beta - gamma) - libm::cos(gamma));
+    PhaseShifts {
+        locked_frequency_hz: f_locked,
+        locked_frequency_deg: -(psi_locked - psi_nominal).to_degrees(),
+        pll_modulation_deg: modulation_phase.to_degrees(),
+        gain: z_nominal / z_locked * modulation_gain,
+    }
+}
+
+/// `δ_S` (cycles) trimmed so that the loop realizes the configured phase: the design's
+/// `δ_S` advanced by the shifts it can know, `(Δψ_L + Δ_PLL)/360°`. The modulation depends on
+/// `δ_S` through `β_s`, so the trim is iterated (it moves by 1e-9 cycles after two steps).
+pub fn trimmed_sense_offset(params: &ResonatorParams, mode: Mode, inputs: &PhaseInputs) -> f64 {
+    let mut trimmed = *inputs;
+    for _ in 0..3 {
+        let shifts = phase_shifts(params, mode, &trimmed);
+        trimmed.sense_offset =
+            inputs.sense_offset + (shifts.locked_frequency_deg + shifts.pll_modulation_deg) / 360.0;
+    }
+    trimmed.sense_offset
 }

@@ -109,7 +109,9 @@ mod overflows;
 mod plan;
 mod settings;
 
-pub use design::{Design, LockPlan, ModePlan};
+pub use design::{
+    phase_shifts, trimmed_sense_offset, Design, LockPlan, ModePlan, PhaseInputs, PhaseShifts,
+};
 pub use fixed::{ChainSample, FixedGyroLoop, FixedStep};
 pub use float::{FloatChainSample, FloatGyroLoop, FloatStep};
 pub use overflows::{LoopNode, LoopOverflows};

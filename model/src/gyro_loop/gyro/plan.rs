@@ -4,7 +4,7 @@
 
 use std::f64::consts::PI;
 
-use super::design::{dac_offset, Design, LockPlan, ModePlan};
+use super::design::{dac_offset, trimmed_sense_offset, Design, LockPlan, ModePlan, PhaseInputs};
 use super::settings::{format, LoopSettings};
 use super::{axes, mode_index};
 use crate::fx::{from_f64, CoefficientFormat, Format, Overflow, Rounding};
@@ -686,7 +686,20 @@ fn mode_plan(
         s.demod_lowpass_shift,
         agc.kp.quantized() * setpoint / (2.0 * nominal_amplitude),
     );
-    let sense_offset = -0.25 - f.sense_phase / (2.0 * PI);
+    let designed = -0.25 - f.sense_phase / (2.0 * PI);
+    let sense_offset = if s.phase_trim {
+        let inputs = PhaseInputs {
+            nominal_frequency_hz: f_nom,
+            sense_offset: designed,
+            pll_kp: pll.kp.quantized(),
+            setpoint,
+            demod_lowpass_shift: s.demod_lowpass_shift,
+            adc_rate_hz: fs,
+        };
+        trimmed_sense_offset(&spec.resonator, f.mode, &inputs)
+    } else {
+        designed
+    };
     let scale = crate::fx::pow2(s.lock_filter_shift as i32);
     let lock_q = setpoint * libm::sin(checked.lock_phase.to_radians()) * scale;
     let lock_a = checked.lock_tolerance * setpoint * scale;
@@ -708,6 +721,7 @@ fn mode_plan(
         dac_offset_word: word(nco, dac_offset)?,
         sense_offset,
         sense_offset_word: word(nco, sense_offset)?,
+        sense_offset_trim: sense_offset - designed,
         sense_gain_per_dps: physics.sense,
         rate_coefficient: coefficients[0],
         quadrature_coefficient: coefficients[1],

@@ -78,6 +78,12 @@ pub struct LoopSettings {
     /// not fit is refused.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scale_coefficient_format: Option<String>,
+    /// Trim each mode's sense offset `δ_S` so that the loop realizes the configured phase
+    /// error: designed at the coupled resonance the PLL locks on and net of the PLL's `2f`
+    /// phase modulation, where `false` designs it at `sqrt(k_aa/m)` (see
+    /// `gyro_loop::realized_phase`). Only the per-mode offset words change.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub phase_trim: bool,
     /// Rate and quadrature outputs, °/s (the chain's input format).
     pub output_format: String,
     /// Rounding mode name at every configurable point.
@@ -130,6 +136,7 @@ impl Default for LoopSettings {
             cic_output_format: s("s32.30"),
             scale_coefficient_width: 24,
             scale_coefficient_format: None,
+            phase_trim: false,
             output_format: s("s24.14"),
             rounding: s("nearest"),
             overflow: s("saturate"),
@@ -173,4 +180,10 @@ impl LoopSettings {
             )
         })
     }
+}
+
+/// `serde`'s skip test for `phase_trim`: the default (off) is left out of the resolved config,
+/// so packages made without it keep their manifests.
+fn is_false(value: &bool) -> bool {
+    !*value
 }
