@@ -43,10 +43,11 @@
  *   droop compensator's taps), $readmemh images.
  */
 module gyrofx_gyro_loop #(
-    // NCOs: phase bits, quarter-wave ROM address bits, sine width
+    // NCOs: phase bits, quarter-wave ROM address bits, sine width, truncation error feedback
     parameter integer NCO_PHASE_W = 32,
     parameter integer NCO_ADDR_W = 10,
     parameter integer NCO_SIN_W = 18,
+    parameter integer NCO_ERROR_FEEDBACK = 1,
     // demodulators (both): ADC, reference, product, state and output formats, low-pass shift
     parameter integer DEMOD_ADC_W = 24,
     parameter integer DEMOD_ADC_F = 23,
@@ -192,21 +193,24 @@ wire signed [NCO_SIN_W-1:0] sense_cos;
 
 /* verilator lint_off PINCONNECTEMPTY */
 gyrofx_nco #(
-    .PHASE_W(NCO_PHASE_W), .ADDR_W(NCO_ADDR_W), .SIN_W(NCO_SIN_W), .ROM_FILE(NCO_ROM_FILE)
+    .PHASE_W(NCO_PHASE_W), .ADDR_W(NCO_ADDR_W), .SIN_W(NCO_SIN_W),
+    .ERROR_FEEDBACK(NCO_ERROR_FEEDBACK), .ROM_FILE(NCO_ROM_FILE)
 ) nco_drive (
     .clk(clk), .rst(rst), .ce(ce), .freq(freq_now), .offset({NCO_PHASE_W{1'b0}}),
     .sin_out(drive_sin), .cos_out(drive_cos), .out_valid()
 );
 
 gyrofx_nco #(
-    .PHASE_W(NCO_PHASE_W), .ADDR_W(NCO_ADDR_W), .SIN_W(NCO_SIN_W), .ROM_FILE(NCO_ROM_FILE)
+    .PHASE_W(NCO_PHASE_W), .ADDR_W(NCO_ADDR_W), .SIN_W(NCO_SIN_W),
+    .ERROR_FEEDBACK(NCO_ERROR_FEEDBACK), .ROM_FILE(NCO_ROM_FILE)
 ) nco_transmit (
     .clk(clk), .rst(rst), .ce(ce), .freq(freq_now), .offset(dac_offset),
     .sin_out(transmit_sin), .cos_out(transmit_cos), .out_valid()
 );
 
 gyrofx_nco #(
-    .PHASE_W(NCO_PHASE_W), .ADDR_W(NCO_ADDR_W), .SIN_W(NCO_SIN_W), .ROM_FILE(NCO_ROM_FILE)
+    .PHASE_W(NCO_PHASE_W), .ADDR_W(NCO_ADDR_W), .SIN_W(NCO_SIN_W),
+    .ERROR_FEEDBACK(NCO_ERROR_FEEDBACK), .ROM_FILE(NCO_ROM_FILE)
 ) nco_sense (
     .clk(clk), .rst(rst), .ce(ce), .freq(freq_now), .offset(sense_offset),
     .sin_out(sense_sin), .cos_out(sense_cos), .out_valid()

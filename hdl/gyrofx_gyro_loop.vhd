@@ -30,10 +30,11 @@ use ieee.numeric_std.all;
 
 entity gyrofx_gyro_loop is
     generic (
-        -- NCOs: phase bits, quarter-wave ROM address bits, sine width
+        -- NCOs: phase bits, quarter-wave ROM address bits, sine width, truncation error feedback
         NCO_PHASE_W : positive := 32;
         NCO_ADDR_W : positive := 10;
         NCO_SIN_W : positive := 18;
+        NCO_ERROR_FEEDBACK : natural := 1;
         -- demodulators (both)
         DEMOD_ADC_W : positive := 24;
         DEMOD_ADC_F : integer := 23;
@@ -282,7 +283,7 @@ begin
     nco_drive : entity work.gyrofx_nco
         generic map (
             PHASE_W => NCO_PHASE_W, ADDR_W => NCO_ADDR_W, SIN_W => NCO_SIN_W,
-            ROM_FILE => NCO_ROM_FILE
+            ERROR_FEEDBACK => NCO_ERROR_FEEDBACK, ROM_FILE => NCO_ROM_FILE
         )
         port map (
             clk => clk, rst => rst, ce => ce, freq => freq_now, offset => (others => '0'),
@@ -292,7 +293,7 @@ begin
     nco_transmit : entity work.gyrofx_nco
         generic map (
             PHASE_W => NCO_PHASE_W, ADDR_W => NCO_ADDR_W, SIN_W => NCO_SIN_W,
-            ROM_FILE => NCO_ROM_FILE
+            ERROR_FEEDBACK => NCO_ERROR_FEEDBACK, ROM_FILE => NCO_ROM_FILE
         )
         port map (
             clk => clk, rst => rst, ce => ce, freq => freq_now, offset => dac_offset,
@@ -302,7 +303,7 @@ begin
     nco_sense : entity work.gyrofx_nco
         generic map (
             PHASE_W => NCO_PHASE_W, ADDR_W => NCO_ADDR_W, SIN_W => NCO_SIN_W,
-            ROM_FILE => NCO_ROM_FILE
+            ERROR_FEEDBACK => NCO_ERROR_FEEDBACK, ROM_FILE => NCO_ROM_FILE
         )
         port map (
             clk => clk, rst => rst, ce => ce, freq => freq_now, offset => sense_offset,

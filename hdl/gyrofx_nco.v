@@ -37,6 +37,8 @@ module gyrofx_nco #(
     parameter integer ADDR_W = 10,
     // sine and cosine width, s SIN_W.SIN_W-1
     parameter integer SIN_W = 18,
+    // 1: carry each truncation error into the next phase (needs PHASE_W > ADDR_W + 2)
+    parameter integer ERROR_FEEDBACK = 1,
     // quarter-wave sine ROM image for $readmemh
     parameter ROM_FILE = "nco_sine.mem"
 ) (
@@ -52,10 +54,17 @@ module gyrofx_nco #(
 
 // Truncated phase: quadrant (2 bits) and ROM index.
 localparam integer T_W = ADDR_W + 2;
+// The carried error's width: the phase bits below the truncation (1 when there are none, and
+// then unused).
+localparam integer R_W = (PHASE_W > T_W) ? PHASE_W - T_W : 1;
 
 initial begin
     if (PHASE_W < T_W) begin
         $display("%m: PHASE_W (%0d) must be >= ADDR_W + 2 (%0d)", PHASE_W, T_W);
+        $finish;
+    end
+    if (ERROR_FEEDBACK != 0 && PHASE_W == T_W) begin
+        $display("%m: ERROR_FEEDBACK needs PHASE_W (%0d) > ADDR_W + 2", PHASE_W);
         $finish;
     end
 end
@@ -71,8 +80,17 @@ reg [ADDR_W-1:0] cos_addr_reg = {ADDR_W{1'b0}};
 reg sin_negative_reg = 1'b0;
 reg cos_negative_reg = 1'b0;
 reg valid_reg = 1'b0;
+// The last truncation error, signed, in phase LSB: [-2^(R_W-1), 2^(R_W-1)).
+reg signed [R_W-1:0] residue_reg = {R_W{1'b0}};
 
-wire [PHASE_W-1:0] phase = acc_reg + offset;
+wire [PHASE_W-1:0] phase_exact = acc_reg + offset;
+// With error feedback the carried error joins the phase (sign-extended, mod one cycle).
+wire [PHASE_W-1:0] residue_extended = {{(PHASE_W - R_W){residue_reg[R_W-1]}}, residue_reg};
+wire [PHASE_W-1:0] phase = (ERROR_FEEDBACK != 0) ? phase_exact + residue_extended : phase_exact;
+// What is left below the truncation, less half a bin: its top bit inverted, read as signed.
+localparam [R_W-1:0] ONES = {R_W{1'b1}};
+localparam [R_W-1:0] HALF_BIN = ONES ^ (ONES >> 1);
+wire signed [R_W-1:0] residue_next = phase[R_W-1:0] ^ HALF_BIN;
 
 // The phase truncation: an unsigned phase seen as a signed value with a zero
 // sign bit, floored to T_W fraction bits; it always fits, so only its low
@@ -105,11 +123,15 @@ always @(posedge clk) begin
         cos_addr_reg <= cos_addr;
         sin_negative_reg <= t_sin[T_W-1];
         cos_negative_reg <= t_cos[T_W-1];
+        if (ERROR_FEEDBACK != 0) begin
+            residue_reg <= residue_next;
+        end
     end
     valid_reg <= ce;
 
     if (rst) begin
         acc_reg <= {PHASE_W{1'b0}};
+        residue_reg <= {R_W{1'b0}};
         valid_reg <= 1'b0;
     end
 end

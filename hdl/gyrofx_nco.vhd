@@ -37,6 +37,8 @@ entity gyrofx_nco is
         ADDR_W : positive := 10;
         -- sine and cosine width, s SIN_W.SIN_W-1
         SIN_W : positive := 18;
+        -- 1: carry each truncation error into the next phase (needs PHASE_W > ADDR_W + 2)
+        ERROR_FEEDBACK : natural := 1;
         -- quarter-wave sine ROM image (hex, one word per line)
         ROM_FILE : string := "nco_sine.mem"
     );
@@ -56,6 +58,24 @@ architecture rtl of gyrofx_nco is
 
     -- Truncated phase: quadrant (2 bits) and ROM index.
     constant T_W : positive := ADDR_W + 2;
+    -- The carried error's width: the phase bits below the truncation (1 when there are none,
+    -- and then unused).
+    function residue_width return positive is
+    begin
+        if PHASE_W > T_W then
+            return PHASE_W - T_W;
+        end if;
+        return 1;
+    end function;
+    constant R_W : positive := residue_width;
+    -- Half a bin in phase LSB: the top bit of the carried error.
+    function top_bit_only return signed is
+        variable bin : signed(R_W - 1 downto 0) := (others => '0');
+    begin
+        bin(R_W - 1) := '1';
+        return bin;
+    end function;
+    constant HALF_BIN : signed(R_W - 1 downto 0) := top_bit_only;
     constant ROM : word_array(0 to 2 ** ADDR_W - 1)(SIN_W - 1 downto 0) :=
         read_mem(ROM_FILE, 2 ** ADDR_W, SIN_W);
 
@@ -65,7 +85,11 @@ architecture rtl of gyrofx_nco is
     signal sin_negative_reg : std_logic := '0';
     signal cos_negative_reg : std_logic := '0';
     signal valid_reg : std_logic := '0';
+    -- The last truncation error, signed, in phase LSB: [-2^(R_W-1), 2^(R_W-1)).
+    signal residue_reg : signed(R_W - 1 downto 0) := (others => '0');
+    signal residue_next : signed(R_W - 1 downto 0);
 
+    signal phase_exact : unsigned(PHASE_W - 1 downto 0);
     signal phase : unsigned(PHASE_W - 1 downto 0);
     signal phase_signed : signed(PHASE_W downto 0);
     signal t_signed : signed(T_W downto 0);
@@ -82,8 +106,17 @@ begin
         report "gyrofx_nco: PHASE_W (" & integer'image(PHASE_W) & ") must be >= ADDR_W + 2 ("
             & integer'image(T_W) & ")"
         severity failure;
+    assert ERROR_FEEDBACK = 0 or PHASE_W > T_W
+        report "gyrofx_nco: ERROR_FEEDBACK needs PHASE_W (" & integer'image(PHASE_W)
+            & ") > ADDR_W + 2"
+        severity failure;
 
-    phase <= acc_reg + offset;
+    phase_exact <= acc_reg + offset;
+    -- With error feedback the carried error joins the phase (sign-extended, mod one cycle).
+    phase <= phase_exact + unsigned(resize(residue_reg, PHASE_W)) when ERROR_FEEDBACK /= 0
+        else phase_exact;
+    -- What is left below the truncation, less half a bin: its top bit inverted, read as signed.
+    residue_next <= signed(phase(R_W - 1 downto 0)) xor HALF_BIN;
 
     -- The phase truncation: the unsigned phase seen as a signed value with a zero sign
     -- bit, floored to T_W fraction bits; it always fits, so only its low T_W bits count.
@@ -112,11 +145,15 @@ begin
                 cos_addr_reg <= cos_addr;
                 sin_negative_reg <= t_sin(T_W - 1);
                 cos_negative_reg <= t_cos(T_W - 1);
+                if ERROR_FEEDBACK /= 0 then
+                    residue_reg <= residue_next;
+                end if;
             end if;
             valid_reg <= ce;
 
             if rst = '1' then
                 acc_reg <= (others => '0');
+                residue_reg <= (others => '0');
                 valid_reg <= '0';
             end if;
         end if;

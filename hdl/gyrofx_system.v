@@ -79,6 +79,7 @@ module gyrofx_system #(
     parameter integer NCO_PHASE_W = 32,
     parameter integer NCO_ADDR_W = 10,
     parameter integer NCO_SIN_W = 18,
+    parameter integer NCO_ERROR_FEEDBACK = 1,
     parameter integer DEMOD_ADC_W = 24,
     parameter integer DEMOD_ADC_F = 23,
     parameter integer DEMOD_REF_W = 18,
@@ -248,6 +249,7 @@ wire loop_valid;
 /* verilator lint_off PINCONNECTEMPTY */
 gyrofx_gyro_loop #(
         .NCO_PHASE_W(NCO_PHASE_W), .NCO_ADDR_W(NCO_ADDR_W), .NCO_SIN_W(NCO_SIN_W),
+        .NCO_ERROR_FEEDBACK(NCO_ERROR_FEEDBACK),
         .DEMOD_ADC_W(DEMOD_ADC_W), .DEMOD_ADC_F(DEMOD_ADC_F), .DEMOD_REF_W(DEMOD_REF_W),
         .DEMOD_REF_F(DEMOD_REF_F), .DEMOD_PROD_W(DEMOD_PROD_W), .DEMOD_PROD_F(DEMOD_PROD_F),
         .DEMOD_STATE_W(DEMOD_STATE_W), .DEMOD_STATE_F(DEMOD_STATE_F),
@@ -285,6 +287,7 @@ gyrofx_gyro_loop #(
 // B decimates by the same factor from the same reset: its out_valid is A's.
 gyrofx_gyro_loop #(
         .NCO_PHASE_W(NCO_PHASE_W), .NCO_ADDR_W(NCO_ADDR_W), .NCO_SIN_W(NCO_SIN_W),
+        .NCO_ERROR_FEEDBACK(NCO_ERROR_FEEDBACK),
         .DEMOD_ADC_W(DEMOD_ADC_W), .DEMOD_ADC_F(DEMOD_ADC_F), .DEMOD_REF_W(DEMOD_REF_W),
         .DEMOD_REF_F(DEMOD_REF_F), .DEMOD_PROD_W(DEMOD_PROD_W), .DEMOD_PROD_F(DEMOD_PROD_F),
         .DEMOD_STATE_W(DEMOD_STATE_W), .DEMOD_STATE_F(DEMOD_STATE_F),

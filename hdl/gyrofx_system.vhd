@@ -71,6 +71,7 @@ entity gyrofx_system is
         NCO_PHASE_W : positive := 32;
         NCO_ADDR_W : positive := 10;
         NCO_SIN_W : positive := 18;
+        NCO_ERROR_FEEDBACK : natural := 1;
         DEMOD_ADC_W : positive := 24;
         DEMOD_ADC_F : integer := 23;
         DEMOD_REF_W : positive := 18;
@@ -254,6 +255,7 @@ begin
     loop_a : entity work.gyrofx_gyro_loop
         generic map (
             NCO_PHASE_W => NCO_PHASE_W, NCO_ADDR_W => NCO_ADDR_W, NCO_SIN_W => NCO_SIN_W,
+            NCO_ERROR_FEEDBACK => NCO_ERROR_FEEDBACK,
             DEMOD_ADC_W => DEMOD_ADC_W, DEMOD_ADC_F => DEMOD_ADC_F, DEMOD_REF_W => DEMOD_REF_W,
             DEMOD_REF_F => DEMOD_REF_F, DEMOD_PROD_W => DEMOD_PROD_W,
             DEMOD_PROD_F => DEMOD_PROD_F, DEMOD_STATE_W => DEMOD_STATE_W,
@@ -296,6 +298,7 @@ begin
     loop_b : entity work.gyrofx_gyro_loop
         generic map (
             NCO_PHASE_W => NCO_PHASE_W, NCO_ADDR_W => NCO_ADDR_W, NCO_SIN_W => NCO_SIN_W,
+            NCO_ERROR_FEEDBACK => NCO_ERROR_FEEDBACK,
             DEMOD_ADC_W => DEMOD_ADC_W, DEMOD_ADC_F => DEMOD_ADC_F, DEMOD_REF_W => DEMOD_REF_W,
             DEMOD_REF_F => DEMOD_REF_F, DEMOD_PROD_W => DEMOD_PROD_W,
             DEMOD_PROD_F => DEMOD_PROD_F, DEMOD_STATE_W => DEMOD_STATE_W,

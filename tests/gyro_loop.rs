@@ -186,7 +186,7 @@ fn loop_plots_the_switch_as_png_or_svg() {
 
 /// `[loop] phase_trim = true` (issue 32): only the per-mode sense offsets change (the
 /// parameters the RTL already takes), the loop then realizes the configured 1° (where it
-/// realizes 0.99914° / 1.00126° untrimmed), and the trimmed loop's vectors hold bit for bit in
+/// realizes 0.99915° / 1.00116° untrimmed), and the trimmed loop's vectors hold bit for bit in
 /// Icarus, Verilator and GHDL.
 #[test]
 fn the_phase_trim_changes_only_the_sense_offsets_and_is_bit_exact_in_every_simulator() {

@@ -84,8 +84,28 @@ fn the_nco_passes_at_other_widths() {
                 phase_bits: 12,
                 address_bits: 4,
                 sine_width: 8,
+                error_feedback: false,
             },
             2,
+        ),
+        // Error feedback: one bit carried (P = A + 3) and many.
+        (
+            "feedback_one_bit",
+            nco_model::Spec {
+                phase_bits: 9,
+                address_bits: 6,
+                sine_width: 12,
+                error_feedback: true,
+            },
+            5,
+        ),
+        (
+            "feedback",
+            nco_model::Spec {
+                error_feedback: true,
+                ..nco_model::Spec::default()
+            },
+            6,
         ),
         // No truncation (P = A + 2), a wide sine.
         (
@@ -94,6 +114,7 @@ fn the_nco_passes_at_other_widths() {
                 phase_bits: 8,
                 address_bits: 6,
                 sine_width: 24,
+                error_feedback: false,
             },
             3,
         ),
@@ -104,6 +125,7 @@ fn the_nco_passes_at_other_widths() {
                 phase_bits: 63,
                 address_bits: 12,
                 sine_width: 16,
+                error_feedback: true,
             },
             4,
         ),

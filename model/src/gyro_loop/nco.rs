@@ -31,6 +31,26 @@
 //! The drive and sense references are two instances fed the same `freq` (their accumulators
 //! stay identical), with `offset` 0 and the per-mode sense phase.
 //!
+//! # Error feedback (`error_feedback`)
+//!
+//! Truncated alone, the phase error `e_k` (at most half a bin) averages out only when the bin
+//! positions of successive samples spread evenly; where `2^(A+2) f/fs` sits near a fraction of
+//! small denominator they do not, and the references hold a static phase error of up to a
+//! quarter bin or so (0.026° at `A` = 10: it moved a gyro loop's bias by mdps, issue 32). With
+//! error feedback each NCO keeps the phase left below the truncation, less half a bin
+//! (`r_k`, signed, `P − A − 2` bits), and adds it to the next sample's phase before
+//! truncating:
+//!
+//! ```text
+//! u   = (phase + r_{k−1}) mod 2^P
+//! t   = floor(u / 2^(P−A−2))
+//! r_k = (u mod 2^(P−A−2)) − 2^(P−A−3)
+//! ```
+//!
+//! Each output is then `r_{k−1} − r_k` from the exact phase (less than a bin), and the errors
+//! of any run of samples sum to `r_{−1} − r_{last}`: less than one bin, whatever the frequency.
+//! The reset clears `r`.
+//!
 //! # Quantization points
 //!
 //! | point | from | to | rounding | overflow |
@@ -79,16 +99,23 @@ pub struct Spec {
     pub address_bits: u32,
     /// `S`: width of the sine and cosine outputs, `s S.(S−1)`.
     pub sine_width: u32,
+    /// Carry each sample's truncation error into the next sample's phase (first-order error
+    /// feedback, see the module doc): the references then hold no static phase error at any
+    /// frequency, at the price of each output being within one bin of the exact phase instead
+    /// of half a bin. Needs `P > A + 2`.
+    pub error_feedback: bool,
 }
 
 impl Default for Spec {
-    /// `P` = 32, `A` = 10, `S` = 18: phase error ≤ 0.044° (half of a 12-bit phase bin),
-    /// truncation spurs near −72 dBc; within 101 output LSB of the exact sine.
+    /// `P` = 32, `A` = 10, `S` = 18, error feedback: phase error < 0.088° (a 12-bit phase
+    /// bin) per sample and no static phase error at any frequency; within 202 output LSB of
+    /// the exact sine.
     fn default() -> Self {
         Spec {
             phase_bits: 32,
             address_bits: 10,
             sine_width: 18,
+            error_feedback: true,
         }
     }
 }
@@ -108,6 +135,8 @@ pub struct Plan {
     pub truncation: Point,
     /// `A`.
     pub address_bits: u32,
+    /// The truncation error is carried into the next sample's phase.
+    pub error_feedback: bool,
     /// `s S.(S−1)`: sine, cosine and ROM words.
     pub output: Format,
     /// Rounding of the ROM words (convergent; a test mutates it).
@@ -157,6 +186,17 @@ impl Plan {
                 ),
             ));
         }
+        if spec.error_feedback && spec.phase_bits == a + 2 {
+            return Err(field_error(
+                "nco",
+                "error_feedback",
+                true,
+                format!(
+                    "false when phase_bits = address_bits + 2 = {} (no bits below the truncation to carry)",
+                    a + 2
+                ),
+            ));
+        }
         let p = spec.phase_bits;
         let phase = Format::new(false, p, p as i32).expect("1..=63 bits");
         let truncated = Format::new(false, a + 2, (a + 2) as i32).expect("4..=22 bits");
@@ -186,6 +226,7 @@ impl Plan {
             phase,
             truncation,
             address_bits: a,
+            error_feedback: spec.error_feedback,
             output,
             rom_rounding,
             rom,
@@ -238,17 +279,20 @@ impl Plan {
     pub fn error_bound_lsb(&self) -> f64 {
         let amplitude_lsb = self.output.max_code() as f64;
         let half_bin_rad = PI / crate::fx::pow2(self.address_bits as i32 + 2);
+        // With error feedback the carried error adds up to another half bin.
+        let bins = if self.error_feedback { 2.0 } else { 1.0 };
         self.rom_rounding.max_error_lsb()
-            + amplitude_lsb * half_bin_rad
+            + amplitude_lsb * half_bin_rad * bins
             + super::f64_rounding(16.0 * amplitude_lsb)
     }
 
-    /// Parameters of `hdl/gyrofx_nco.v`: `PHASE_W`, `ADDR_W`, `SIN_W`.
+    /// Parameters of `hdl/gyrofx_nco.v`: `PHASE_W`, `ADDR_W`, `SIN_W`, `ERROR_FEEDBACK`.
     pub fn rtl_parameters(&self) -> Vec<RtlParameter> {
         vec![
             ("PHASE_W", i128::from(self.phase.width)),
             ("ADDR_W", i128::from(self.address_bits)),
             ("SIN_W", i128::from(self.output.width)),
+            ("ERROR_FEEDBACK", i128::from(self.error_feedback)),
         ]
     }
 }
@@ -270,6 +314,8 @@ pub struct FixedNco {
     truncation_shift: u32,
     mask: u64,
     address_bits: u32,
+    /// With error feedback: the last truncation error, phase LSB in `[−2^(P−A−3), 2^(P−A−3))`.
+    residue: Option<i64>,
     acc: u64,
 }
 
@@ -281,13 +327,15 @@ impl FixedNco {
             truncation_shift: plan.phase.width - (plan.address_bits + 2),
             mask: u64::MAX >> (64 - plan.phase.width),
             address_bits: plan.address_bits,
+            residue: plan.error_feedback.then_some(0),
             acc: 0,
         }
     }
 
-    /// Synchronous reset: the accumulator to 0.
+    /// Synchronous reset: the accumulator (and the carried error) to 0.
     pub fn reset(&mut self) {
         self.acc = 0;
+        self.residue = self.residue.map(|_| 0);
     }
 
     /// The accumulator (`u P.P` cycles): the phase of the next sample without offset.
@@ -300,8 +348,15 @@ impl FixedNco {
     /// ports have only `P`).
     #[inline]
     pub fn step(&mut self, freq: u64, offset: u64) -> Reference {
-        let phase = self.acc.wrapping_add(offset) & self.mask;
+        let mut phase = self.acc.wrapping_add(offset) & self.mask;
         self.acc = self.acc.wrapping_add(freq) & self.mask;
+        if let Some(residue) = self.residue.as_mut() {
+            // The carried error, then the new one: the phase below the truncation, less
+            // half a bin (the ROM holds bin centres), in [−half, half).
+            phase = phase.wrapping_add(*residue as u64) & self.mask;
+            let half = 1i64 << (self.truncation_shift - 1);
+            *residue = (phase & ((1u64 << self.truncation_shift) - 1)) as i64 - half;
+        }
         // The plan's truncation point: floor of the unsigned phase into A + 2 bits.
         let t = (phase >> self.truncation_shift) as u32;
         let quarter = 1u32 << self.address_bits;

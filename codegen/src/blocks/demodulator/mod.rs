@@ -113,6 +113,7 @@ pub fn push_vectors(block: &mut Block, plan: &Plan, seed: u64) -> u64 {
         phase_bits: 32,
         address_bits: 8,
         sine_width: r_format.width,
+        error_feedback: false,
     })
     .expect("the reference is an NCO's sine");
     let mut reference = FixedNco::new(&tone);

@@ -410,11 +410,13 @@ proptest! {
         qs in (100.0f64..400.0, 100.0f64..400.0),
         latency in 0u32..=3,
         phase_trim in any::<bool>(),
+        nco_error_feedback in any::<bool>(),
     ) {
         let mut spec = structure(angles, phases, frequencies, qs, latency);
         spec.settings.phase_trim = phase_trim;
+        spec.settings.nco_error_feedback = nco_error_feedback;
         let plan = Plan::new(&spec).unwrap();
-        let truncation = truncation_allowance_deg(&plan);
+        let truncation = if nco_error_feedback { 0.0 } else { truncation_allowance_deg(&plan) };
         // Some structures in this range have a closed-loop pole of ~45 ms after a switch
         // (ε 2.2°, split 20 Hz, Q 364 / 100): 300 ms leaves 10 mdps of it in reverse mode.
         let procedure = Procedure { switch_ms: 1000.0, ..Procedure::default() };
@@ -490,4 +492,63 @@ fn the_phase_trim_realizes_the_configured_phase() {
         "{residual:?} against {}",
         float.residual_configured_phase_dps
     );
+}
+
+/// Two structures whose locked frequency puts `2^12 f_L/fs` near a small fraction (0.49997 and
+/// 0.99958 mod 1 in reverse mode), where the plain truncation moves the fixed loop's phase by
+/// 0.026° and its gain by 3e-4 (a phase off by 0.026°, a residual off by 76 mdps on 41):
+/// `nco_error_feedback` (the default) brings both within the 5 % or 2 mdps of the
+/// prediction, and
+/// each phase within 2e-3° of it.
+#[test]
+fn nco_error_feedback_takes_the_truncations_static_error_away() {
+    let structures = [
+        structure(
+            (0.05, 0.0),
+            (0.0, 0.0),
+            (10593.638240397779, 22.350705291363926),
+            (100.0, 100.0),
+            0,
+        ),
+        structure(
+            (0.05, 4.40813367455242),
+            (0.0, 0.0),
+            (9837.512429938424, 71.90772520106682),
+            (167.7771012092544, 100.0),
+            0,
+        ),
+    ];
+    let procedure = Procedure {
+        switch_ms: 1000.0,
+        ..Procedure::default()
+    };
+    for mut spec in structures {
+        spec.settings.nco_error_feedback = false;
+        let run = |spec: &Spec| {
+            let plan = Plan::new(spec).unwrap();
+            characterize::<FixedHarness>(&plan, &spec.resonator, &spec.front_end, &procedure)
+                .unwrap()
+        };
+        let phase_gap = |c: &Characterization| {
+            [&c.normal, &c.reverse]
+                .map(|m| (m.reference_phase_deg.measured - m.reference_phase_deg.predicted).abs())
+                .into_iter()
+                .fold(0.0, f64::max)
+        };
+        let plain = run(&spec);
+        assert!(
+            residual_gap(&plain, 0.0) > 1.0 || phase_gap(&plain) > 0.01,
+            "{:?}, phase {}",
+            plain.residual_bias_dps,
+            phase_gap(&plain)
+        );
+        spec.settings.nco_error_feedback = true;
+        let fed_back = run(&spec);
+        assert!(
+            residual_gap(&fed_back, 0.0) <= 1.0,
+            "{:?}",
+            fed_back.residual_bias_dps
+        );
+        assert!(phase_gap(&fed_back) < 2e-3, "{}", phase_gap(&fed_back));
+    }
 }

@@ -89,6 +89,7 @@ const NCO_KEYS: Keys = &[
     ("phase_bits", "nco_phase_bits"),
     ("address_bits", "nco_address_bits"),
     ("sine_width", "nco_sine_width"),
+    ("error_feedback", "nco_error_feedback"),
 ];
 const DEMODULATOR_KEYS: Keys = &[
     ("input_format", "adc_format"),
@@ -347,6 +348,7 @@ impl LeafBlocks {
             phase_bits: s.nco_phase_bits,
             address_bits: s.nco_address_bits,
             sine_width: s.nco_sine_width,
+            error_feedback: s.nco_error_feedback,
         })
         .map_err(config_key(NCO_KEYS))?;
         let demod_output = format("demod_output_format", &s.demod_output_format)?;

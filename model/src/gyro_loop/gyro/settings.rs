@@ -35,6 +35,9 @@ pub struct LoopSettings {
     pub nco_phase_bits: u32,
     /// NCO quarter-wave ROM address bits `A`.
     pub nco_address_bits: u32,
+    /// Carry each NCO's truncation error into its next phase (see `gyro_loop::nco`): no static
+    /// phase error from the truncation at any locked frequency. On by default.
+    pub nco_error_feedback: bool,
     /// NCO sine width `S` (`s S.(S−1)`).
     pub nco_sine_width: u32,
     /// ADC codes, `s W.(W−1)` full-scale units; `W` must be the resonator's ADC width.
@@ -116,6 +119,7 @@ impl Default for LoopSettings {
             lock_filter_shift: 9,
             nco_phase_bits: 32,
             nco_address_bits: 10,
+            nco_error_feedback: true,
             nco_sine_width: 18,
             adc_format: s("s24.23"),
             demod_product_format: s("s36.34"),

@@ -6,6 +6,7 @@ fn spec(p: u32, a: u32, s: u32) -> Spec {
         phase_bits: p,
         address_bits: a,
         sine_width: s,
+        error_feedback: false,
     }
 }
 
@@ -131,17 +132,97 @@ fn plan_errors_name_the_field() {
     assert!(text.contains("nco.sine_width = 40"), "{text}");
 }
 
+/// The mean phase error (in bins) of the sine over `n` samples at frequency word `freq`, read
+/// as `(sin_fixed cos θ − cos_fixed sin θ)/A_nco ≈ sin e` against the exact phase `θ`.
+fn mean_phase_error_bins(plan: &Plan, freq: u64, n: usize) -> f64 {
+    let mut nco = FixedNco::new(plan);
+    let cycle = crate::fx::pow2(plan.phase.width as i32);
+    let amplitude = plan.amplitude();
+    let bin_rad = 2.0 * std::f64::consts::PI / crate::fx::pow2(plan.address_bits as i32 + 2);
+    let mut sum = 0.0;
+    for _ in 0..n {
+        let theta = 2.0 * std::f64::consts::PI * (nco.accumulator() as f64 / cycle);
+        let r = nco.step(freq, 0);
+        let (sin, cos) = (
+            plan.output.to_f64(i128::from(r.sin)),
+            plan.output.to_f64(i128::from(r.cos)),
+        );
+        sum += (sin * libm::cos(theta) - cos * libm::sin(theta)) / amplitude;
+    }
+    sum / n as f64 / bin_rad
+}
+
+/// Where `2^(A+2) f/fs` sits half-way between integers the bin positions alternate between
+/// two values and the truncation errors stop averaging out: a static error of a quarter bin
+/// (issue 32's gyro loop, `2^12 f_L/fs` = 0.49997 mod 1). Error feedback takes it to the
+/// bound of one bin over the run.
+#[test]
+fn error_feedback_takes_the_static_error_of_a_near_fraction_away() {
+    let (p, a) = (32, 10);
+    let bin = 1u64 << (p - a - 2);
+    // Half a bin a sample, plus a whole number of bins and a drift of one LSB.
+    let freq = 167 * bin + bin / 2 + 1;
+    let n = 20_000;
+    let plain = Plan::new(&spec(p, a, 18)).unwrap();
+    let fed_back = Plan::new(&Spec {
+        error_feedback: true,
+        ..spec(p, a, 18)
+    })
+    .unwrap();
+    let static_error = mean_phase_error_bins(&plain, freq, n);
+    assert!(static_error.abs() > 0.2, "{static_error}");
+    let shaped = mean_phase_error_bins(&fed_back, freq, n);
+    // One bin over the run, and the ROM's rounding.
+    assert!(shaped.abs() < 2.0 / n as f64 + 1e-4, "{shaped}");
+}
+
+/// The carried error is what is left below the truncation less half a bin, and the reset
+/// clears it: the first sample after a reset is the plain NCO's.
+#[test]
+fn error_feedback_carries_the_remainder_and_the_reset_clears_it() {
+    let plain = Plan::new(&spec(16, 4, 12)).unwrap();
+    let fed_back = Plan::new(&Spec {
+        error_feedback: true,
+        ..spec(16, 4, 12)
+    })
+    .unwrap();
+    // A bin is 2^10 phase LSB; a step of 1.25 bins moves the plain NCO by one bin three times in
+    // four and the fed-back one in the pattern of the carried quarter bins.
+    let freq = 1280;
+    let (mut a, mut b) = (FixedNco::new(&plain), FixedNco::new(&fed_back));
+    let walk = |nco: &mut FixedNco| -> Vec<i64> { (0..8).map(|_| nco.step(freq, 0).sin).collect() };
+    let (first, shaped) = (walk(&mut a), walk(&mut b));
+    assert_eq!(first[0], shaped[0]);
+    assert_ne!(first, shaped);
+    b.reset();
+    assert_eq!(walk(&mut b), shaped);
+    let text = Plan::new(&Spec {
+        error_feedback: true,
+        ..spec(12, 10, 18)
+    })
+    .unwrap_err()
+    .to_string();
+    assert!(
+        text.contains("nco.error_feedback = true")
+            && text.contains("phase_bits = address_bits + 2"),
+        "{text}"
+    );
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(200))]
-    /// Random widths, frequency words and offsets: every sample within the derived bound.
+    /// Random widths, frequency words and offsets, with or without error feedback: every
+    /// sample within the derived bound.
     #[test]
     fn fixed_stays_within_the_derived_bound_of_float(
         a in 2u32..=12,
         s in 3u32..=24,
         extra in 0u32..=30,
+        error_feedback in any::<bool>(),
         words in prop::collection::vec((any::<u64>(), any::<u64>()), 1..400),
     ) {
-        let plan = Plan::new(&spec(a + 2 + extra, a, s)).unwrap();
+        let error_feedback = error_feedback && extra > 0;
+        let plan = Plan::new(&Spec { error_feedback, ..spec(a + 2 + extra, a, s) }).unwrap();
         let worst = worst_error(&plan, &words);
         prop_assert!(worst <= plan.error_bound_lsb(), "{} > {}", worst, plan.error_bound_lsb());
     }

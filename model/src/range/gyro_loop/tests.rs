@@ -409,6 +409,7 @@ fn any_demodulator() -> impl Strategy<Value = (nco::Plan, demodulator::Plan)> {
                     phase_bits: a + 2 + p,
                     address_bits: a,
                     sine_width: s,
+                    error_feedback: false,
                 })
                 .ok()?;
                 let input = signed(1, w as i32 - 1)?;
