@@ -101,8 +101,11 @@ def test_a_loop_closed_around_the_resonator_retraces_the_vectors_run(package):
 
 def test_the_loops_float_twin_agrees_away_from_saturation(package):
     """Fed the same ADC record, the twin's rate and quadrature agree with the fixed loop's
-    within 0.01 °/s (the settling criterion of the loop's closed-loop tests) wherever the fixed
-    output is not saturated (right after a switch it is, by design)."""
+    within 0.01 °/s (the settling criterion of the loop's closed-loop tests) plus 5e-5 of the
+    output, wherever the fixed output is not saturated (right after a switch it is, by design).
+    The relative part is for the samples just after a switch, where the outputs are hundreds
+    of °/s: the NCOs' references differ from the twin's exact phase by up to a bin per sample
+    (error feedback), and 1e-5 to 3e-5 of such an output is left after the CIC."""
     plan = gyrofx.Plan.from_package(package)
     rows = loop_record(package)
     loop, twin = plan.gyro_loop(), plan.gyro_loop_float()
@@ -117,7 +120,8 @@ def test_the_loops_float_twin_agrees_away_from_saturation(package):
         assert real["out_valid"] == fixed["out_valid"]
         if fixed["out_valid"] and all(low < fixed[p] < high for p in ("rate", "quadrature")):
             for port in ("rate", "quadrature"):
-                assert abs(real[port] - fixed[port] * 2.0**-out_frac) < 0.01, (row["sample"], port)
+                tolerance = 0.01 + 5e-5 * abs(real[port])
+                assert abs(real[port] - fixed[port] * 2.0**-out_frac) < tolerance, (row["sample"], port)
             compared += 1
     assert compared >= 20
 
