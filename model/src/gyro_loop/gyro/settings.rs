@@ -36,7 +36,10 @@ pub struct LoopSettings {
     /// NCO quarter-wave ROM address bits `A`.
     pub nco_address_bits: u32,
     /// Carry each NCO's truncation error into its next phase (see `gyro_loop::nco`): no static
-    /// phase error from the truncation at any locked frequency. On by default.
+    /// phase error from the truncation at any locked frequency. On by default; a resolved
+    /// config without the key (a package manifest written before it existed) was made with
+    /// plain truncation, so it reads as off.
+    #[serde(default)]
     pub nco_error_feedback: bool,
     /// NCO sine width `S` (`s S.(S−1)`).
     pub nco_sine_width: u32,

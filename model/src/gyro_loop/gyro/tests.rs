@@ -14,6 +14,18 @@ fn settings_keys_round_trip_and_unknown_keys_are_refused() {
     assert!(serde_json::from_str::<LoopSettings>(&unknown).is_err());
 }
 
+/// A package made before `nco_error_feedback` existed has no such key in its manifest's
+/// config and was made with plain truncation: it reads as off, so the model rebuilt from it
+/// reproduces its vectors, while the default is on.
+#[test]
+fn a_config_without_nco_error_feedback_is_plain_truncation() {
+    let mut value = serde_json::to_value(LoopSettings::default()).unwrap();
+    assert_eq!(value["nco_error_feedback"], true);
+    value.as_object_mut().unwrap().remove("nco_error_feedback");
+    let old: LoopSettings = serde_json::from_value(value).unwrap();
+    assert!(!old.nco_error_feedback);
+}
+
 #[test]
 fn design_follows_the_physics() {
     let spec = Spec::paper_004();
