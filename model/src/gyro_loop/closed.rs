@@ -211,7 +211,7 @@ impl<L: LoopUnderTest> ClosedLoop<L> {
 
     /// The driven axis's amplitude now, m.
     pub fn drive_amplitude_m(&self) -> f64 {
-        let axis = super::gyro::axes(self.mode)[0];
+        let axis = self.mode.axes()[0];
         let w = self.nominal_drive[super::gyro::mode_index(self.mode)];
         let q = self.resonator.position()[axis];
         let v = self.resonator.velocity()[axis] / w;

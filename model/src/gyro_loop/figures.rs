@@ -7,9 +7,9 @@
 //! From rest in normal mode: `startup_ms` to lock, then each figure is the mean of
 //! `average_samples` chain samples at `Ω = 0` and, after `rate_settle_ms`, at `Ω = rate_dps`.
 //! Then a switch to reverse mode at `Ω = 0`, traced in windows of `window_samples` ADC
-//! samples for `switch_ms` (and run on until the formerly driven axis has rung down to 1e-6
-//! °/s, when its time constant asks for longer), reverse mode's figures the same way, and a switch back to
-//! normal mode, traced likewise (normal mode's settling).
+//! samples for `switch_ms` (and run on until the formerly driven axis has rung down to
+//! [`RING_DOWN_LEFT_DPS`], when its time constant asks for longer), reverse mode's figures the
+//! same way, and a switch back to normal mode, traced likewise (normal mode's settling).
 //!
 //! - `scale_factor`: `(S(Ω) − S(0)) / Ω`, output °/s per input °/s (predicted 1: the loop
 //!   divides by the closed-form SF).
@@ -33,8 +33,8 @@
 //!   at `Ω = 0`; `residual_configured_phase_dps` is `(B − B′)/2` at the configured phases.
 //! - `reference_phase_deg`: the phase the loop realizes, read from the zero-rate outputs
 //!   ([`ModeFigures::phase_from_outputs_at`] of `σ S(0)` and the quadrature at the locked
-//!   frequency); predicted the
-//!   derived `φ_r`. `configured_phase_deg` is the config's `φ` (or `φ′`).
+//!   frequency); predicted the derived `φ_r`. `configured_phase_deg` is the config's `φ` (or
+//!   `φ′`).
 
 use serde::Serialize;
 
@@ -149,13 +149,18 @@ const RATE_SETTLED_DPS: f64 = 0.01;
 /// Amplitude within 0.1 %.
 const AMPLITUDE_SETTLED: f64 = 1e-3;
 
-/// From a switch into `mode` until the formerly driven axis has rung down from the drive
-/// amplitude (`q0/SF`, °/s) to [`RING_DOWN_LEFT_DPS`], with its time constant, ms.
+/// What the formerly driven axis rings down from after a switch into `f`'s mode: the drive
+/// amplitude read through that mode's scale factor, `q0/SF`, °/s (about 2e4).
+fn ring_start_dps(f: &ModeFigures) -> f64 {
+    f.drive_amplitude / f.scale_factor_m_per_dps()
+}
+
+/// From a switch into `mode` until the formerly driven axis has rung down from
+/// [`ring_start_dps`] to [`RING_DOWN_LEFT_DPS`], with its time constant, ms.
 fn ring_down_ms(plan: &Plan, mode: Mode) -> f64 {
-    let f = plan.mode(mode).figures;
     let other = plan.modes[1 - mode_index(mode)].figures;
-    let ring_start = f.drive_amplitude / f.scale_factor_m_per_dps();
-    1e3 * other.ring_down_time_constant * libm::log(ring_start / RING_DOWN_LEFT_DPS)
+    let start = ring_start_dps(&plan.mode(mode).figures);
+    1e3 * other.ring_down_time_constant * libm::log(start / RING_DOWN_LEFT_DPS)
 }
 
 struct Means {
@@ -343,7 +348,7 @@ pub fn characterize_reporting<L: LoopUnderTest>(
         let other = plan.modes[1 - mode_index(mode)].figures;
         let (settled, rate_settled) = settling(trace, final_amp, zero.rate);
         let sigma = f.sigma();
-        let ring_start = f.drive_amplitude / f.scale_factor_m_per_dps();
+        let ring_start = ring_start_dps(&f);
         let (saturations, transient_saturations) = ledger.of(mode);
         let realized = realized_phase::derive(plan, params, mode);
         ModeCharacterization {
@@ -408,7 +413,8 @@ pub fn characterize_reporting<L: LoopUnderTest>(
         reverse: reverse_report,
         residual_bias_dps: Figure {
             measured: (normal.0.rate + reverse.0.rate) / 2.0,
-            predicted: realized_phase::predicted_residual_dps(plan, params),
+            // Each mode's prediction is in the chain's convention: (g B − g′ B′)/2.
+            predicted: (normal_report.bias_dps.predicted + reverse_report.bias_dps.predicted) / 2.0,
         },
         residual_configured_phase_dps: (figures[0].bias_dps() - figures[1].bias_dps()) / 2.0,
     })

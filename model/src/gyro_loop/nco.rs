@@ -316,6 +316,10 @@ pub struct FixedNco {
     address_bits: u32,
     /// With error feedback: the last truncation error, phase LSB in `[−2^(P−A−3), 2^(P−A−3))`.
     residue: Option<i64>,
+    /// The phase bits below the truncation, `2^(P−A−2) − 1`.
+    below_truncation: u64,
+    /// Half a bin, `2^(P−A−3)` phase LSB (0 without error feedback).
+    half_bin: i64,
     acc: u64,
 }
 
@@ -328,6 +332,12 @@ impl FixedNco {
             mask: u64::MAX >> (64 - plan.phase.width),
             address_bits: plan.address_bits,
             residue: plan.error_feedback.then_some(0),
+            below_truncation: (1u64 << (plan.phase.width - plan.address_bits - 2)) - 1,
+            half_bin: if plan.error_feedback {
+                1 << (plan.phase.width - plan.address_bits - 3)
+            } else {
+                0
+            },
             acc: 0,
         }
     }
@@ -354,8 +364,7 @@ impl FixedNco {
             // The carried error, then the new one: the phase below the truncation, less
             // half a bin (the ROM holds bin centres), in [−half, half).
             phase = phase.wrapping_add(*residue as u64) & self.mask;
-            let half = 1i64 << (self.truncation_shift - 1);
-            *residue = (phase & ((1u64 << self.truncation_shift) - 1)) as i64 - half;
+            *residue = (phase & self.below_truncation) as i64 - self.half_bin;
         }
         // The plan's truncation point: floor of the unsigned phase into A + 2 bits.
         let t = (phase >> self.truncation_shift) as u32;

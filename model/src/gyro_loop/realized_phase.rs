@@ -38,11 +38,13 @@
 //! the offset word's rounding; [`RealizedPhase::trim_deg`] is that advance. Only the per-mode
 //! offset words (`SENSE_OFFSET_N`/`_R` of `gyrofx_gyro_loop`) change: the RTL is the same.
 //!
-//! What is left is the NCO's phase truncation to `A + 2` bits, which the derivation does not
-//! model: it moves the fixed loop's realized phase by up to about 0.002° at `A = 10` (a few
-//! hundredths of a ROM bin, depending on where the locked frequency falls against the bins),
-//! 5e-5° at `A = 14`; [`super::figures`] measures it as the gap between the measured and the
-//! derived phase, and `gyrofx formats` shows what it costs.
+//! The derivation leaves out the NCOs' phase truncation to `A + 2` bits. Plainly truncated, it
+//! averages out except where `2^(A+2) f_L / fs` sits near a fraction of small denominator;
+//! there it leaves a static phase error of up to about 0.3 bin (0.026° at `A = 10`) and, through
+//! the DAC NCO, a sense gain error of up to 3e-4. With `[loop] nco_error_feedback` (the
+//! default, see [`super::nco`]) no frequency leaves a static error, and the fixed loop realizes
+//! the derived phase within about 2e-4° at the defaults; [`super::figures`] measures the gap
+//! between the measured and the derived phase.
 
 use std::f64::consts::PI;
 
@@ -134,12 +136,4 @@ fn phase_inputs(plan: &Plan, mode: Mode) -> PhaseInputs {
         demod_lowpass_shift: plan.settings.demod_lowpass_shift,
         adc_rate_hz: plan.adc_rate_hz,
     }
-}
-
-/// The reversal residual `(g B(φ_r) − g′ B′(φ_r′))/2` (°/s) the derivation predicts for the
-/// loop `plan` closes around `params`.
-pub fn predicted_residual_dps(plan: &Plan, params: &ResonatorParams) -> f64 {
-    let [normal, reverse] =
-        [Mode::Normal, Mode::Reverse].map(|mode| derive(plan, params, mode).bias_dps(params, mode));
-    (normal - reverse) / 2.0
 }

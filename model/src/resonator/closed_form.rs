@@ -67,19 +67,10 @@ impl ModeFigures {
     pub fn new(params: &ResonatorParams, mode: Mode) -> Self {
         let m = params.mass_kg;
         let mats = params.matrices();
-        let (k_aa, k_ss, d_ss, phase_deg) = match mode {
-            Mode::Normal => (
-                mats.k[0][0],
-                mats.k[1][1],
-                mats.d[1][1],
-                params.phase_error_deg,
-            ),
-            Mode::Reverse => (
-                mats.k[1][1],
-                mats.k[0][0],
-                mats.d[0][0],
-                params.phase_error_reverse_deg,
-            ),
+        let k_aa = mats.k[mode.axes()[0]][mode.axes()[0]];
+        let phase_deg = match mode {
+            Mode::Normal => params.phase_error_deg,
+            Mode::Reverse => params.phase_error_reverse_deg,
         };
         let (k_xy, d_xy) = (mats.k[0][1], mats.d[0][1]);
         let misalignment = (params.stiffness_angle_deg - params.damping_angle_deg) * RAD_PER_DEG;
@@ -93,16 +84,14 @@ impl ModeFigures {
             Mode::Reverse => d1 * s2 + d2 * c2,
         };
         let w = (k_aa / m).sqrt();
-        let z_re = k_ss - m * w * w;
-        let z_im = w * d_ss;
-        let z_abs = libm::hypot(z_re, z_im);
+        let (z_abs, psi) = sense_impedance(params, mode, w);
         let phi = phase_deg * RAD_PER_DEG;
         let q0 = params.drive_amplitude_m;
         ModeFigures {
             mode,
             drive_angular_frequency: w,
             sense_impedance: z_abs,
-            sense_phase: libm::atan2(z_im, z_re),
+            sense_phase: psi,
             phase_error: phi,
             drive_amplitude: q0,
             scale_factor: 2.0 * m * w * q0 * libm::cos(phi) / z_abs,
@@ -175,6 +164,12 @@ impl ModeFigures {
         self.phase_from_outputs_at(in_phase, quadrature, self.drive_angular_frequency)
     }
 
+    /// `arg(k_xy + i w d_xy)` at the drive's `angular_frequency` (rad/s), rad: the phase of
+    /// the coupling force on the sense axis against the drive displacement (less π).
+    pub fn mechanical_angle(&self, angular_frequency: f64) -> f64 {
+        libm::atan2(angular_frequency * self.d_xy, self.k_xy)
+    }
+
     /// [`Self::phase_from_outputs`] for a drive at `angular_frequency` (rad/s) instead of
     /// `w`: a loop locks on the coupled resonance, where `C = w_L d_xy`.
     pub fn phase_from_outputs_at(
@@ -183,12 +178,20 @@ impl ModeFigures {
         quadrature: f64,
         angular_frequency: f64,
     ) -> f64 {
-        let mechanical = libm::atan2(angular_frequency * self.d_xy, self.k_xy);
-        let angle = libm::atan2(in_phase, quadrature) - mechanical;
+        let angle = libm::atan2(in_phase, quadrature) - self.mechanical_angle(angular_frequency);
         // Wrapped to (−π, π].
         let turns = libm::ceil((angle - PI) / (2.0 * PI));
         angle - 2.0 * PI * turns
     }
+}
+
+/// The sense axis's impedance `Z_ss(w) = k_ss − m w² + i w d_ss` of `mode` at the angular
+/// frequency `w` (rad/s), as `(|Z|, arg Z)` in N/m and rad (`arg` in (−π, π]).
+pub fn sense_impedance(params: &ResonatorParams, mode: Mode, w: f64) -> (f64, f64) {
+    let mats = params.matrices();
+    let s = mode.axes()[1];
+    let (re, im) = (mats.k[s][s] - params.mass_kg * w * w, w * mats.d[s][s]);
+    (libm::hypot(re, im), libm::atan2(im, re))
 }
 
 /// The coupled drive resonance of `mode` at `Ω = 0`, Hz: where `Re(Z_aa − Z_as²/Z_ss) = 0`
@@ -196,10 +199,7 @@ impl ModeFigures {
 pub fn coupled_resonance_hz(params: &ResonatorParams, mode: Mode) -> f64 {
     let mats = params.matrices();
     let m = params.mass_kg;
-    let (a, s) = match mode {
-        Mode::Normal => (0, 1),
-        Mode::Reverse => (1, 0),
-    };
+    let [a, s] = mode.axes();
     let real_part = |w: f64| {
         let zaa_re = mats.k[a][a] - m * w * w;
         let (zss_re, zss_im) = (mats.k[s][s] - m * w * w, w * mats.d[s][s]);

@@ -104,7 +104,7 @@ pub mod params;
 pub mod physics;
 pub mod settings;
 
-pub use closed_form::{coupled_resonance_hz, ModeFigures, Reversal};
+pub use closed_form::{coupled_resonance_hz, sense_impedance, ModeFigures, Reversal};
 pub use params::{Matrices, ParamError, ResonatorParams};
 pub use physics::{Resonator, BOLTZMANN_J_PER_K};
 pub use settings::{GaussMarkov, PhysicsSettings};
@@ -119,6 +119,14 @@ pub enum Mode {
 }
 
 impl Mode {
+    /// `[driven, sensed]` axis (0 = x, 1 = y).
+    pub fn axes(self) -> [usize; 2] {
+        match self {
+            Mode::Normal => [0, 1],
+            Mode::Reverse => [1, 0],
+        }
+    }
+
     /// `normal` or `reverse`, as reports and the config name it.
     pub fn name(self) -> &'static str {
         match self {

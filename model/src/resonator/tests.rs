@@ -12,14 +12,6 @@ use crate::analysis::spectrum::welch;
 
 const DEG: f64 = PI / 180.0;
 
-/// The axis each mode drives and senses.
-fn axes(mode: Mode) -> (usize, usize) {
-    match mode {
-        Mode::Normal => (0, 1),
-        Mode::Reverse => (1, 0),
-    }
-}
-
 /// Continuous-time steady-state displacement phasors (m) of the undiscretised equation of
 /// motion for the force phasors `force` (N) at `w` (rad/s) and the rate `omega` (rad/s):
 /// `(K − m w² I + i w (D − G)) q̂ = f̂`.
@@ -54,7 +46,7 @@ struct IdealDrive {
 
 fn ideal_drive(params: &ResonatorParams, mode: Mode, omega: f64, fs: f64) -> IdealDrive {
     let w = ModeFigures::new(params, mode).drive_angular_frequency;
-    let (driven, _) = axes(mode);
+    let [driven, _] = mode.axes();
     let mut unit = [C::new(0.0, 0.0); 2];
     unit[driven] = C::new(1.0, 0.0);
     let per_newton = steady_state(params, omega, w, unit);
@@ -115,7 +107,7 @@ fn run(
     let gain = resonator.pickoff_gain();
     let figures = ModeFigures::new(params, mode);
     let drive = ideal_drive(params, mode, omega, fs);
-    let (driven, sensed) = axes(mode);
+    let [driven, sensed] = mode.axes();
     resonator.set_mode(mode);
     resonator.set_rate(omega);
     if !from_rest {

@@ -4,7 +4,7 @@
 use std::f64::consts::PI;
 
 use crate::gyro_loop::Coefficient;
-use crate::resonator::{coupled_resonance_hz, Mode, ModeFigures, ResonatorParams};
+use crate::resonator::{coupled_resonance_hz, sense_impedance, Mode, ModeFigures, ResonatorParams};
 
 /// The float values the design produced (before quantization), for the float twin and the
 /// report.
@@ -131,16 +131,6 @@ pub struct PhaseShifts {
     pub gain: f64,
 }
 
-/// The sense axis's impedance `Z_ss(f) = k_ss − m w² + i w d_ss` of `mode` at `f_hz`, as
-/// `(|Z|, arg Z)` in N/m and rad.
-fn sense_impedance(params: &ResonatorParams, mode: Mode, f_hz: f64) -> (f64, f64) {
-    let mats = params.matrices();
-    let s = super::axes(mode)[1];
-    let w = 2.0 * PI * f_hz;
-    let (re, im) = (mats.k[s][s] - params.mass_kg * w * w, w * mats.d[s][s]);
-    (libm::hypot(re, im), libm::atan2(im, re))
-}
-
 /// `|P|` and `γ = arg P` of the PLL's `2f` phase modulation at `f_hz`:
 /// `P = 2π kp a_set H e^{−2iΩ} / (1 − e^{−iΩ})`, `H = α / (1 − (1 − α) e^{−iΩ})`, `Ω = 4π f/fs`.
 fn pll_modulation(inputs: &PhaseInputs, f_hz: f64) -> (f64, f64) {
@@ -161,13 +151,15 @@ fn pll_modulation(inputs: &PhaseInputs, f_hz: f64) -> (f64, f64) {
 pub fn phase_shifts(params: &ResonatorParams, mode: Mode, inputs: &PhaseInputs) -> PhaseShifts {
     let f = ModeFigures::new(params, mode);
     let f_locked = coupled_resonance_hz(params, mode);
-    let (z_nominal, psi_nominal) = sense_impedance(params, mode, inputs.nominal_frequency_hz);
-    let (z_locked, psi_locked) = sense_impedance(params, mode, f_locked);
+    let (z_nominal, psi_nominal) =
+        sense_impedance(params, mode, 2.0 * PI * inputs.nominal_frequency_hz);
+    let (z_locked, psi_locked) = sense_impedance(params, mode, 2.0 * PI * f_locked);
     let (p_abs, gamma) = pll_modulation(inputs, f_locked);
-    let mats = params.matrices();
-    let mechanical = libm::atan2(f.drive_angular_frequency * mats.d[0][1], mats.k[0][1]);
     // The sense signal's phase against the NCO's sine.
-    let beta = 2.0 * PI * inputs.sense_offset + mechanical + f.phase_error - PI / 2.0;
+    let beta = 2.0 * PI * inputs.sense_offset
+        + f.mechanical_angle(f.drive_angular_frequency)
+        + f.phase_error
+        - PI / 2.0;
     let modulation_phase = -(p_abs / 2.0) * (libm::sin(2.0 * beta - gamma) + libm::sin(gamma));
     let modulation_gain = 1.0 + (p_abs / 2.0) * (libm::cos(2.0 * beta - gamma) - libm::cos(gamma));
     PhaseShifts {

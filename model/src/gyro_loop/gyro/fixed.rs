@@ -2,9 +2,9 @@
 //! quadrature every `R`-th sample.
 
 use super::design::ModePlan;
+use super::mode_index;
 use super::overflows::{LoopNode, LoopOverflows};
 use super::plan::Plan;
-use super::{axes, mode_index};
 use crate::fx::Quantizer;
 use crate::gyro_loop::cic::FixedCic;
 use crate::gyro_loop::demodulator::{FixedDemodulator, Iq};
@@ -184,7 +184,7 @@ impl FixedGyroLoop {
             self.enter(mode);
         }
         let m = self.modes[mode_index(mode)];
-        let [driven, sensed] = axes(mode);
+        let [driven, sensed] = mode.axes();
         let freq = self.freq;
         let reference = self.nco_drive.step(freq, 0);
         let transmit = self.nco_dac.step(freq, m.dac_offset);

@@ -4,8 +4,8 @@
 
 use std::f64::consts::PI;
 
+use super::mode_index;
 use super::plan::{Plan, MAX_LATENCY};
-use super::{axes, mode_index};
 use crate::gyro_loop::cic::FloatCic;
 use crate::gyro_loop::demodulator::FloatDemodulator;
 use crate::gyro_loop::pi::FloatPi;
@@ -148,7 +148,7 @@ impl FloatGyroLoop {
             self.enter(mode);
         }
         let m = self.modes[mode_index(mode)];
-        let [driven, sensed] = axes(mode);
+        let [driven, sensed] = mode.axes();
         let [sin_d, cos_d] = self.reference(0.0);
         let [_, cos_t] = self.reference(m.dac_offset);
         let [sin_s, cos_s] = self.reference(m.sense_offset);

@@ -128,13 +128,5 @@ pub fn mode_index(mode: Mode) -> usize {
     }
 }
 
-/// `[driven, sensed]` axis of `mode` (0 = x, 1 = y).
-pub fn axes(mode: Mode) -> [usize; 2] {
-    match mode {
-        Mode::Normal => [0, 1],
-        Mode::Reverse => [1, 0],
-    }
-}
-
 #[cfg(test)]
 mod tests;

@@ -5,8 +5,8 @@
 use std::f64::consts::PI;
 
 use super::design::{dac_offset, trimmed_sense_offset, Design, LockPlan, ModePlan, PhaseInputs};
+use super::mode_index;
 use super::settings::{format, LoopSettings};
-use super::{axes, mode_index};
 use crate::fx::{from_f64, CoefficientFormat, Format, Overflow, Rounding};
 use crate::gyro_loop::{
     cic, demodulator, field_error, nco, pi, quantize_coefficients, Coefficient, PlanError, Point,
@@ -413,7 +413,7 @@ impl ModePhysics {
         fs: f64,
     ) -> ModePhysics {
         let per_fs = |axis: usize| front.pickoff_gain_v_per_m[axis] / front.adc_full_scale_v;
-        let [driven, sensed] = axes(f.mode);
+        let [driven, sensed] = f.mode.axes();
         let f_nom = f.drive_frequency_hz();
         let x = PI * f_nom / fs;
         let hold_gain = libm::sin(x) / x;
