@@ -186,14 +186,29 @@ fn error_feedback_carries_the_remainder_and_the_reset_clears_it() {
         ..spec(16, 4, 12)
     })
     .unwrap();
-    // A bin is 2^10 phase LSB; a step of 1.25 bins moves the plain NCO by one bin three times in
-    // four and the fed-back one in the pattern of the carried quarter bins.
+    // A bin is 2^10 phase LSB; a step of 1.25 bins. By hand, in bins: the exact phase 1.25 k
+    // plus the carried r, floored to t, and r = what is left less ½:
+    //   k      0     1     2     3     4     5     6     7
+    //   u      0     0.75  2.75  4     4.5   6.25  7.25  8.5
+    //   t      0     0     2     4     4     6     7     8
+    //   r     −½    ¼     ¼    −½     0    −¼    −¼     0
+    // (errors of the bin centres t + ½ against 1.25 k: +½ −¾ 0 +¾ −½ +¼ 0 −¼, summing to 0).
+    // The plain NCO takes t = floor(1.25 k): 0 1 2 3 5 6 7 8.
     let freq = 1280;
+    let sine = |t: &[u32]| -> Vec<i64> {
+        // The platform's sine at the bin centres of a 64-bin cycle, as in the sweep test.
+        t.iter()
+            .map(|&t| {
+                let angle = 2.0 * std::f64::consts::PI * (f64::from(t) + 0.5) / 64.0;
+                (2047.0 * angle.sin()).round() as i64
+            })
+            .collect()
+    };
     let (mut a, mut b) = (FixedNco::new(&plain), FixedNco::new(&fed_back));
     let walk = |nco: &mut FixedNco| -> Vec<i64> { (0..8).map(|_| nco.step(freq, 0).sin).collect() };
-    let (first, shaped) = (walk(&mut a), walk(&mut b));
-    assert_eq!(first[0], shaped[0]);
-    assert_ne!(first, shaped);
+    assert_eq!(walk(&mut a), sine(&[0, 1, 2, 3, 5, 6, 7, 8]));
+    let shaped = walk(&mut b);
+    assert_eq!(shaped, sine(&[0, 0, 2, 4, 4, 6, 7, 8]));
     b.reset();
     assert_eq!(walk(&mut b), shaped);
     let text = Plan::new(&Spec {
