@@ -8,8 +8,10 @@
 --   gyrofx_model::gyro_loop::nco::FixedNco.
 --
 -- Algorithm (per sample, ce high; phases in cycles, u PHASE_W.PHASE_W):
---     phase = acc + offset                      mod 2^PHASE_W (wraps)
+--     phase = acc + offset (+ r)                mod 2^PHASE_W (wraps; r with ERROR_FEEDBACK)
 --     t     = floor(phase / 2^(PHASE_W-ADDR_W-2))   ADDR_W+2 bits (gyrofx_quantize, floor)
+--     r    <= (phase mod 2^(PHASE_W-ADDR_W-2)) - half a bin   (ERROR_FEEDBACK: the carried
+--               truncation error, signed; errors of any run of samples sum to < 1 bin)
 --     sin   = +/- ROM(i or 2^ADDR_W-1-i)       i = t mod 2^ADDR_W, quadrant = t / 2^ADDR_W:
 --               q 0: ROM(i)  1: ROM(not i)  2: -ROM(i)  3: -ROM(not i)
 --     cos   = the same at t + 2^ADDR_W         (a quarter cycle on)
@@ -18,7 +20,7 @@
 --
 -- Pipeline: the ROM addresses and signs are registered at ce (a block-RAM read
 --   port); sin_out, cos_out and out_valid are valid 1 clock after ce and hold
---   until the next ce. A clock with rst high clears acc and out_valid (rst wins
+--   until the next ce. A clock with rst high clears acc, r and out_valid (rst wins
 --   over ce).
 --
 -- ROM: ROM_FILE (read by gyrofx_mem_pkg at elaboration), 2^ADDR_W words of SIN_W bits.

@@ -23,9 +23,11 @@ use super::usage;
 /// Runs both gyros' closed loops (resonator physics, NCO, PLL, AGC, sense demodulation, CIC,
 /// 1/SF) in normal and reverse mode at a constant rate and print, per gyro and mode, the
 /// locked drive frequency, drive amplitude, scale factor, bias (the chain's sign convention),
-/// quadrature and settling after a switch beside SPEC 1.6's closed forms, the residual bias
-/// after reversal, and the fixed loop's nodes that saturated or wrapped (counts; a warning when
-/// that clipped the figures). Noise and drift are off unless --noise is given.
+/// quadrature, the sense reference's phase the loop realizes (read from its outputs, beside the
+/// phase derived from the plan and its parts) and settling after a switch beside SPEC 1.6's
+/// closed forms, the residual bias after reversal (predicted at the realized phases, and at
+/// the configured ones), and the fixed loop's nodes that saturated or wrapped (counts; a
+/// warning when that clipped the figures). Noise and drift are off unless --noise is given.
 #[derive(clap::Args)]
 pub struct Args {
     #[command(flatten)]
