@@ -20,16 +20,25 @@ fn gyro_loop(c: &mut Criterion) {
 
     let mut group = c.benchmark_group("gyro_loop");
     group.throughput(Throughput::Elements(N as u64));
-    group.bench_function("nco", |b| {
-        let mut m = nco::FixedNco::new(&nco_plan);
-        b.iter(|| {
-            let mut acc = 0i64;
-            for _ in 0..N {
-                acc = acc.wrapping_add(m.step(black_box(freq), 0).sin);
-            }
-            black_box(acc)
-        })
-    });
+    // The default NCO carries its truncation error; `nco_plain` is the plain truncation, for
+    // what the error feedback costs per sample.
+    let plain_plan = nco::Plan::new(&nco::Spec {
+        error_feedback: false,
+        ..nco::Spec::default()
+    })
+    .unwrap();
+    for (name, plan) in [("nco", &nco_plan), ("nco_plain", &plain_plan)] {
+        group.bench_function(name, |b| {
+            let mut m = nco::FixedNco::new(plan);
+            b.iter(|| {
+                let mut acc = 0i64;
+                for _ in 0..N {
+                    acc = acc.wrapping_add(m.step(black_box(freq), 0).sin);
+                }
+                black_box(acc)
+            })
+        });
+    }
     group.bench_function("demodulator", |b| {
         let mut m = demodulator::FixedDemodulator::new(&demodulator_plan);
         let reference = nco::Reference {
