@@ -402,6 +402,58 @@ fn an_output_error_budget_is_met_by_the_written_config() {
     assert!(last(&lsb).contains("at most 2.000 LSB"), "{lsb}");
 }
 
+/// `--residual-budget` (issue 32): at the defaults 1 mdps needs the phase trim and an 11-bit
+/// ROM; the written config carries them, `gyrofx loop` on it departs from the configured-phase
+/// residual by less than the target, and the JSON's worst cases are within it.
+#[test]
+fn a_residual_budget_is_met_by_the_loop_of_the_written_config() {
+    let dir = tempfile::tempdir().unwrap();
+    let written = dir.path().join("budget.toml");
+    let written_text = written.to_str().unwrap();
+    let json: serde_json::Value = serde_json::from_str(&ok(&[
+        "formats",
+        "--residual-budget",
+        "1mdps",
+        "--json",
+        "--write",
+        written_text,
+    ]))
+    .unwrap();
+    let report = &json["residual_budget"];
+    let chosen = &report["chosen"];
+    assert_eq!(chosen["nco_address_bits"], 11, "{report}");
+    assert_eq!(chosen["phase_trim"], true, "{report}");
+    assert_eq!(report["configured"]["nco_address_bits"], 10);
+    let config = std::fs::read_to_string(&written).unwrap();
+    for line in [
+        "nco_address_bits = 11".to_string(),
+        format!("nco_phase_bits = {}", chosen["nco_phase_bits"]),
+        "phase_trim = true".to_string(),
+    ] {
+        assert!(config.contains(&line), "{line} in {config}");
+    }
+    let loops: serde_json::Value = serde_json::from_str(&ok(&[
+        "loop",
+        "--config",
+        written_text,
+        "--json",
+        "--quiet",
+    ]))
+    .unwrap();
+    for gyro in loops.as_array().unwrap() {
+        let measured = gyro["residual_bias_dps"]["measured"].as_f64().unwrap();
+        let configured = gyro["residual_configured_phase_dps"].as_f64().unwrap();
+        assert!((measured - configured).abs() < 1e-3, "{gyro}");
+    }
+    // The configured loop misses 1 mdps by its locked frequency alone.
+    let table = ok(&["formats", "--residual-budget", "1mdps"]);
+    let row = table
+        .lines()
+        .find(|l| l.trim_start().starts_with("locked frequency"))
+        .unwrap();
+    assert!(row.contains("-3.75"), "{row}");
+}
+
 /// Bad input as a new user gives it: one clear error each, exit 2 (1 for a missing file), and
 /// nothing written.
 #[test]
@@ -423,6 +475,17 @@ fn bad_input_is_refused_naming_what_is_allowed_and_writes_nothing() {
             "is not allowed: more than 1.5",
         ),
         (vec!["--output-error", "lots"], 2, "is not a budget"),
+        (vec!["--residual-budget", "1"], 2, "is not a target"),
+        (
+            vec!["--residual-budget", "-1mdps"],
+            2,
+            "a positive residual bias",
+        ),
+        (
+            vec!["--residual-budget", "0.001mdps"],
+            2,
+            "the finest leaves",
+        ),
         (vec!["--write", folder, "--force"], 2, "is a folder"),
         (
             vec!["--config", missing.to_str().unwrap()],

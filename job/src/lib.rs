@@ -32,4 +32,5 @@ pub mod input;
 pub mod job;
 pub mod pipeline;
 pub mod recording;
+pub mod residual_budget;
 pub mod system;

@@ -12,6 +12,7 @@ use super::usage;
 
 use gyrofx_codegen::output_folder;
 use gyrofx_job::formats::{analyse, fractions_for};
+use gyrofx_job::residual_budget::{parse_target, residual_budget, BudgetError};
 
 /// Prove the formats: which quantization points can overflow, and the bits that prevent it.
 ///
@@ -35,6 +36,12 @@ pub struct Args {
     /// estimates and KF state that meet it over the record (for --write and the table).
     #[arg(long, allow_hyphen_values = true)]
     output_error: Option<String>,
+    /// Residual bias after reversal to budget for, in mdps (`1mdps`) or °/s (`0.001dps`): also
+    /// show what each part of the gyro loops (NCO phase and address bits, latency, trim, ...)
+    /// moves `(B − B′)/2` by, measured beside it, and choose the cheapest NCO and phase trim
+    /// whose worst case meets the target (for --write and the table).
+    #[arg(long, allow_hyphen_values = true)]
+    residual_budget: Option<String>,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -87,8 +94,22 @@ pub fn run(args: Args) -> Result<ExitCode> {
             }
         }
     };
+    let residual = match &args.residual_budget {
+        None => None,
+        Some(text) => match parse_target(text).map(|target| residual_budget(&config, target)) {
+            Ok(Ok(report)) => Some(report),
+            // A target under what the loop can reach is the flag's fault, not the config's.
+            Ok(Err(e @ BudgetError::Target { .. })) => usage!("{e}"),
+            Ok(Err(e)) => return Err(e.into()),
+            Err(message) => usage!("{message}"),
+        },
+    };
     if let Some(path) = &args.write {
-        let derived = analysis.derived_config(&config, budget.as_ref())?;
+        let mut derived = analysis.derived_config(&config, budget.as_ref())?;
+        if let Some(report) = &residual {
+            report.apply(&mut derived);
+            gyrofx_codegen::blocks::checked_job(derived.clone())?;
+        }
         let folder = match path.parent() {
             Some(p) if !p.as_os_str().is_empty() => p,
             _ => std::path::Path::new("."),
@@ -126,6 +147,9 @@ pub fn run(args: Args) -> Result<ExitCode> {
                 "mean_filter_bound_lsb": b.mean_filter_bound_lsb,
             });
         }
+        if let Some(report) = &residual {
+            json["residual_budget"] = serde_json::to_value(report)?;
+        }
         println!("{}", serde_json::to_string_pretty(&json)?);
     } else {
         print!("{}", analysis.text());
@@ -135,6 +159,9 @@ pub fn run(args: Args) -> Result<ExitCode> {
                 b.budget_lsb, b.floor_lsb, b.mean, b.bias, b.state, b.bound_lsb,
                 b.mean_filter_reciprocal_width, b.mean_filter_bound_lsb
             );
+        }
+        if let Some(report) = &residual {
+            print!("{report}");
         }
     }
     Ok(if args.strict && analysis.overflows().next().is_some() {

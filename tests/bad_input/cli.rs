@@ -149,6 +149,7 @@ fn no_numeric_flag_value_panics() {
         "formats --samples V",
         "formats --switches V",
         "formats --output-error V",
+        "formats --residual-budget V",
         "explore --out OUT --guard-bits 0..0 --samples V",
         "explore --out OUT --guard-bits 0..0 --jobs V",
         "synth --out OUT --target xilinx --jobs V",

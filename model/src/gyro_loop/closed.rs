@@ -339,4 +339,4 @@ pub fn record(
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -46,6 +46,7 @@ pub mod gyro;
 pub mod nco;
 pub mod pi;
 pub mod realized_phase;
+pub mod residual_budget;
 pub mod trace;
 
 /// A refused spec: each variant names the block, the field or coefficient, its value and what

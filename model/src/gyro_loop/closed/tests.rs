@@ -332,7 +332,7 @@ fn the_default_loop_saturates_nothing() {
 /// A random structure for the realized-phase property: coupling angles, phase errors,
 /// frequencies, Qs and the loop's latency (the output widened to s32.16 so that large
 /// quadratures do not clip it).
-fn structure(
+pub(crate) fn structure(
     (stiffness_angle, damping_angle): (f64, f64),
     (phase, phase_reverse): (f64, f64),
     (drive_hz, split_hz): (f64, f64),

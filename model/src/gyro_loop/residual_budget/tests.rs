@@ -1,0 +1,261 @@
+//! The residual budget: its derived parts against first-order sensitivities, its worst case
+//! against the closed fixed loop, the chooser's choice against its neighbours.
+
+use proptest::prelude::*;
+
+use super::*;
+use crate::gyro_loop::closed::tests::structure;
+use crate::gyro_loop::closed::FixedHarness;
+
+fn budget(spec: &Spec) -> ResidualBudget {
+    let plan = Plan::new(spec).unwrap();
+    ResidualBudget::new(&plan, &spec.resonator)
+}
+
+fn part<'a>(budget: &'a ResidualBudget, name: &str) -> &'a Part {
+    budget.parts.iter().find(|p| p.name == name).unwrap()
+}
+
+fn derived(part: &Part) -> f64 {
+    match part.cost {
+        Cost::Derived(v) => v,
+        other => panic!("{}: {other:?}", part.name),
+    }
+}
+
+/// Issue 32's second structure (stiffness 2°, damping 0.5°, phases 3° / 3°).
+fn second_structure() -> Spec {
+    structure((2.0, 0.5), (3.0, 3.0), (8195.0, 53.0), (184.0, 195.0), 1)
+}
+
+/// Each derived phase part costs what a first-order sensitivity says,
+/// `Σ σ_m (dB_m/dφ) δ_m / 2` with `dB/dφ = k_xy/(2 m w cos² φ)` from the closed forms (so a
+/// sign slip or a mode swapped in the budget shows), and with the trim the phase parts cancel.
+#[test]
+fn derived_phase_parts_cost_their_first_order_sensitivity() {
+    for mut spec in [Spec::paper_004(), second_structure()] {
+        for trim in [false, true] {
+            spec.settings.phase_trim = trim;
+            let b = budget(&spec);
+            let sensitivity =
+                [Mode::Normal, Mode::Reverse].map(|m| ModeFigures::new(&spec.resonator, m));
+            for name in ["locked frequency", "PLL 2f modulation", "phase trim"] {
+                let p = part(&b, name);
+                let first_order: f64 = (0..2)
+                    .map(|i| {
+                        let f = &sensitivity[i];
+                        f.sigma() * f.bias_sensitivity_to_phase() * p.phase_deg[i] / 2.0
+                    })
+                    .sum();
+                let cost = derived(p);
+                // The locked frequency also moves w_L/w in the bias: 1e-7 of it.
+                let allowed = 0.03 * first_order.abs() + 1e-7 * spec_bias(&spec);
+                assert!(
+                    (cost - first_order).abs() <= allowed,
+                    "{name} (trim {trim}): {cost} against {first_order}"
+                );
+            }
+            let names = ["locked frequency", "PLL 2f modulation", "phase trim"];
+            for i in 0..2 {
+                let phase: f64 = names.iter().map(|n| part(&b, n).phase_deg[i]).sum();
+                if trim {
+                    assert!(phase.abs() < 1e-6, "{phase}°");
+                } else {
+                    assert!(phase.abs() > 1e-4, "{phase}°");
+                }
+            }
+        }
+    }
+}
+
+fn spec_bias(spec: &Spec) -> f64 {
+    ModeFigures::new(&spec.resonator, Mode::Normal)
+        .bias_dps()
+        .abs()
+}
+
+/// The bounds scale as their settings say: one more address bit halves the truncation's, one
+/// more phase bit the offset word's, and plain truncation is allowed 60 times the carried one.
+#[test]
+fn bounds_scale_with_their_settings() {
+    let mut spec = Spec::paper_004();
+    let cost = |spec: &Spec, name: &str| match part(&budget(spec), name).cost {
+        Cost::Bound(v) => v,
+        other => panic!("{other:?}"),
+    };
+    let truncation = cost(&spec, "NCO truncation");
+    spec.settings.nco_error_feedback = false;
+    let plain = cost(&spec, "NCO truncation");
+    spec.settings.nco_error_feedback = true;
+    let word = cost(&spec, "offset word");
+    spec.settings.nco_address_bits += 1;
+    spec.settings.nco_phase_bits += 1;
+    assert!((cost(&spec, "NCO truncation") / truncation - 0.5).abs() < 1e-12);
+    assert!((cost(&spec, "offset word") / word - 0.5).abs() < 1e-12);
+    // The plain bounds are 60 times the carried ones, phase and gain alike.
+    assert!((plain / truncation - PLAIN_TRUNCATION_BINS / FEEDBACK_TRUNCATION_BINS).abs() < 1e-9);
+}
+
+/// Cases of the closed-loop property: 8, or `GYROFX_RESIDUAL_BUDGET_CASES` offline.
+fn budget_cases() -> u32 {
+    std::env::var("GYROFX_RESIDUAL_BUDGET_CASES")
+        .ok()
+        .and_then(|cases| cases.parse().ok())
+        .unwrap_or(8)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: budget_cases(),
+        rng_seed: proptest::test_runner::RngSeed::Fixed(33),
+        ..ProptestConfig::default()
+    })]
+
+    /// Over random structures, NCO widths (error feedback, `P ≥ A + 12`), trims and latencies,
+    /// the closed fixed loop's residual lies within the budget: `R_c + Σ derived ± Σ bounds`.
+    #[test]
+    fn the_closed_loop_stays_within_its_budget(
+        angles in (0.05f64..2.5, -5.0f64..5.0),
+        phases in (-3.0f64..3.0, -3.0f64..3.0),
+        frequencies in (6000.0f64..12000.0, 20.0f64..100.0),
+        qs in (100.0f64..400.0, 100.0f64..400.0),
+        latency in 0u32..=3,
+        address_bits in 6u32..=12,
+        extra_phase_bits in 0u32..=8,
+        phase_trim in any::<bool>(),
+    ) {
+        let mut spec = structure(angles, phases, frequencies, qs, latency);
+        spec.settings.nco_address_bits = address_bits;
+        spec.settings.nco_phase_bits = (address_bits + 12).max(20) + extra_phase_bits;
+        spec.settings.phase_trim = phase_trim;
+        let plan = Plan::new(&spec).unwrap();
+        let leftover = twin_leftover_dps(&spec).unwrap();
+        let b = ResidualBudget::new(&plan, &spec.resonator).with_twin(leftover);
+        let c = characterize::<FixedHarness>(&plan, &spec.resonator, &spec.front_end, &procedure()).unwrap();
+        let departure = c.residual_bias_dps.measured - b.configured_dps;
+        prop_assert!(
+            (departure - b.derived_dps()).abs() <= b.bound_dps(),
+            "departure {departure} °/s, derived {} ± {}: {:?}", b.derived_dps(), b.bound_dps(), b.parts
+        );
+    }
+}
+
+/// The offline sweep behind [`FEEDBACK_TRUNCATION_BINS`] and [`FEEDBACK_TRUNCATION_GAIN`]: over
+/// random structures, the fixed loop's realized phase and gain stay that close to its float
+/// twin's. `GYROFX_TRUNCATION_A`,
+/// `GYROFX_TRUNCATION_P` (default 6 and 32) and `GYROFX_TRUNCATION_CASES` (default 6; the
+/// offline sweep's 200 take about 70 s in release) set it.
+#[test]
+fn truncation_stays_within_its_budget() {
+    let setting = |name: &str, default: u32| {
+        std::env::var(name)
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(default)
+    };
+    let (a, p) = (
+        setting("GYROFX_TRUNCATION_A", 6),
+        setting("GYROFX_TRUNCATION_P", 32),
+    );
+    let mut runner = proptest::test_runner::TestRunner::new(ProptestConfig {
+        cases: setting("GYROFX_TRUNCATION_CASES", 6),
+        rng_seed: proptest::test_runner::RngSeed::Fixed(34),
+        ..ProptestConfig::default()
+    });
+    let strategy = (
+        (0.05f64..2.5, -5.0f64..5.0),
+        (-3.0f64..3.0, -3.0f64..3.0),
+        (6000.0f64..12000.0, 20.0f64..100.0),
+        (100.0f64..400.0, 100.0f64..400.0),
+        0u32..=3,
+    );
+    let worst = std::cell::Cell::new(0.0f64);
+    let worst_gain = std::cell::Cell::new(0.0f64);
+    runner
+        .run(&strategy, |(angles, phases, frequencies, qs, latency)| {
+            let mut spec = structure(angles, phases, frequencies, qs, latency);
+            spec.settings.nco_address_bits = a;
+            spec.settings.nco_phase_bits = p;
+            let plan = Plan::new(&spec).unwrap();
+            let (r, f) = (&spec.resonator, &spec.front_end);
+            let fixed = characterize::<FixedHarness>(&plan, r, f, &procedure()).unwrap();
+            let float = characterize::<FloatHarness>(&plan, r, f, &procedure()).unwrap();
+            let bin = 360.0 / crate::fx::pow2(a as i32 + 2);
+            for (x, y) in [
+                (&fixed.normal, &float.normal),
+                (&fixed.reverse, &float.reverse),
+            ] {
+                let gap = (x.reference_phase_deg.measured - y.reference_phase_deg.measured) / bin;
+                prop_assert!(
+                    gap.abs() <= FEEDBACK_TRUNCATION_BINS,
+                    "{gap} bin at {}",
+                    x.mode
+                );
+                worst.set(worst.get().max(gap.abs()));
+                let magnitude = |m: &crate::gyro_loop::figures::ModeCharacterization| {
+                    libm::hypot(m.bias_dps.measured, m.quadrature_dps.measured)
+                };
+                let gain = (magnitude(x) / magnitude(y) - 1.0) / bin.to_radians();
+                worst_gain.set(worst_gain.get().max(gain.abs()));
+                prop_assert!(
+                    gain.abs() <= FEEDBACK_TRUNCATION_GAIN,
+                    "{gain} per radian at {}",
+                    x.mode
+                );
+                prop_assert!(
+                    gap.abs() <= FEEDBACK_TRUNCATION_BINS,
+                    "{gap} bin at {}",
+                    x.mode
+                );
+            }
+            Ok(())
+        })
+        .unwrap();
+    println!(
+        "A = {a}, P = {p}: worst {:.5} bin, gain {:.3e} per rad of bin",
+        worst.get(),
+        worst_gain.get()
+    );
+}
+
+/// At the defaults, 1 mdps needs the trim (the locked frequency alone costs 3.8 mdps) and an
+/// 11-bit ROM: the choice meets the target, one address bit fewer (at any phase bits) or one
+/// phase bit fewer does not, and the closed fixed loop so built departs from `R_c` by less.
+#[test]
+fn the_choice_is_the_cheapest_that_meets_the_target() {
+    let spec = Spec::paper_004();
+    let leftover = twin_leftover_dps(&spec).unwrap();
+    let target = 1e-3;
+    let choice = choose(std::slice::from_ref(&spec), &[leftover], target).unwrap();
+    assert!(choice.phase_trim && choice.nco_error_feedback);
+    assert!(choice.budgets[0].worst_dps() <= target);
+    let with = |a: u32, p: u32| {
+        let mut s = spec.clone();
+        s.settings.nco_address_bits = a;
+        s.settings.nco_phase_bits = p;
+        s.settings.phase_trim = true;
+        s
+    };
+    let (a, p) = (choice.nco_address_bits, choice.nco_phase_bits);
+    let coarser_rom = budget(&with(a - 1, 38)).with_twin(leftover);
+    assert!(coarser_rom.worst_dps() > target, "{coarser_rom:?}");
+    let lowest = (a + 2 + MIN_RESIDUE_BITS).max(MIN_FEEDBACK_PHASE_BITS);
+    if p > lowest {
+        let coarser_word = budget(&with(a, p - 1)).with_twin(leftover);
+        assert!(coarser_word.worst_dps() > target, "{coarser_word:?}");
+    }
+    let chosen = with(a, p);
+    let plan = Plan::new(&chosen).unwrap();
+    let c = characterize::<FixedHarness>(&plan, &chosen.resonator, &chosen.front_end, &procedure())
+        .unwrap();
+    let departure = c.residual_bias_dps.measured - choice.budgets[0].configured_dps;
+    assert!(departure.abs() <= target, "{departure}");
+}
+
+/// A target under what the finest loop leaves is refused, naming that floor.
+#[test]
+fn a_target_under_the_floor_is_refused() {
+    let spec = Spec::paper_004();
+    let message = choose(std::slice::from_ref(&spec), &[0.0], 1e-6).unwrap_err();
+    assert!(message.contains("the finest leaves 0.1"), "{message}");
+}
