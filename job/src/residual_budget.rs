@@ -345,6 +345,12 @@ impl fmt::Display for GyroBudget {
                 1e3 * chosen
             )?;
         }
+        for (mode, p, q) in &c.small_fractions {
+            writeln!(
+                f,
+                "  warning: the {mode} mode locks on {p}/{q} of the ADC rate, where the ROM's and the DAC's roundings repeat instead of averaging out (up to 7e-4° of phase seen): the budget does not cover that; another adc_rate_hz moves the lock off it"
+            )?;
+        }
         Ok(())
     }
 }

@@ -25,12 +25,18 @@
 //! mode's `dB/dφ`, and a bounded gain error `g` at most `g (|B| + |B′|)/2`. The budget's worst
 //! case is `|Σ derived| + Σ bounds`.
 //!
+//! The budget leaves out a locked frequency on a small fraction of `fs` ([`small_fraction_near`]
+//! names it, and `formats` warns): there the ROM's and the DAC's roundings repeat with the
+//! NCO's few phases and leave a static phase of their own (7e-4° seen at 6000 Hz = 3/100 of
+//! 200 kHz, gone 0.02 Hz away), which no NCO width takes away.
+//!
 //! The truncation's bounds are measured, not proven: over random structures (the realized-phase
 //! property's ranges), the fixed loop's phase departed from its float twin's (which has no
-//! truncation) by at most 0.0038 bin with error feedback (rms 0.0009; 2,200 modes at `A` = 6,
-//! 8, 9, 10 and 11 with `P` from 20 to 32), and its gain (`|B + iQ|`) by at most 3.4e-3 per
-//! radian of a bin; plainly truncated, by up to 0.29 bin where `2^(A+2) f_L/fs` sits near a
-//! fraction of small denominator. The offline sweep that checks it is
+//! truncation) by at most 0.0038 bin with error feedback (0.0044 at `A` = 12 and 13; rms
+//! 0.0009; 3,400 modes at `A` = 6, 8, 9, 10 and 11 with `P` from 20 to 32), and its gain
+//! (`|B + iQ|`) by at most 3.4e-3 per radian of a bin (1,000 of those modes); plainly
+//! truncated, by up to 0.29 bin where `2^(A+2) f_L/fs` sits near a fraction of small
+//! denominator. The offline sweep that checks it is
 //! `GYROFX_TRUNCATION_CASES=200 GYROFX_TRUNCATION_A=8 GYROFX_TRUNCATION_P=20 cargo test
 //! --release -p gyrofx-model --lib truncation_stays_within_its_budget`. With fewer
 //! than [`MIN_RESIDUE_BITS`] bits under the truncation, or fewer than
@@ -62,6 +68,14 @@ pub const FEEDBACK_TRUNCATION_GAIN: f64 = 0.005;
 /// (3e-4 at `A` = 10, 0.2 per radian, seen near a small fraction).
 pub const PLAIN_TRUNCATION_GAIN: f64 = 0.3;
 
+/// The least phase bound of the truncation part, deg: where the bins are fine (14 address bits
+/// and more) the fixed loop's other roundings (the ROM's words, the demodulators') are what
+/// moves its phase from the twin's (3.9e-5° seen at 14 address bits, 3.5e-5° at 16).
+pub const ROUNDINGS_FLOOR_DEG: f64 = 5e-5;
+
+/// The least gain bound of the truncation part, relative (4e-7 seen at 16 address bits).
+pub const ROUNDINGS_GAIN_FLOOR: f64 = 1e-6;
+
 /// Fewest bits below the truncation (`P − A − 2`) for which [`FEEDBACK_TRUNCATION_BINS`] was
 /// measured.
 pub const MIN_RESIDUE_BITS: u32 = 10;
@@ -69,6 +83,25 @@ pub const MIN_RESIDUE_BITS: u32 = 10;
 /// Fewest phase bits for which [`FEEDBACK_TRUNCATION_BINS`] was measured (at `A` = 6,
 /// `P` = 18 the PLL's 0.8 Hz frequency step let 0.007 bin through).
 pub const MIN_FEEDBACK_PHASE_BITS: u32 = 20;
+
+/// Largest denominator `q` of a fraction `p/q` of `fs` that [`small_fraction_near`] names.
+pub const SMALL_FRACTION_DENOMINATOR: u32 = 100;
+
+/// How close to `p/q · fs` a locked frequency must be for [`small_fraction_near`] to name it,
+/// Hz (0.02 Hz away from 3/100 · 200 kHz the departure is down to 1.1e-4°).
+pub const SMALL_FRACTION_WIDTH_HZ: f64 = 0.05;
+
+/// The fraction `p/q` of `fs_hz` (in lowest terms, `q ≤` [`SMALL_FRACTION_DENOMINATOR`])
+/// within [`SMALL_FRACTION_WIDTH_HZ`] of `f_hz`, if any. There the NCO visits only `q` phases
+/// (its error feedback aside), so the ROM's and the DAC's roundings repeat instead of
+/// averaging out and leave a static phase error of their own: 7e-4° at 6000 Hz = 3/100 of
+/// 200 kHz with 18-bit words, 1e-4° at 6000.02 Hz.
+pub fn small_fraction_near(f_hz: f64, fs_hz: f64) -> Option<(u32, u32)> {
+    (1..=SMALL_FRACTION_DENOMINATOR).find_map(|q| {
+        let p = libm::round(f_hz / fs_hz * f64::from(q));
+        ((f_hz - p * fs_hz / f64::from(q)).abs() < SMALL_FRACTION_WIDTH_HZ).then_some((p as u32, q))
+    })
+}
 
 /// How a part moves the residual.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -105,6 +138,9 @@ pub struct ResidualBudget {
     pub configured_dps: f64,
     /// The parts, in the order of the module doc.
     pub parts: Vec<Part>,
+    /// Each mode whose locked frequency sits on a small fraction `p/q` of `fs` (see
+    /// [`small_fraction_near`]): the budget does not cover it.
+    pub small_fractions: Vec<(&'static str, u32, u32)>,
 }
 
 impl ResidualBudget {
@@ -150,10 +186,18 @@ impl ResidualBudget {
             phase_deg: [0.0; 2],
             cost: Cost::Bound(plan.output.to.lsb() / 2.0),
         });
+        let small_fractions = modes
+            .iter()
+            .filter_map(|&mode| {
+                small_fraction_near(coupled_resonance_hz(params, mode), plan.adc_rate_hz)
+                    .map(|(p, q)| (mode.name(), p, q))
+            })
+            .collect();
         ResidualBudget {
             slope_dps_per_deg: slope,
             configured_dps,
             parts,
+            small_fractions,
         }
     }
 
@@ -292,7 +336,8 @@ fn coefficient_part(plan: &Plan, params: &ResonatorParams, realized: &[RealizedP
 }
 
 /// The most the NCOs' truncation moves a mode's phase, deg, and its sense gain (relative): a
-/// share of a bin of the `A + 2`-bit phase, and of that bin in radians (see the module doc).
+/// share of a bin of the `A + 2`-bit phase (at least [`ROUNDINGS_FLOOR_DEG`]), and of that bin
+/// in radians (at least [`ROUNDINGS_GAIN_FLOOR`]; see the module doc).
 pub fn truncation_bounds(plan: &Plan) -> (f64, f64) {
     let nco = &plan.nco;
     let residue_bits = nco.phase.width - nco.address_bits - 2;
@@ -305,7 +350,10 @@ pub fn truncation_bounds(plan: &Plan) -> (f64, f64) {
         (PLAIN_TRUNCATION_BINS, PLAIN_TRUNCATION_GAIN)
     };
     let bin_deg = 360.0 / crate::fx::pow2(nco.address_bits as i32 + 2);
-    (bins * bin_deg, gain_per_radian * bin_deg.to_radians())
+    (
+        (bins * bin_deg).max(ROUNDINGS_FLOOR_DEG),
+        (gain_per_radian * bin_deg.to_radians()).max(ROUNDINGS_GAIN_FLOOR),
+    )
 }
 
 /// The latency's first-order effect on a mode's phase, deg. `δ_T` compensates the loop's
@@ -412,7 +460,7 @@ pub fn choose(specs: &[Spec], leftovers_dps: &[f64], target_dps: f64) -> Result<
         }
     }
     Err(format!(
-        "no NCO of up to {} address bits and {MAX_CHOSEN_PHASE_BITS} phase bits, with or without the phase trim, meets it: the finest leaves {:.6} mdps (the sense gain's, the coefficients', the output's and the twin's own parts)",
+        "no NCO of up to {} address bits and {MAX_CHOSEN_PHASE_BITS} phase bits, with or without the phase trim, meets it: the finest leaves {:.6} mdps (the sense gain's, the coefficients', the other roundings', the output's and the twin's own parts)",
         super::nco::MAX_ADDRESS_BITS,
         1e3 * floor
     ))
