@@ -642,6 +642,13 @@ fn reproduce_paper_004_compares_its_table_2() {
         assert!((residual[0] - residual[1]).abs() < 5e-3, "{bias:?}");
     }
     assert!(out.contains("**Cancelled exactly:**") && out.contains("**Left:**"));
+    // The default trims the phase: the text says what the trim adds against what.
+    assert!(
+        out.contains(
+            "its phase trim (`[loop] phase_trim`, the default) adds +0.00102° / -0.00129°"
+        ),
+        "{out}"
+    );
     let log = fails(&["reproduce", "--paper", "004", "--samples", "100"]);
     assert!(log.contains("--samples 100 is too few"), "{log}");
 }

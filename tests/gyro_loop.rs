@@ -26,8 +26,8 @@ fn the_default_gyros_match_the_closed_forms_in_both_modes() {
         for (mode, bias) in [("normal", 20.376), ("reverse", -20.395)] {
             let m = &gyro[mode];
             let (measured, predicted) = figure(m, "bias_dps");
-            // Predicted at the realized phase, which the loop moves by about 0.001°
-            // (2.9 mdps) from the configured 1° of the closed form's 20.376 / −20.395.
+            // Predicted at the realized phase: the configured 1° of the closed form's 20.376 /
+            // −20.395, trimmed (untrimmed the loop moves it by about 0.001°, 2.9 mdps).
             assert!((predicted - bias).abs() < 6e-3, "{mode}: {predicted}");
             let (phase, derived) = figure(m, "reference_phase_deg");
             assert!(
@@ -47,12 +47,13 @@ fn the_default_gyros_match_the_closed_forms_in_both_modes() {
             let (settling, _) = figure(m, "rate_settling_ms");
             assert!(settling > 50.0 && settling < 150.0, "{mode}: {settling} ms");
         }
-        // (B − B′)/2 is −9.4 mdps at the configured phases; the realized ones make it
-        // −12.7 predicted, and the loop's must be within 5 % of that (issue 32).
+        // (B − B′)/2 is −9.4 mdps at the configured phases; the trimmed phases (the default)
+        // make it −9.3 predicted (the sense gains' part; −12.7 untrimmed), and the loop's must
+        // be within 5 % of that (issue 32).
         let configured = gyro["residual_configured_phase_dps"].as_f64().unwrap();
         assert!((configured + 0.0094).abs() < 2e-4, "{configured}");
         let (measured, predicted) = figure(gyro, "residual_bias_dps");
-        assert!((predicted + 0.0127).abs() < 2e-4, "{predicted}");
+        assert!((predicted + 0.0093).abs() < 2e-4, "{predicted}");
         assert!(
             (measured / predicted - 1.0).abs() < 0.05,
             "{measured} vs {predicted}"
@@ -82,7 +83,7 @@ fn the_config_sets_each_gyros_structure_and_bad_values_are_refused() {
     let optional = write_config(
         dir.path(),
         "optional.toml",
-        "[loop]\nscale_coefficient_format = \"s24.6\"\nphase_trim = false\n",
+        "[loop]\nscale_coefficient_format = \"s24.6\"\n",
     );
     ok(&["loop", "--config", &optional]);
 
@@ -184,20 +185,29 @@ fn loop_plots_the_switch_as_png_or_svg() {
     assert!(!bad.exists());
 }
 
-/// `[loop] phase_trim = true` (issue 32): only the per-mode sense offsets change (the
-/// parameters the RTL already takes), the loop then realizes the configured 1° (where it
-/// realizes 0.99915° / 1.00116° untrimmed), and the trimmed loop's vectors hold bit for bit in
-/// Icarus, Verilator and GHDL.
+/// `[loop] phase_trim` (issue 32, on by default): the trimmed loop realizes the configured 1°
+/// (untrimmed it realizes 0.99915° / 1.00116°), only the per-mode sense offsets change between
+/// the two (the parameters the RTL already takes), and the untrimmed loop's vectors hold bit
+/// for bit in Icarus, Verilator and GHDL as the default's do.
 #[test]
 fn the_phase_trim_changes_only_the_sense_offsets_and_is_bit_exact_in_every_simulator() {
     let dir = tempfile::tempdir().unwrap();
-    let config = write_config(dir.path(), "trim.toml", "[loop]\nphase_trim = true\n");
-    let figures: serde_json::Value =
-        serde_json::from_str(&ok(&["loop", "--json", "--config", &config])).unwrap();
-    for mode in ["normal", "reverse"] {
-        let (phase, derived) = figure(&figures[0][mode], "reference_phase_deg");
-        assert!((derived - 1.0).abs() < 1e-6, "{mode}: derived {derived}");
-        assert!((phase - 1.0).abs() < 3e-4, "{mode}: realized {phase}");
+    let config = write_config(dir.path(), "untrimmed.toml", "[loop]\nphase_trim = false\n");
+    let phases = |args: &[&str]| {
+        let figures: serde_json::Value =
+            serde_json::from_str(&ok(&[&["loop", "--json"], args].concat())).unwrap();
+        ["normal", "reverse"].map(|mode| figure(&figures[0][mode], "reference_phase_deg"))
+    };
+    for (phase, derived) in phases(&[]) {
+        assert!((derived - 1.0).abs() < 1e-6, "trimmed: derived {derived}");
+        assert!((phase - 1.0).abs() < 3e-4, "trimmed: realized {phase}");
+    }
+    for (phase, derived) in phases(&["--config", &config]) {
+        assert!((derived - 1.0).abs() > 8e-4, "untrimmed: derived {derived}");
+        assert!(
+            (phase - derived).abs() < 3e-4,
+            "untrimmed: realized {phase}"
+        );
     }
 
     let package = dir.path().join("pkg");
@@ -215,10 +225,10 @@ fn the_phase_trim_changes_only_the_sense_offsets_and_is_bit_exact_in_every_simul
         std::fs::read_to_string(root.join("gyro_loop/gyro_loop_params.vh")).unwrap()
     };
     let golden = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("vectors");
-    let (trimmed, untrimmed) = (params(&package), params(&golden));
-    let differing: Vec<&str> = trimmed
+    let (untrimmed, trimmed) = (params(&package), params(&golden));
+    let differing: Vec<&str> = untrimmed
         .lines()
-        .zip(untrimmed.lines())
+        .zip(trimmed.lines())
         // The header line names the config: not a parameter.
         .filter(|(t, u)| t != u && !t.starts_with("//"))
         .map(|(t, _)| t.split_whitespace().nth(2).unwrap_or(t))
@@ -226,7 +236,7 @@ fn the_phase_trim_changes_only_the_sense_offsets_and_is_bit_exact_in_every_simul
     assert_eq!(
         differing,
         ["P_SENSE_OFFSET_N", "P_SENSE_OFFSET_R"],
-        "{trimmed}"
+        "{untrimmed}"
     );
 
     let log = ok(&[

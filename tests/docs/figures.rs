@@ -814,6 +814,92 @@ fn the_loop_table_the_guide_quotes_is_what_loop_measures() {
     );
 }
 
+/// The residual budget's table in the gyro-loop explanation is what `formats
+/// --residual-budget 1mdps` gives for gyro A: each part as configured and as chosen, the worst
+/// cases, the measured departures and the choice.
+#[test]
+fn the_residual_budget_the_guide_quotes_is_what_formats_gives() {
+    let report = &json(&["formats", "--residual-budget", "1mdps", "--json"])["residual_budget"];
+    let gyro = &report["gyros"][0];
+    let cost = |budget: &str, name: &str| {
+        let parts = gyro[budget]["parts"].as_array().unwrap();
+        let part = parts.iter().find(|p| p["name"] == name).unwrap();
+        let cost = &part["cost"];
+        if let Some(bound) = cost["bound"].as_f64() {
+            format!("≤ {}", decimals(1e3 * bound, 3))
+        } else {
+            let value = 1e3
+                * cost["derived"]
+                    .as_f64()
+                    .or(cost["measured"].as_f64())
+                    .unwrap();
+            let sign = if value >= 0.0 { "+" } else { "" };
+            format!("{sign}{}", decimals(value, 3))
+        }
+    };
+    let page = "explanation/gyro-loop.md";
+    for (label, settings, name) in [
+        ("locked frequency", "the structure", "locked frequency"),
+        (
+            "PLL `2f` modulation",
+            "`pll_bandwidth_hz`, `demod_lowpass_shift`",
+            "PLL 2f modulation",
+        ),
+        ("phase trim", "`phase_trim`", "phase trim"),
+        ("sense gain", "the structure, the PLL", "sense gain"),
+        (
+            "NCO truncation",
+            "`nco_address_bits`, `nco_error_feedback`",
+            "NCO truncation",
+        ),
+        ("float twin leftover", "—", "float twin leftover"),
+    ] {
+        let row = format!(
+            "| {label} | {settings} | {} | {} |",
+            cost("configured", name),
+            cost("chosen", name)
+        );
+        assert_quotes(page, &row);
+    }
+    let worst = |budget: &str| {
+        let parts = gyro[budget]["parts"].as_array().unwrap();
+        let (mut derived, mut bounds) = (0.0, 0.0);
+        for part in parts {
+            let c = &part["cost"];
+            match c["bound"].as_f64() {
+                Some(b) => bounds += b,
+                None => derived += c["derived"].as_f64().or(c["measured"].as_f64()).unwrap(),
+            }
+        }
+        decimals(1e3 * (f64::abs(derived) + bounds), 3)
+    };
+    assert_quotes(
+        page,
+        &format!(
+            "| worst case | | {} | {} |",
+            worst("configured"),
+            worst("chosen")
+        ),
+    );
+    let measured = |key: &str| decimals(1e3 * gyro[key].as_f64().unwrap(), 3);
+    assert_quotes(
+        page,
+        &format!(
+            "| measured (closed fixed loop) | | +{} | +{} |",
+            measured("configured_measured_dps"),
+            measured("chosen_measured_dps")
+        ),
+    );
+    let chosen = &report["chosen"];
+    assert_quotes(
+        page,
+        &format!(
+            "1 mdps needs `nco_address_bits = {}` and `nco_phase_bits = {}`",
+            chosen["nco_address_bits"], chosen["nco_phase_bits"]
+        ),
+    );
+}
+
 /// The first-package tutorial shows what its commands give: `generate`'s first lines, the
 /// testbenches' sample counts, and the expected value it flips (the hex word on line 3 of
 /// the KF's expected file, and its real value in the mismatch line).

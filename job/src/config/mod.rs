@@ -142,13 +142,12 @@ pub fn preset(name: &str) -> Result<&'static str> {
 }
 
 /// Optional keys that the default leaves commented out.
-const OPTIONAL_KEYS: [&str; 6] = [
+const OPTIONAL_KEYS: [&str; 5] = [
     "stimulus.csv_path",
     "stimulus.csv_column",
     "kf.g1_format",
     "kf.g2_format",
     "loop.scale_coefficient_format",
-    "loop.phase_trim",
 ];
 
 /// Refuses a key of `user` that neither the default nor [`OPTIONAL_KEYS`] has, naming it and

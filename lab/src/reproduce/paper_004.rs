@@ -328,6 +328,26 @@ impl Paper004 {
         }
         if let Some(r) = self.resonators.first() {
             let [n, v] = &r.modes;
+            let phase_offsets = |figures: &Characterization| {
+                let (normal, reverse) = (
+                    &figures.normal.realized_phase,
+                    &figures.reverse.realized_phase,
+                );
+                let moved = format!(
+                    "the sense phase at the coupled resonance the drive locks on ({:+.5}° / {:+.5}°)",
+                    normal.locked_frequency_deg, reverse.locked_frequency_deg
+                );
+                if normal.trim_deg == 0.0 && reverse.trim_deg == 0.0 {
+                    format!("{}, mostly through {moved}", realized_phases(figures))
+                } else {
+                    format!(
+                        "{}: its phase trim (`[loop] phase_trim`, the default) adds {:+.5}° / {:+.5}° against {moved} and the PLL's `2f` modulation",
+                        realized_phases(figures),
+                        normal.trim_deg,
+                        reverse.trim_deg
+                    )
+                }
+            };
             let _ = write!(
                 out,
                 "\n- **Cancelled exactly:** the damping coupling is the same in both modes \
@@ -338,9 +358,8 @@ impl Paper004 {
                  through the drive frequency (`w` {:.3} Hz, `w′` {:.3} Hz: {:.2} % apart) and \
                  through `φ ≠ φ′` when the phase errors differ; with φ = φ′ = 1° the residual \
                  is the frequency term alone, {:+.2e} °/s at the configured phases.\n\
-                 - **The loop's own phase offsets:** the closed loop realizes {}, mostly \
-                 through the sense phase at the coupled resonance the drive locks on \
-                 ({:+.5}° / {:+.5}°). With the realized phases the residual is \
+                 - **The loop's own phase offsets:** the closed loop realizes {}. With the \
+                 realized phases the residual is \
                  {:+.3e} °/s predicted and {:+.3e} °/s measured: the offsets make {:.0} % of it. \
                  A phase error that drifts between modes leaks `k_xy/(2mw) · Δφ` (about {:.2} °/s \
                  per degree here) straight into the calibrated output.\n",
@@ -350,9 +369,7 @@ impl Paper004 {
                 100.0 * (n.drive_frequency_hz() - v.drive_frequency_hz()).abs()
                     / n.drive_frequency_hz(),
                 r.figures.residual_configured_phase_dps,
-                realized_phases(&r.figures),
-                r.figures.normal.realized_phase.locked_frequency_deg,
-                r.figures.reverse.realized_phase.locked_frequency_deg,
+                phase_offsets(&r.figures),
                 r.figures.residual_bias_dps.predicted,
                 r.figures.residual_bias_dps.measured,
                 100.0

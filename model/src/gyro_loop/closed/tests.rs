@@ -453,6 +453,7 @@ proptest! {
 #[test]
 fn the_phase_trim_realizes_the_configured_phase() {
     let mut spec = structure((2.0, 0.5), (3.0, 3.0), (8195.0, 53.0), (184.0, 195.0), 1);
+    spec.settings.phase_trim = false;
     let untrimmed = Plan::new(&spec).unwrap();
     spec.settings.phase_trim = true;
     let plan = Plan::new(&spec).unwrap();
