@@ -417,9 +417,9 @@ proptest! {
         spec.settings.nco_error_feedback = nco_error_feedback;
         let plan = Plan::new(&spec).unwrap();
         let truncation = if nco_error_feedback { 0.0 } else { truncation_allowance_deg(&plan) };
-        // Some structures in this range have a closed-loop pole of ~45 ms after a switch
-        // (ε 2.2°, split 20 Hz, Q 364 / 100): 300 ms leaves 10 mdps of it in reverse mode.
-        let procedure = Procedure { switch_ms: 1000.0, ..Procedure::default() };
+        // The default second after a switch: some structures in this range have a
+        // closed-loop pole of ~45 ms (ε 2.2°, split 20 Hz, Q 364 / 100).
+        let procedure = Procedure::default();
         let [fixed, float] = [true, false].map(|fixed| {
             let (r, f) = (&spec.resonator, &spec.front_end);
             if fixed {
@@ -518,10 +518,7 @@ fn nco_error_feedback_takes_the_truncations_static_error_away() {
             0,
         ),
     ];
-    let procedure = Procedure {
-        switch_ms: 1000.0,
-        ..Procedure::default()
-    };
+    let procedure = Procedure::default();
     for mut spec in structures {
         spec.settings.nco_error_feedback = false;
         let run = |spec: &Spec| {
