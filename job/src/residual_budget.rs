@@ -54,7 +54,7 @@ pub struct GyroBudget {
 pub struct Sweep {
     /// The `[loop]` key.
     pub setting: &'static str,
-    /// The budget part it sets.
+    /// The budget parts it sets (their costs summed).
     pub part: &'static str,
     /// Each value and its part's cost (a bound), °/s.
     pub costs: Vec<(u32, f64)>,
@@ -217,13 +217,17 @@ fn sweeps(spec: &Spec) -> Vec<Sweep> {
         set(&mut spec);
         let plan = Plan::new(&spec).ok()?;
         let budget = ResidualBudget::new(&plan, &spec.resonator);
-        budget
-            .parts
-            .iter()
-            .find(|p| p.name == part)
-            .map(|p| match p.cost {
-                Cost::Bound(v) | Cost::Derived(v) | Cost::Measured(v) => v,
-            })
+        let names: Vec<&str> = part.split(" + ").collect();
+        Some(
+            budget
+                .parts
+                .iter()
+                .filter(|p| names.contains(&p.name))
+                .map(|p| match p.cost {
+                    Cost::Bound(v) | Cost::Derived(v) | Cost::Measured(v) => v,
+                })
+                .sum(),
+        )
     };
     let sweep =
         |setting, part, values: std::ops::RangeInclusive<u32>, set: fn(&mut Spec, u32)| Sweep {
@@ -237,9 +241,14 @@ fn sweeps(spec: &Spec) -> Vec<Sweep> {
         sweep("nco_address_bits", "NCO truncation", 6..=14, |s, v| {
             s.settings.nco_address_bits = v;
         }),
-        sweep("nco_phase_bits", "offset word", 16..=36, |s, v| {
-            s.settings.nco_phase_bits = v;
-        }),
+        sweep(
+            "nco_phase_bits",
+            "offset word + PLL frequency step",
+            16..=36,
+            |s, v| {
+                s.settings.nco_phase_bits = v;
+            },
+        ),
         sweep("adc_to_dac_latency_samples", "latency", 0..=8, |s, v| {
             s.settings.adc_to_dac_latency_samples = v;
         }),
@@ -348,7 +357,7 @@ impl fmt::Display for GyroBudget {
         for (mode, p, q) in &c.small_fractions {
             writeln!(
                 f,
-                "  warning: the {mode} mode locks on {p}/{q} of the ADC rate, where the ROM's and the DAC's roundings repeat instead of averaging out (up to 7e-4° of phase seen): the budget does not cover that; another adc_rate_hz moves the lock off it"
+                "  warning: the {mode} mode locks on {p}/{q} of the ADC rate, where the ROM's and the DAC's roundings repeat instead of averaging out (up to 1.4e-3° of phase seen): the budget does not cover that; another adc_rate_hz moves the lock off it"
             )?;
         }
         Ok(())

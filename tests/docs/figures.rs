@@ -848,6 +848,11 @@ fn the_residual_budget_the_guide_quotes_is_what_formats_gives() {
         ("phase trim", "`phase_trim`", "phase trim"),
         ("sense gain", "the structure, the PLL", "sense gain"),
         (
+            "PLL frequency step",
+            "`nco_phase_bits`, `pll_bandwidth_hz`",
+            "PLL frequency step",
+        ),
+        (
             "NCO truncation",
             "`nco_address_bits`, `nco_error_feedback`",
             "NCO truncation",

@@ -17,6 +17,7 @@
 //! | sense gain | (the structure, the PLL) | derived | `|Z_ss(f_nom)|/|Z_ss(f_L)|` and the modulation's gain |
 //! | 1/SF coefficients | `scale_coefficient_width` | derived | each mode's rate coefficient's rounding |
 //! | offset word | `nco_phase_bits` | bound | `δ_S` rounded to `P` bits: `180°·2^−P` |
+//! | PLL frequency step | `nco_phase_bits`, `pll_bandwidth_hz` | bound | [`FREQUENCY_STEP_SHARE`] of `(fs/2^P)/(2π f_PLL)` rad: the word's dither |
 //! | NCO truncation | `nco_address_bits`, `nco_error_feedback` | bound | [`FEEDBACK_TRUNCATION_BINS`] or [`PLAIN_TRUNCATION_BINS`] of `360°/2^(A+2)` of phase, [`FEEDBACK_TRUNCATION_GAIN`] or [`PLAIN_TRUNCATION_GAIN`] of a bin (rad) of gain |
 //! | latency | `adc_to_dac_latency_samples` | bound | `δ_T` is exact at `f_nom`, not at `f_L` |
 //! | output LSB | `output_format` | bound | half an LSB of the constant rate output |
@@ -27,7 +28,7 @@
 //!
 //! The budget leaves out a locked frequency on a small fraction of `fs` ([`small_fraction_near`]
 //! names it, and `formats` warns): there the ROM's and the DAC's roundings repeat with the
-//! NCO's few phases and leave a static phase of their own (7e-4° seen at 6000 Hz = 3/100 of
+//! NCO's few phases and leave a static phase of their own (1.4e-3° seen at 8000 Hz = 1/25 of
 //! 200 kHz, gone 0.02 Hz away), which no NCO width takes away.
 //!
 //! The truncation's bounds are measured, not proven: over random structures (the realized-phase
@@ -76,6 +77,10 @@ pub const ROUNDINGS_FLOOR_DEG: f64 = 5e-5;
 /// The least gain bound of the truncation part, relative (4e-7 seen at 16 address bits).
 pub const ROUNDINGS_GAIN_FLOOR: f64 = 1e-6;
 
+/// The share of `Δf/(2π f_PLL)` (rad) bounding the frequency step's phase wander (0.042
+/// seen; see [`frequency_step_bound_deg`]).
+pub const FREQUENCY_STEP_SHARE: f64 = 0.1;
+
 /// Fewest bits below the truncation (`P − A − 2`) for which [`FEEDBACK_TRUNCATION_BINS`] was
 /// measured.
 pub const MIN_RESIDUE_BITS: u32 = 10;
@@ -88,14 +93,14 @@ pub const MIN_FEEDBACK_PHASE_BITS: u32 = 20;
 pub const SMALL_FRACTION_DENOMINATOR: u32 = 100;
 
 /// How close to `p/q · fs` a locked frequency must be for [`small_fraction_near`] to name it,
-/// Hz (0.02 Hz away from 3/100 · 200 kHz the departure is down to 1.1e-4°).
+/// Hz (0.02 Hz away from 1/25 · 200 kHz the departure is down to 2e-5°).
 pub const SMALL_FRACTION_WIDTH_HZ: f64 = 0.05;
 
 /// The fraction `p/q` of `fs_hz` (in lowest terms, `q ≤` [`SMALL_FRACTION_DENOMINATOR`])
 /// within [`SMALL_FRACTION_WIDTH_HZ`] of `f_hz`, if any. There the NCO visits only `q` phases
 /// (its error feedback aside), so the ROM's and the DAC's roundings repeat instead of
-/// averaging out and leave a static phase error of their own: 7e-4° at 6000 Hz = 3/100 of
-/// 200 kHz with 18-bit words, 1e-4° at 6000.02 Hz.
+/// averaging out and leave a static phase error of their own: 1.4e-3° at 8000 Hz = 1/25 of
+/// 200 kHz with 18-bit words, 3e-4° at 6000 Hz = 3/100, 2e-5° at 8000.02 Hz.
 pub fn small_fraction_near(f_hz: f64, fs_hz: f64) -> Option<(u32, u32)> {
     (1..=SMALL_FRACTION_DENOMINATOR).find_map(|q| {
         let p = libm::round(f_hz / fs_hz * f64::from(q));
@@ -161,6 +166,13 @@ impl ResidualBudget {
             settings: "nco_phase_bits",
             phase_deg: [word; 2],
             cost: bounded([word; 2]),
+        });
+        let step = frequency_step_bound_deg(plan);
+        parts.push(Part {
+            name: "PLL frequency step",
+            settings: "nco_phase_bits, pll_bandwidth_hz",
+            phase_deg: [step; 2],
+            cost: bounded([step; 2]),
         });
         let (truncation, gain) = truncation_bounds(plan);
         let biases = figures.map(|f| f.bias_dps().abs());
@@ -356,6 +368,17 @@ pub fn truncation_bounds(plan: &Plan) -> (f64, f64) {
     )
 }
 
+/// The most the PLL's output rounded to the NCO's `P`-bit frequency word moves a mode's phase,
+/// deg: [`FREQUENCY_STEP_SHARE`] of `Δf/(2π f_PLL)` rad, `Δf = fs/2^P` the word's step and
+/// `f_PLL` the loop's crossover. The word dithers between two steps around the locked frequency
+/// and the phase wanders with it over seconds (0.042 of `Δf/(2π f_PLL)` seen on a 1.2°
+/// stiffness angle at 22 and 23 phase bits: 8e-4° at 22).
+pub fn frequency_step_bound_deg(plan: &Plan) -> f64 {
+    let step_hz = plan.adc_rate_hz * crate::fx::pow2(-(plan.nco.phase.width as i32));
+    let crossover = 2.0 * std::f64::consts::PI * plan.settings.pll_bandwidth_hz;
+    (FREQUENCY_STEP_SHARE * step_hz / crossover).to_degrees()
+}
+
 /// The latency's first-order effect on a mode's phase, deg. `δ_T` compensates the loop's
 /// `L + ½` samples at `f_nom`, so at `f_L` the drive is `2π (f_L − f_nom)(L + ½)/fs` rad off;
 /// the PLL takes that up by moving the drive frequency along the driven axis's phase slope
@@ -466,13 +489,9 @@ pub fn choose(specs: &[Spec], leftovers_dps: &[f64], target_dps: f64) -> Result<
     ))
 }
 
-/// The procedure the budget's measurements use: SPEC §1.6's, with a second after each switch
-/// (some strongly coupled structures ring for 45 ms time constants).
+/// The procedure the budget's measurements use: `gyrofx loop`'s.
 pub fn procedure() -> Procedure {
-    Procedure {
-        switch_ms: 1000.0,
-        ..Procedure::default()
-    }
+    Procedure::default()
 }
 
 /// The float twin's residual less the one the plan predicts for `spec`, °/s, noise off.
