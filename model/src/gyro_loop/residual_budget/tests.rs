@@ -4,7 +4,7 @@
 use proptest::prelude::*;
 
 use super::*;
-use crate::gyro_loop::closed::tests::structure;
+use crate::gyro_loop::closed::tests::{structure, structures};
 use crate::gyro_loop::closed::FixedHarness;
 
 fn budget(spec: &Spec) -> ResidualBudget {
@@ -115,16 +115,12 @@ proptest! {
     /// the closed fixed loop's residual lies within the budget: `R_c + Σ derived ± Σ bounds`.
     #[test]
     fn the_closed_loop_stays_within_its_budget(
-        angles in (0.05f64..2.5, -5.0f64..5.0),
-        phases in (-3.0f64..3.0, -3.0f64..3.0),
-        frequencies in (6000.0f64..12000.0, 20.0f64..100.0),
-        qs in (100.0f64..400.0, 100.0f64..400.0),
-        latency in 0u32..=3,
+        structure in structures(),
         address_bits in 6u32..=12,
         extra_phase_bits in 0u32..=8,
         phase_trim in any::<bool>(),
     ) {
-        let mut spec = structure(angles, phases, frequencies, qs, latency);
+        let mut spec = structure;
         spec.settings.nco_address_bits = address_bits;
         spec.settings.nco_phase_bits = (address_bits + 12).max(20) + extra_phase_bits;
         spec.settings.phase_trim = phase_trim;
@@ -164,18 +160,10 @@ fn truncation_stays_within_its_budget() {
         rng_seed: proptest::test_runner::RngSeed::Fixed(34),
         ..ProptestConfig::default()
     });
-    let strategy = (
-        (0.05f64..2.5, -5.0f64..5.0),
-        (-3.0f64..3.0, -3.0f64..3.0),
-        (6000.0f64..12000.0, 20.0f64..100.0),
-        (100.0f64..400.0, 100.0f64..400.0),
-        0u32..=3,
-    );
     let worst = std::cell::Cell::new(0.0f64);
     let worst_gain = std::cell::Cell::new(0.0f64);
     runner
-        .run(&strategy, |(angles, phases, frequencies, qs, latency)| {
-            let mut spec = structure(angles, phases, frequencies, qs, latency);
+        .run(&structures(), |mut spec| {
             spec.settings.nco_address_bits = a;
             spec.settings.nco_phase_bits = p;
             let plan = Plan::new(&spec).unwrap();
