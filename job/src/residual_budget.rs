@@ -9,28 +9,14 @@ use std::fmt;
 use serde::Serialize;
 
 use gyrofx_model::gyro_loop::closed::FixedHarness;
-use gyrofx_model::gyro_loop::figures::characterize;
+use gyrofx_model::gyro_loop::figures::{characterize, Procedure};
 use gyrofx_model::gyro_loop::gyro::{Plan, Spec};
 use gyrofx_model::gyro_loop::residual_budget::{
-    choose, procedure, twin_leftover_dps, Choice, Cost, ResidualBudget,
+    choose, twin_leftover_dps, Choice, Cost, NcoSettings, ResidualBudget, Unreachable,
 };
 
 use crate::config::Config;
-use crate::config::GyroLoop;
 use crate::error::{Error, Result};
-
-/// The NCO and trim settings the budget chooses between.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-pub struct NcoSettings {
-    /// `nco_address_bits`, `A`.
-    pub nco_address_bits: u32,
-    /// `nco_phase_bits`, `P`.
-    pub nco_phase_bits: u32,
-    /// `nco_error_feedback`.
-    pub nco_error_feedback: bool,
-    /// `phase_trim`.
-    pub phase_trim: bool,
-}
 
 /// One gyro's budget as configured and as chosen, with the fixed loop's measured departure
 /// from `R_c` for each.
@@ -40,12 +26,12 @@ pub struct GyroBudget {
     pub gyro: &'static str,
     /// The configured loop's budget.
     pub configured: ResidualBudget,
-    /// The closed fixed loop's residual less `R_c`, as configured, °/s.
-    pub configured_measured_dps: f64,
+    /// The closed fixed loop, as configured.
+    pub configured_measured: Measured,
     /// The chosen loop's budget.
     pub chosen: ResidualBudget,
-    /// The closed fixed loop's residual less `R_c`, as chosen, °/s.
-    pub chosen_measured_dps: f64,
+    /// The closed fixed loop, as chosen.
+    pub chosen_measured: Measured,
 }
 
 /// What one setting's values cost in residual at gyro `a`, the rest as configured: `(value,
@@ -55,7 +41,7 @@ pub struct Sweep {
     /// The `[loop]` key.
     pub setting: &'static str,
     /// The budget parts it sets (their costs summed).
-    pub part: &'static str,
+    pub parts: &'static [&'static str],
     /// Each value and its part's cost (a bound), °/s.
     pub costs: Vec<(u32, f64)>,
 }
@@ -73,36 +59,6 @@ pub struct Report {
     pub gyros: Vec<GyroBudget>,
     /// NCO address bits, phase bits and latency, each alone.
     pub sweeps: Vec<Sweep>,
-}
-
-impl NcoSettings {
-    fn of(spec: &Spec) -> Self {
-        let s = &spec.settings;
-        NcoSettings {
-            nco_address_bits: s.nco_address_bits,
-            nco_phase_bits: s.nco_phase_bits,
-            nco_error_feedback: s.nco_error_feedback,
-            phase_trim: s.phase_trim,
-        }
-    }
-
-    fn apply(&self, spec: &Spec) -> Spec {
-        let mut spec = spec.clone();
-        let s = &mut spec.settings;
-        s.nco_address_bits = self.nco_address_bits;
-        s.nco_phase_bits = self.nco_phase_bits;
-        s.nco_error_feedback = self.nco_error_feedback;
-        s.phase_trim = self.phase_trim;
-        spec
-    }
-}
-
-fn spec_of(gyro: &GyroLoop) -> Spec {
-    Spec {
-        settings: gyro.plan.settings.clone(),
-        resonator: gyro.params,
-        front_end: gyro.front_end,
-    }
 }
 
 /// Parses a `--residual-budget` target: a number of mdps (`1mdps`) or °/s (`0.001dps`),
@@ -124,12 +80,33 @@ pub fn parse_target(text: &str) -> std::result::Result<f64, String> {
     }
 }
 
-/// The closed fixed loop's residual less `R_c`, °/s, noise off.
-fn measured_departure(spec: &Spec, budget: &ResidualBudget) -> Result<f64> {
+/// The closed fixed loop's residual less `R_c`, °/s, noise off, and what saturated while it
+/// was measured (`None`: nothing).
+fn measured_departure(spec: &Spec, budget: &ResidualBudget) -> Result<Measured> {
     let plan = Plan::new(spec).map_err(|e| loop_error(e.to_string()))?;
-    let c = characterize::<FixedHarness>(&plan, &spec.resonator, &spec.front_end, &procedure())
-        .map_err(|e| loop_error(e.to_string()))?;
-    Ok(c.residual_bias_dps.measured - budget.configured_dps)
+    let c = characterize::<FixedHarness>(
+        &plan,
+        &spec.resonator,
+        &spec.front_end,
+        &Procedure::default(),
+    )
+    .map_err(|e| loop_error(e.to_string()))?;
+    let mut saturations = c.normal.saturations;
+    saturations.add(&c.reverse.saturations);
+    Ok(Measured {
+        departure_dps: c.residual_bias_dps.measured - budget.configured_dps,
+        clipped: (saturations.total() > 0).then(|| saturations.summary()),
+    })
+}
+
+/// A closed-loop measurement of the residual.
+#[derive(Clone, Debug, Serialize)]
+pub struct Measured {
+    /// The residual less `R_c`, °/s.
+    pub departure_dps: f64,
+    /// The fixed loop's nodes that saturated or wrapped while the figures were measured, as
+    /// `gyrofx loop` counts them (`None`: none; otherwise the departure is clipped).
+    pub clipped: Option<String>,
 }
 
 fn loop_error(message: String) -> Error {
@@ -144,12 +121,12 @@ fn loop_error(message: String) -> Error {
 #[derive(Debug, thiserror::Error)]
 pub enum BudgetError {
     /// No NCO meets the target; the message names the floor.
-    #[error("--residual-budget {target_mdps} mdps is not allowed: {message}")]
+    #[error("--residual-budget {target_mdps} mdps is not allowed: {unreachable}")]
     Target {
         /// The target, mdps.
         target_mdps: f64,
         /// What the finest loop leaves.
-        message: String,
+        unreachable: Unreachable,
     },
     /// The loops cannot be planned or measured.
     #[error(transparent)]
@@ -165,91 +142,78 @@ pub fn residual_budget(
     target_dps: f64,
 ) -> std::result::Result<Report, BudgetError> {
     let loops = config.gyro_loops()?;
-    let specs: Vec<Spec> = loops.iter().map(spec_of).collect();
-    let leftovers = specs
-        .iter()
-        .map(twin_leftover_dps)
-        .collect::<std::result::Result<Vec<f64>, String>>()
-        .map_err(loop_error)?;
-    let Choice {
-        nco_address_bits,
-        nco_phase_bits,
-        nco_error_feedback,
-        phase_trim,
-        budgets,
-    } = choose(&specs, &leftovers, target_dps).map_err(|message| BudgetError::Target {
-        target_mdps: 1e3 * target_dps,
-        message,
-    })?;
-    let chosen = NcoSettings {
-        nco_address_bits,
-        nco_phase_bits,
-        nco_error_feedback,
-        phase_trim,
-    };
     let mut gyros = Vec::new();
-    for (((gyro, spec), chosen_budget), &leftover) in
-        loops.iter().zip(&specs).zip(budgets).zip(&leftovers)
-    {
-        let configured = ResidualBudget::new(&gyro.plan, &gyro.params).with_twin(leftover);
-        let chosen_spec = chosen.apply(spec);
-        gyros.push(GyroBudget {
+    for gyro in &loops {
+        let spec = gyro.spec();
+        let leftover = twin_leftover_dps(&spec).map_err(loop_error)?;
+        gyros.push((spec, leftover));
+    }
+    let Choice { settings, budgets } =
+        choose(&gyros, target_dps).map_err(|unreachable| BudgetError::Target {
+            target_mdps: 1e3 * target_dps,
+            unreachable,
+        })?;
+    let mut reports = Vec::new();
+    for ((gyro, (spec, leftover)), chosen) in loops.iter().zip(&gyros).zip(budgets) {
+        let configured = ResidualBudget::new(&gyro.plan, &gyro.params).with_twin(*leftover);
+        reports.push(GyroBudget {
             gyro: gyro.name,
-            configured_measured_dps: measured_departure(spec, &configured)?,
-            chosen_measured_dps: measured_departure(&chosen_spec, &chosen_budget)?,
+            configured_measured: measured_departure(spec, &configured)?,
+            chosen_measured: measured_departure(&settings.apply(spec), &chosen)?,
             configured,
-            chosen: chosen_budget,
+            chosen,
         });
     }
     Ok(Report {
         target_dps,
-        configured: NcoSettings::of(&specs[0]),
-        chosen,
-        gyros,
-        sweeps: sweeps(&specs[0]),
+        configured: NcoSettings::of(&gyros[0].0),
+        chosen: settings,
+        gyros: reports,
+        sweeps: sweeps(&gyros[0].0),
     })
 }
 
 /// Each of `A`, `P` and `L` alone, the rest of `spec` as configured.
 fn sweeps(spec: &Spec) -> Vec<Sweep> {
-    let cost = |part: &'static str, set: &dyn Fn(&mut Spec)| -> Option<f64> {
+    let cost = |parts: &[&str], set: &dyn Fn(&mut Spec)| -> Option<f64> {
         let mut spec = spec.clone();
         set(&mut spec);
         let plan = Plan::new(&spec).ok()?;
         let budget = ResidualBudget::new(&plan, &spec.resonator);
-        let names: Vec<&str> = part.split(" + ").collect();
         Some(
             budget
                 .parts
                 .iter()
-                .filter(|p| names.contains(&p.name))
+                .filter(|p| parts.contains(&p.name))
                 .map(|p| match p.cost {
                     Cost::Bound(v) | Cost::Derived(v) | Cost::Measured(v) => v,
                 })
                 .sum(),
         )
     };
-    let sweep =
-        |setting, part, values: std::ops::RangeInclusive<u32>, set: fn(&mut Spec, u32)| Sweep {
-            setting,
-            part,
-            costs: values
-                .filter_map(|v| cost(part, &|s| set(s, v)).map(|c| (v, c)))
-                .collect(),
-        };
+    let sweep = |setting,
+                 parts: &'static [&'static str],
+                 values: std::ops::RangeInclusive<u32>,
+                 set: fn(&mut Spec, u32)| Sweep {
+        setting,
+        parts,
+        costs: values
+            .filter_map(|v| cost(parts, &|s| set(s, v)).map(|c| (v, c)))
+            .collect(),
+    };
     vec![
-        sweep("nco_address_bits", "NCO truncation", 6..=14, |s, v| {
+        sweep("nco_address_bits", &["NCO truncation"], 6..=14, |s, v| {
             s.settings.nco_address_bits = v;
         }),
         sweep(
             "nco_phase_bits",
-            "offset word + PLL frequency step",
+            &["offset word", "PLL frequency step"],
             16..=36,
             |s, v| {
                 s.settings.nco_phase_bits = v;
             },
         ),
-        sweep("adc_to_dac_latency_samples", "latency", 0..=8, |s, v| {
+        sweep("adc_to_dac_latency_samples", &["latency"], 0..=8, |s, v| {
             s.settings.adc_to_dac_latency_samples = v;
         }),
     ]
@@ -296,16 +260,6 @@ fn mdps(cost: Cost) -> String {
     }
 }
 
-impl fmt::Display for NcoSettings {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "nco_address_bits = {}, nco_phase_bits = {}, nco_error_feedback = {}, phase_trim = {}",
-            self.nco_address_bits, self.nco_phase_bits, self.nco_error_feedback, self.phase_trim
-        )
-    }
-}
-
 impl fmt::Display for GyroBudget {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let (c, h) = (&self.configured, &self.chosen);
@@ -340,8 +294,8 @@ impl fmt::Display for GyroBudget {
             ("worst case", c.worst_dps(), h.worst_dps()),
             (
                 "measured",
-                self.configured_measured_dps,
-                self.chosen_measured_dps,
+                self.configured_measured.departure_dps,
+                self.chosen_measured.departure_dps,
             ),
         ];
         for (name, configured, chosen) in rows {
@@ -353,6 +307,17 @@ impl fmt::Display for GyroBudget {
                 1e3 * configured,
                 1e3 * chosen
             )?;
+        }
+        for (which, measured) in [
+            ("configured", &self.configured_measured),
+            ("chosen", &self.chosen_measured),
+        ] {
+            if let Some(clipped) = &measured.clipped {
+                writeln!(
+                    f,
+                    "  warning: the {which} loop saturated while it was measured ({clipped}): its measured residual is clipped, not the loop's"
+                )?;
+            }
         }
         for (mode, p, q) in &c.small_fractions {
             writeln!(
@@ -378,7 +343,7 @@ impl fmt::Display for Report {
             "each setting alone (gyro a, the rest as configured), mdps:"
         )?;
         for sweep in &self.sweeps {
-            write!(f, "  {:<27} ({}):", sweep.setting, sweep.part)?;
+            write!(f, "  {:<27} ({}):", sweep.setting, sweep.parts.join(" + "))?;
             for (value, cost) in &sweep.costs {
                 write!(f, " {value}: {}", short_mdps(*cost))?;
             }

@@ -886,13 +886,13 @@ fn the_residual_budget_the_guide_quotes_is_what_formats_gives() {
             worst("chosen")
         ),
     );
-    let measured = |key: &str| decimals(1e3 * gyro[key].as_f64().unwrap(), 3);
+    let measured = |key: &str| decimals(1e3 * gyro[key]["departure_dps"].as_f64().unwrap(), 3);
     assert_quotes(
         page,
         &format!(
             "| measured (closed fixed loop) | | +{} | +{} |",
-            measured("configured_measured_dps"),
-            measured("chosen_measured_dps")
+            measured("configured_measured"),
+            measured("chosen_measured")
         ),
     );
     let chosen = &report["chosen"];

@@ -28,6 +28,18 @@ pub struct GyroLoop {
     pub front_end: PhysicsSettings,
 }
 
+impl GyroLoop {
+    /// The spec its plan was made from: the `[loop]` settings and this gyro's structure and
+    /// front end.
+    pub fn spec(&self) -> Spec {
+        Spec {
+            settings: self.plan.settings.clone(),
+            resonator: self.params,
+            front_end: self.front_end,
+        }
+    }
+}
+
 /// Deserializes `table` (a config section after overlaying) as `T`, naming the section in the
 /// error.
 fn section<T: serde::de::DeserializeOwned>(name: &str, table: toml::Table) -> Result<T> {

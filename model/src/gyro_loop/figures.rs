@@ -373,7 +373,7 @@ pub fn characterize_reporting<L: LoopUnderTest>(
             },
             bias_dps: Figure {
                 measured: zero.rate,
-                predicted: sigma * realized.bias_dps(params, mode),
+                predicted: realized.chain_bias_dps(params, mode),
             },
             quadrature_dps: Figure {
                 measured: zero.quadrature,
@@ -416,8 +416,10 @@ pub fn characterize_reporting<L: LoopUnderTest>(
         reverse: reverse_report,
         residual_bias_dps: Figure {
             measured: (normal.0.rate + reverse.0.rate) / 2.0,
-            // Each mode's prediction is in the chain's convention: (g B − g′ B′)/2.
-            predicted: (normal_report.bias_dps.predicted + reverse_report.bias_dps.predicted) / 2.0,
+            predicted: realized_phase::residual_dps(
+                params,
+                &[normal_report.realized_phase, reverse_report.realized_phase],
+            ),
         },
         residual_configured_phase_dps: (figures[0].bias_dps() - figures[1].bias_dps()) / 2.0,
     })

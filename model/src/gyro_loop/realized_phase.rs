@@ -105,6 +105,20 @@ impl RealizedPhase {
                 * libm::cos(design.phase_error));
         self.gain * rate.to_degrees()
     }
+
+    /// [`RealizedPhase::bias_dps`] in the chain's sign convention (`+B` normal, `−B′`
+    /// reverse), as the loop's rate output reads it.
+    pub fn chain_bias_dps(&self, params: &ResonatorParams, mode: Mode) -> f64 {
+        ModeFigures::new(params, mode).sigma() * self.bias_dps(params, mode)
+    }
+}
+
+/// The residual after reversal, `(g B(φ_r) − g′ B′(φ_r′))/2` in the chain's convention, °/s,
+/// for the modes' realized phases `[normal, reverse]`.
+pub fn residual_dps(params: &ResonatorParams, realized: &[RealizedPhase; 2]) -> f64 {
+    (realized[0].chain_bias_dps(params, Mode::Normal)
+        + realized[1].chain_bias_dps(params, Mode::Reverse))
+        / 2.0
 }
 
 /// The realized reference phase of `mode` in the loop `plan` closes around `params`, derived

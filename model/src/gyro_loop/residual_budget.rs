@@ -255,14 +255,6 @@ impl ResidualBudget {
     }
 }
 
-/// `R` in the chain's convention for the modes' realized phases.
-fn residual(params: &ResonatorParams, realized: &[RealizedPhase; 2]) -> f64 {
-    let bias = |mode: Mode, r: &RealizedPhase| {
-        ModeFigures::new(params, mode).sigma() * r.bias_dps(params, mode)
-    };
-    (bias(Mode::Normal, &realized[0]) + bias(Mode::Reverse, &realized[1])) / 2.0
-}
-
 /// A derived part: its name, its settings, and what it copies from the realized phase into the
 /// one being built (returning its phase, deg).
 type Step = (
@@ -317,7 +309,7 @@ fn derived_parts(
         .iter()
         .map(|(name, settings, step)| {
             let phase_deg = [0, 1].map(|i| step(&mut current[i], &realized[i]));
-            let after = residual(params, &current);
+            let after = realized_phase::residual_dps(params, &current);
             let part = Part {
                 name,
                 settings,
@@ -335,8 +327,7 @@ fn derived_parts(
 fn coefficient_part(plan: &Plan, params: &ResonatorParams, realized: &[RealizedPhase; 2]) -> Part {
     let moved = [Mode::Normal, Mode::Reverse].map(|mode| {
         let c = plan.mode(mode).rate_coefficient;
-        let bias = ModeFigures::new(params, mode).sigma()
-            * realized[super::gyro::mode_index(mode)].bias_dps(params, mode);
+        let bias = realized[super::gyro::mode_index(mode)].chain_bias_dps(params, mode);
         bias * (c.quantized() / c.value - 1.0)
     });
     Part {
@@ -402,20 +393,75 @@ fn latency_bound_deg(plan: &Plan, params: &ResonatorParams, mode: Mode) -> f64 {
     (slope * moved_w).abs().to_degrees()
 }
 
+/// The `[loop]` settings the budget chooses: the NCO's widths, its error feedback and the
+/// phase trim.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct NcoSettings {
+    /// `nco_address_bits`, `A`.
+    pub nco_address_bits: u32,
+    /// `nco_phase_bits`, `P`.
+    pub nco_phase_bits: u32,
+    /// `nco_error_feedback`.
+    pub nco_error_feedback: bool,
+    /// `phase_trim`.
+    pub phase_trim: bool,
+}
+
+impl NcoSettings {
+    /// The settings `spec` has.
+    pub fn of(spec: &Spec) -> Self {
+        let s = &spec.settings;
+        NcoSettings {
+            nco_address_bits: s.nco_address_bits,
+            nco_phase_bits: s.nco_phase_bits,
+            nco_error_feedback: s.nco_error_feedback,
+            phase_trim: s.phase_trim,
+        }
+    }
+
+    /// `spec` with these settings.
+    pub fn apply(&self, spec: &Spec) -> Spec {
+        let mut spec = spec.clone();
+        let s = &mut spec.settings;
+        s.nco_address_bits = self.nco_address_bits;
+        s.nco_phase_bits = self.nco_phase_bits;
+        s.nco_error_feedback = self.nco_error_feedback;
+        s.phase_trim = self.phase_trim;
+        spec
+    }
+}
+
+impl std::fmt::Display for NcoSettings {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "nco_address_bits = {}, nco_phase_bits = {}, nco_error_feedback = {}, phase_trim = {}",
+            self.nco_address_bits, self.nco_phase_bits, self.nco_error_feedback, self.phase_trim
+        )
+    }
+}
+
 /// A budget's choice: the cheapest NCO (fewest ROM address bits, then fewest phase bits)
-/// whose worst case meets the target for every gyro.
+/// whose worst case meets the target for every gyro. Error feedback is always chosen (it
+/// costs a `P − A − 2`-bit adder per NCO); the trim is the configured one unless the target
+/// needs it on.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Choice {
-    /// `nco_address_bits`.
-    pub nco_address_bits: u32,
-    /// `nco_phase_bits`.
-    pub nco_phase_bits: u32,
-    /// `nco_error_feedback` (always chosen: it costs a `P − A − 2`-bit adder per NCO).
-    pub nco_error_feedback: bool,
-    /// `phase_trim` (the configured one unless the target needs it on).
-    pub phase_trim: bool,
-    /// Each gyro's budget with the choice.
+    /// The settings chosen.
+    pub settings: NcoSettings,
+    /// Each gyro's budget with them.
     pub budgets: Vec<ResidualBudget>,
+}
+
+/// No NCO meets the target: the least worst case the finest NCO of any width leaves, °/s,
+/// over the trims tried.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+#[error("no NCO of up to {max_address_bits} address bits and {MAX_CHOSEN_PHASE_BITS} phase bits{trim} meets it: the finest leaves {floor_mdps:.6} mdps (the sense gain's, the coefficients', the other roundings', the output's and the twin's own parts)", max_address_bits = super::nco::MAX_ADDRESS_BITS, trim = if *only_trimmed { ", trimmed," } else { ", with or without the phase trim," }, floor_mdps = 1e3 * floor_dps)]
+pub struct Unreachable {
+    /// The floor, °/s.
+    pub floor_dps: f64,
+    /// Only the trimmed loop was tried (the config trims).
+    pub only_trimmed: bool,
 }
 
 /// Smallest `A` the chooser tries (a 16-word quarter-wave ROM).
@@ -424,74 +470,66 @@ const MIN_CHOSEN_ADDRESS_BITS: u32 = 4;
 const MAX_CHOSEN_PHASE_BITS: u32 = 40;
 
 /// The cheapest NCO and trim whose worst case (see [`ResidualBudget::worst_dps`]) is at most
-/// `target_dps` for each of `specs` (the gyros, which share the `[loop]` settings), or why
-/// none is: the floor the target is under.
-pub fn choose(specs: &[Spec], leftovers_dps: &[f64], target_dps: f64) -> Result<Choice, String> {
-    let trims: &[bool] = if specs[0].settings.phase_trim {
+/// `target_dps` for each of `gyros` (each gyro's spec, which share the `[loop]` settings, and
+/// its [`twin_leftover_dps`], measured as configured and taken for every candidate).
+///
+/// # Errors
+/// [`Unreachable`], naming the floor, when no NCO meets the target.
+pub fn choose(gyros: &[(Spec, f64)], target_dps: f64) -> Result<Choice, Unreachable> {
+    let only_trimmed = gyros[0].0.settings.phase_trim;
+    let trims: &[bool] = if only_trimmed {
         &[true]
     } else {
         &[false, true]
     };
-    let budgets = |a: u32, p: u32, trim: bool| -> Option<Vec<ResidualBudget>> {
-        specs
+    let budgets = |settings: NcoSettings| -> Option<Vec<ResidualBudget>> {
+        gyros
             .iter()
-            .zip(leftovers_dps)
-            .map(|(spec, &leftover)| {
-                let mut spec = spec.clone();
-                spec.settings.nco_address_bits = a;
-                spec.settings.nco_phase_bits = p;
-                spec.settings.nco_error_feedback = true;
-                spec.settings.phase_trim = trim;
+            .map(|(spec, leftover)| {
+                let spec = settings.apply(spec);
                 Plan::new(&spec)
                     .ok()
-                    .map(|plan| ResidualBudget::new(&plan, &spec.resonator).with_twin(leftover))
+                    .map(|plan| ResidualBudget::new(&plan, &spec.resonator).with_twin(*leftover))
             })
             .collect()
     };
-    let meets = |b: &[ResidualBudget]| b.iter().all(|b| b.worst_dps() <= target_dps);
-    let mut floor = f64::INFINITY;
+    let worst = |b: &[ResidualBudget]| b.iter().map(ResidualBudget::worst_dps).fold(0.0, f64::max);
+    let mut floor_dps = f64::INFINITY;
     for a in MIN_CHOSEN_ADDRESS_BITS..=super::nco::MAX_ADDRESS_BITS {
         let lowest = (a + 2 + MIN_RESIDUE_BITS).max(MIN_FEEDBACK_PHASE_BITS);
-        for &trim in trims {
+        for &phase_trim in trims {
+            let settings = |p: u32| NcoSettings {
+                nco_address_bits: a,
+                nco_phase_bits: p,
+                nco_error_feedback: true,
+                phase_trim,
+            };
             // The finest NCO of this A the loop accepts first (the PLL's integrator must
             // resolve its frequency step): if it misses, no coarser P meets the target.
             let Some((finest, budget)) = (lowest..=MAX_CHOSEN_PHASE_BITS)
                 .rev()
-                .find_map(|p| budgets(a, p, trim).map(|b| (p, b)))
+                .find_map(|p| budgets(settings(p)).map(|b| (p, b)))
             else {
                 continue;
             };
-            let worst = budget
-                .iter()
-                .map(ResidualBudget::worst_dps)
-                .fold(0.0, f64::max);
-            floor = floor.min(worst);
-            if worst > target_dps {
+            floor_dps = floor_dps.min(worst(&budget));
+            if worst(&budget) > target_dps {
                 continue;
             }
             for p in lowest..=finest {
-                if let Some(b) = budgets(a, p, trim).filter(|b| meets(b)) {
+                if let Some(budgets) = budgets(settings(p)).filter(|b| worst(b) <= target_dps) {
                     return Ok(Choice {
-                        nco_address_bits: a,
-                        nco_phase_bits: p,
-                        nco_error_feedback: true,
-                        phase_trim: trim,
-                        budgets: b,
+                        settings: settings(p),
+                        budgets,
                     });
                 }
             }
         }
     }
-    Err(format!(
-        "no NCO of up to {} address bits and {MAX_CHOSEN_PHASE_BITS} phase bits, with or without the phase trim, meets it: the finest leaves {:.6} mdps (the sense gain's, the coefficients', the other roundings', the output's and the twin's own parts)",
-        super::nco::MAX_ADDRESS_BITS,
-        1e3 * floor
-    ))
-}
-
-/// The procedure the budget's measurements use: `gyrofx loop`'s.
-pub fn procedure() -> Procedure {
-    Procedure::default()
+    Err(Unreachable {
+        floor_dps,
+        only_trimmed,
+    })
 }
 
 /// The float twin's residual less the one the plan predicts for `spec`, °/s, noise off.
@@ -500,8 +538,13 @@ pub fn procedure() -> Procedure {
 /// A spec the loop refuses, or a twin that does not lock.
 pub fn twin_leftover_dps(spec: &Spec) -> Result<f64, String> {
     let plan = Plan::new(spec).map_err(|e| e.to_string())?;
-    let c = characterize::<FloatHarness>(&plan, &spec.resonator, &spec.front_end, &procedure())
-        .map_err(|e| e.to_string())?;
+    let c = characterize::<FloatHarness>(
+        &plan,
+        &spec.resonator,
+        &spec.front_end,
+        &Procedure::default(),
+    )
+    .map_err(|e| e.to_string())?;
     Ok(c.residual_bias_dps.measured - c.residual_bias_dps.predicted)
 }
 

@@ -6,6 +6,7 @@ use proptest::prelude::*;
 use super::*;
 use crate::gyro_loop::closed::tests::{structure, structures};
 use crate::gyro_loop::closed::FixedHarness;
+use crate::gyro_loop::figures::Procedure;
 
 fn budget(spec: &Spec) -> ResidualBudget {
     let plan = Plan::new(spec).unwrap();
@@ -129,7 +130,7 @@ proptest! {
         let b = ResidualBudget::new(&plan, &spec.resonator).with_twin(leftover);
         // What the budget leaves out, and says so (6000 Hz, where shrinking goes, is 3/100).
         prop_assume!(b.small_fractions.is_empty());
-        let c = characterize::<FixedHarness>(&plan, &spec.resonator, &spec.front_end, &procedure()).unwrap();
+        let c = characterize::<FixedHarness>(&plan, &spec.resonator, &spec.front_end, &Procedure::default()).unwrap();
         let departure = c.residual_bias_dps.measured - b.configured_dps;
         prop_assert!(
             (departure - b.derived_dps()).abs() <= b.bound_dps(),
@@ -172,8 +173,8 @@ fn truncation_stays_within_its_budget() {
                 .small_fractions
                 .is_empty());
             let (r, f) = (&spec.resonator, &spec.front_end);
-            let fixed = characterize::<FixedHarness>(&plan, r, f, &procedure()).unwrap();
-            let float = characterize::<FloatHarness>(&plan, r, f, &procedure()).unwrap();
+            let fixed = characterize::<FixedHarness>(&plan, r, f, &Procedure::default()).unwrap();
+            let float = characterize::<FloatHarness>(&plan, r, f, &Procedure::default()).unwrap();
             let bin = 360.0 / crate::fx::pow2(a as i32 + 2);
             for (x, y) in [
                 (&fixed.normal, &float.normal),
@@ -222,8 +223,8 @@ fn the_choice_is_the_cheapest_that_meets_the_target() {
     let spec = Spec::paper_004();
     let leftover = twin_leftover_dps(&spec).unwrap();
     let target = 1e-3;
-    let choice = choose(std::slice::from_ref(&spec), &[leftover], target).unwrap();
-    assert!(choice.phase_trim && choice.nco_error_feedback);
+    let choice = choose(&[(spec.clone(), leftover)], target).unwrap();
+    assert!(choice.settings.phase_trim && choice.settings.nco_error_feedback);
     assert!(choice.budgets[0].worst_dps() <= target);
     let with = |a: u32, p: u32| {
         let mut s = spec.clone();
@@ -232,7 +233,10 @@ fn the_choice_is_the_cheapest_that_meets_the_target() {
         s.settings.phase_trim = true;
         s
     };
-    let (a, p) = (choice.nco_address_bits, choice.nco_phase_bits);
+    let (a, p) = (
+        choice.settings.nco_address_bits,
+        choice.settings.nco_phase_bits,
+    );
     let coarser_rom = budget(&with(a - 1, 38)).with_twin(leftover);
     assert!(coarser_rom.worst_dps() > target, "{coarser_rom:?}");
     let lowest = (a + 2 + MIN_RESIDUE_BITS).max(MIN_FEEDBACK_PHASE_BITS);
@@ -242,18 +246,35 @@ fn the_choice_is_the_cheapest_that_meets_the_target() {
     }
     let chosen = with(a, p);
     let plan = Plan::new(&chosen).unwrap();
-    let c = characterize::<FixedHarness>(&plan, &chosen.resonator, &chosen.front_end, &procedure())
-        .unwrap();
+    let c = characterize::<FixedHarness>(
+        &plan,
+        &chosen.resonator,
+        &chosen.front_end,
+        &Procedure::default(),
+    )
+    .unwrap();
     let departure = c.residual_bias_dps.measured - choice.budgets[0].configured_dps;
     assert!(departure.abs() <= target, "{departure}");
 }
 
-/// A target under what the finest loop leaves is refused, naming that floor.
+/// A target under what the finest loop leaves is refused, naming that floor, and the floor is
+/// the true one: a target 0.1 % above it is met, and the message says it in mdps.
 #[test]
 fn a_target_under_the_floor_is_refused() {
-    let spec = Spec::paper_004();
-    let message = choose(std::slice::from_ref(&spec), &[0.0], 1e-6).unwrap_err();
-    assert!(message.contains("the finest leaves 0.3"), "{message}");
+    let gyros = [(Spec::paper_004(), 0.0)];
+    let refused = choose(&gyros, 1e-6).unwrap_err();
+    assert!(refused.only_trimmed);
+    let floor = refused.floor_dps;
+    assert!(floor > 1e-6 && floor < 1e-3, "{floor}");
+    assert_eq!(choose(&gyros, 0.999 * floor).unwrap_err(), refused);
+    let met = choose(&gyros, 1.001 * floor).unwrap();
+    assert!(met.budgets[0].worst_dps() <= 1.001 * floor);
+    let message = refused.to_string();
+    assert!(
+        message.contains(&format!("the finest leaves {:.6} mdps", 1e3 * floor))
+            && message.contains(", trimmed,"),
+        "{message}"
+    );
 }
 
 /// A mode locked on a small fraction of `fs` is named (6000 Hz is 3/100 of 200 kHz, 8000 Hz
@@ -278,8 +299,8 @@ fn a_lock_on_a_small_fraction_of_the_sample_rate_is_named() {
     let gap = |spec: &Spec| {
         let plan = Plan::new(spec).unwrap();
         let (r, f) = (&spec.resonator, &spec.front_end);
-        let fixed = characterize::<FixedHarness>(&plan, r, f, &procedure()).unwrap();
-        let float = characterize::<FloatHarness>(&plan, r, f, &procedure()).unwrap();
+        let fixed = characterize::<FixedHarness>(&plan, r, f, &Procedure::default()).unwrap();
+        let float = characterize::<FloatHarness>(&plan, r, f, &Procedure::default()).unwrap();
         let budget = ResidualBudget::new(&plan, r);
         let gap = (fixed.normal.reference_phase_deg.measured
             - float.normal.reference_phase_deg.measured)
