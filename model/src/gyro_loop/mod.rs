@@ -42,6 +42,7 @@ pub mod cic;
 pub mod closed;
 pub mod demodulator;
 pub mod figures;
+pub mod folded;
 pub mod gyro;
 pub mod nco;
 pub mod pi;

@@ -1,0 +1,405 @@
+//! The control word: what the folded loop's datapath does in one clock. Each field drives one
+//! multiplexer or one write enable of `hdl/gyrofx_gyro_loop_serial.v`; the schedule is a
+//! sequence of these words, one a clock, stored in the schedule ROM (`SCHEDULE_FILE`).
+//!
+//! Bit layout (LSB first), [`Control::encode`]:
+//!
+//! | bits | field | meaning |
+//! |------|-------|---------|
+//! | 0–2 | `rom` | [`RomRead`]: the NCO reference read this clock |
+//! | 3 | `advance` | the NCO accumulator advances by this sample's frequency word |
+//! | 4–7 | `a` | [`ASource`]: the multiplier's `a` operand (0: no product issued) |
+//! | 8–10 | `limb` | which 15-bit limb of `a` |
+//! | 11 | `top` | the limb is `a`'s top (signed) limb |
+//! | 12–14 | `b` | [`BSource`]: the multiplier's `b` operand |
+//! | 15–18 | `tap` | compensator tap index, for `b` = tap |
+//! | 19–22 | `x` | [`AccX`]: the accumulator's base |
+//! | 23–26 | `y` | [`AccY`]: the accumulator's addend |
+//! | 27–29 | `product_limb` | the limb of the product arriving now, for `y` = product |
+//! | 30–32 | `align` | [`Align`]: the product's extra left shift |
+//! | 33 | `read` | a RAM read this clock |
+//! | 34–40 | `read_address` | its word |
+//! | 41–43 | `gate` | [`ReadGate`]: when it reads as 0 (or the PLL preset) |
+//! | 44–47 | `seen` | for the `seen` gate: 0 until this many decimations since reset |
+//! | 48 | `write` | a RAM write this clock |
+//! | 49–55 | `write_address` | its word |
+//! | 56–58 | `data` | [`WriteData`]: what is written |
+//! | 59–62 | `quantize` | [`Quantize`]: the quantization point that fires |
+
+/// Width of a limb of the multiplier's operands, bits: `15` unsigned bits fit a signed 16×16
+/// multiplier (one SB_MAC16, one DSP48 slice) with a zero sign bit.
+pub const LIMB_BITS: u32 = 15;
+
+/// Width of the control word, bits.
+pub const CONTROL_BITS: u32 = 63;
+
+/// Width of a RAM address field, bits.
+pub const ADDRESS_BITS: u32 = 7;
+
+macro_rules! field_enum {
+    ($(#[$meta:meta])* $name:ident { $($(#[$vmeta:meta])* $variant:ident = $value:expr),* $(,)? }) => {
+        $(#[$meta])*
+        #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+        #[repr(u8)]
+        pub enum $name {
+            $($(#[$vmeta])* $variant = $value),*
+        }
+
+        impl $name {
+            /// The field's code.
+            pub const fn code(self) -> u64 {
+                self as u64
+            }
+        }
+    };
+}
+
+field_enum!(
+    /// The NCO reference read from the sine ROM; the value is the `b` operand from the next
+    /// clock on. The cosine read of an NCO also stores its truncation error (error feedback).
+    RomRead {
+        /// No read.
+        #[default]
+        None = 0,
+        /// The drive reference's sine (the drive demodulator's I).
+        DriveSin = 1,
+        /// The drive reference's cosine (Q).
+        DriveCos = 2,
+        /// The transmit reference's cosine (the DAC's carrier).
+        TransmitCos = 3,
+        /// The sense reference's sine.
+        SenseSin = 4,
+        /// The sense reference's cosine.
+        SenseCos = 5,
+    }
+);
+
+field_enum!(
+    /// The multiplier's `a` operand (sign-extended, split into 15-bit limbs).
+    ASource {
+        /// No product this clock.
+        #[default]
+        None = 0,
+        /// The driven axis's ADC code.
+        AdcDrive = 1,
+        /// The sensed axis's ADC code.
+        AdcSense = 2,
+        /// The drive demodulator's `Q`: the PLL's error.
+        DriveQ = 3,
+        /// The AGC's error `e_A`.
+        AmplitudeError = 4,
+        /// The AGC's output: the drive amplitude.
+        Amplitude = 5,
+        /// The CIC output `c` of this decimation.
+        Cic = 6,
+        /// The RAM read register (the compensator's delay line).
+        Read = 7,
+        /// The compensator's output, for the `1/SF` product.
+        CicOutput = 8,
+    }
+);
+
+field_enum!(
+    /// The multiplier's `b` operand.
+    BSource {
+        /// The last sine ROM read, with its sign.
+        #[default]
+        Reference = 0,
+        /// The PLL's `ki`.
+        PllKi = 1,
+        /// The PLL's `kp`.
+        PllKp = 2,
+        /// The AGC's `ki`.
+        AgcKi = 3,
+        /// The AGC's `kp`.
+        AgcKp = 4,
+        /// Compensator tap `tap`.
+        Tap = 5,
+        /// This mode's `1/SF` of the rate.
+        RateCoefficient = 6,
+        /// This mode's `1/SF` of the quadrature.
+        QuadratureCoefficient = 7,
+    }
+);
+
+field_enum!(
+    /// The accumulator's base: `acc <= x + y`.
+    AccX {
+        /// The accumulator itself (accumulate; with `y` = zero, hold).
+        #[default]
+        Keep = 0,
+        /// Zero (a new sum).
+        Zero = 1,
+        /// The RAM read register.
+        Read = 2,
+        /// The RAM read register `<< k`: a demodulator state at the update's fraction bits.
+        ReadLowpass = 3,
+        /// This mode's AGC setpoint.
+        Setpoint = 4,
+        /// The RAM read register aligned as the PLL's update needs its integrator.
+        PllIntegrator = 5,
+        /// The integrator register aligned as the PLL's output sum needs it.
+        PllSum = 6,
+        /// As `PllIntegrator`, for the AGC.
+        AgcIntegrator = 7,
+        /// As `PllSum`, for the AGC.
+        AgcSum = 8,
+    }
+);
+
+field_enum!(
+    /// The accumulator's addend.
+    AccY {
+        /// Zero.
+        #[default]
+        Zero = 0,
+        /// The product of the limb issued two clocks ago, `<< 15·product_limb + align`.
+        Product = 1,
+        /// Minus the RAM read register.
+        NegRead = 2,
+        /// The demodulator product `p`, aligned to the state's fraction bits.
+        DemodProduct = 3,
+        /// Minus the demodulator output of the state register (`−I`).
+        NegDemodOutput = 4,
+        /// The demodulator output of the state register (the CIC's input).
+        DemodOutput = 5,
+        /// The RAM read register of the clock before (the previous integrator).
+        PreviousRead = 6,
+        /// Minus the RAM read register `>> s` (the lock filter's leak).
+        NegReadShifted = 7,
+        /// The drive demodulator's `Q`.
+        DriveQ = 8,
+        /// The AGC's error.
+        AmplitudeError = 9,
+    }
+);
+
+field_enum!(
+    /// An extra left shift of the product, when a PI's product has fewer fraction bits than
+    /// the sum it enters.
+    Align {
+        /// None.
+        #[default]
+        None = 0,
+        /// `ki·e` into the PLL's update.
+        PllKi = 1,
+        /// `kp·e` into the PLL's output sum.
+        PllKp = 2,
+        /// `ki·e` into the AGC's update.
+        AgcKi = 3,
+        /// `kp·e` into the AGC's output sum.
+        AgcKp = 4,
+    }
+);
+
+field_enum!(
+    /// When a RAM read returns 0 instead of the word: the clears of a mode switch and a reset,
+    /// without a clock spent clearing the RAM.
+    ReadGate {
+        /// Never.
+        #[default]
+        None = 0,
+        /// In a sample that switches mode (demodulator states, AGC integrator, lock filters).
+        Switch = 1,
+        /// In a sample that switches mode, the PLL's preset (clamped) instead.
+        Preset = 2,
+        /// In the first sample after reset (CIC integrators).
+        First = 3,
+        /// Until `seen` decimations since reset (CIC combs, compensator delay line).
+        Seen = 4,
+    }
+);
+
+field_enum!(
+    /// What a RAM write stores (sign-extended to the RAM's width).
+    WriteData {
+        /// The accumulator, wrapped to the CIC register width.
+        #[default]
+        AccCic = 0,
+        /// The accumulator, a lock filter's `z`.
+        AccLock = 1,
+        /// The accumulator through the demodulator state's point.
+        DemodState = 2,
+        /// The accumulator through the PLL's integrator point and clamp.
+        PllIntegrator = 3,
+        /// The same for the AGC.
+        AgcIntegrator = 4,
+        /// The RAM read register (the delay lines' shift).
+        Read = 5,
+        /// The CIC output register `c`.
+        Cic = 6,
+    }
+);
+
+field_enum!(
+    /// The quantization point (or check) that fires this clock, and the register it loads.
+    Quantize {
+        /// None.
+        #[default]
+        None = 0,
+        /// Demodulator product `p` ← accumulator.
+        DemodProduct = 1,
+        /// Demodulator state register ← accumulator.
+        DemodState = 2,
+        /// `Q` of the drive demodulator ← the state register's output point.
+        DriveQ = 3,
+        /// AGC error ← accumulator (`setpoint − I`).
+        AmplitudeError = 4,
+        /// PLL integrator register ← accumulator, clamped.
+        PllIntegrator = 5,
+        /// NCO frequency word of the next sample ← accumulator (PLL output).
+        PllOutput = 6,
+        /// AGC integrator register ← accumulator, clamped.
+        AgcIntegrator = 7,
+        /// Drive amplitude ← accumulator (AGC output).
+        AgcOutput = 8,
+        /// DAC code ← accumulator: the delay line shifts and `dac_x`/`dac_y` load.
+        Dac = 9,
+        /// CIC output `c` ← accumulator (the comb chain).
+        Cic = 10,
+        /// Compensator output ← accumulator.
+        CicOutput = 11,
+        /// `rate` ← accumulator.
+        Rate = 12,
+        /// `quadrature` ← accumulator; `out_valid` pulses on the next clock.
+        Quadrature = 13,
+        /// The phase lock filter's check ← accumulator.
+        LockQ = 14,
+        /// The amplitude lock filter's check ← accumulator: the lock count and `locked` load.
+        LockA = 15,
+    }
+);
+
+/// A RAM read: the word, and when it reads as 0.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Read {
+    /// Word address.
+    pub address: u8,
+    /// When the read returns 0 (or the PLL preset).
+    pub gate: ReadGate,
+    /// For [`ReadGate::Seen`]: decimations since reset below which it returns 0.
+    pub seen: u8,
+}
+
+/// A RAM write.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Write {
+    /// Word address.
+    pub address: u8,
+    /// What is written.
+    pub data: WriteData,
+}
+
+/// A product issued to the multiplier: one limb of `a` times all of `b`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Issue {
+    /// The `a` operand.
+    pub a: ASource,
+    /// Which limb of `a` (0: least significant).
+    pub limb: u8,
+    /// Whether it is `a`'s top limb (signed).
+    pub top: bool,
+    /// The `b` operand.
+    pub b: BSource,
+    /// The tap, for [`BSource::Tap`].
+    pub tap: u8,
+}
+
+/// An accumulator operation `acc <= x + y`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Accumulate {
+    /// Base.
+    pub x: AccX,
+    /// Addend.
+    pub y: AccY,
+    /// For [`AccY::Product`]: the limb of the product arriving now.
+    pub product_limb: u8,
+    /// For [`AccY::Product`]: its extra shift.
+    pub align: Align,
+}
+
+/// One clock of the schedule. `None` fields leave their unit idle.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Control {
+    /// Sine ROM read.
+    pub rom: RomRead,
+    /// NCO accumulator advance.
+    pub advance: bool,
+    /// Multiplier issue.
+    pub issue: Option<Issue>,
+    /// Accumulator operation.
+    pub accumulate: Option<Accumulate>,
+    /// RAM read.
+    pub read: Option<Read>,
+    /// RAM write.
+    pub write: Option<Write>,
+    /// Quantization point.
+    pub quantize: Quantize,
+}
+
+/// Two controls asked for the same unit in one clock (a schedule conflict).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Busy(pub &'static str);
+
+impl Control {
+    /// The control word's bits ([module doc](self)).
+    pub fn encode(&self) -> u64 {
+        let mut word = self.rom.code() | u64::from(self.advance) << 3;
+        if let Some(issue) = self.issue {
+            word |= issue.a.code() << 4
+                | u64::from(issue.limb) << 8
+                | u64::from(issue.top) << 11
+                | issue.b.code() << 12
+                | u64::from(issue.tap) << 15;
+        }
+        if let Some(acc) = self.accumulate {
+            word |= acc.x.code() << 19
+                | acc.y.code() << 23
+                | u64::from(acc.product_limb) << 27
+                | acc.align.code() << 30;
+        }
+        if let Some(read) = self.read {
+            word |= 1 << 33
+                | u64::from(read.address) << 34
+                | read.gate.code() << 41
+                | u64::from(read.seen) << 44;
+        }
+        if let Some(write) = self.write {
+            word |= 1 << 48 | u64::from(write.address) << 49 | write.data.code() << 56;
+        }
+        word | self.quantize.code() << 59
+    }
+
+    /// This clock's units and `other`'s together, or the first unit both use.
+    ///
+    /// # Errors
+    /// [`Busy`] naming the unit.
+    pub fn merge(&self, other: &Control) -> Result<Control, Busy> {
+        fn one<T: Copy>(a: Option<T>, b: Option<T>, unit: &'static str) -> Result<Option<T>, Busy> {
+            match (a, b) {
+                (Some(_), Some(_)) => Err(Busy(unit)),
+                (a, b) => Ok(a.or(b)),
+            }
+        }
+        let rom = match (self.rom, other.rom) {
+            (RomRead::None, r) | (r, RomRead::None) => r,
+            _ => return Err(Busy("sine ROM")),
+        };
+        if self.advance && other.advance {
+            return Err(Busy("NCO advance"));
+        }
+        let quantize = match (self.quantize, other.quantize) {
+            (Quantize::None, q) | (q, Quantize::None) => q,
+            _ => return Err(Busy("quantizer")),
+        };
+        Ok(Control {
+            rom,
+            advance: self.advance || other.advance,
+            issue: one(self.issue, other.issue, "multiplier")?,
+            accumulate: one(self.accumulate, other.accumulate, "accumulator")?,
+            read: one(self.read, other.read, "RAM read port")?,
+            write: one(self.write, other.write, "RAM write port")?,
+            quantize,
+        })
+    }
+}

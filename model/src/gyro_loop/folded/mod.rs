@@ -1,0 +1,143 @@
+//! The folded gyro loop: the same loop as [`super::gyro::FixedGyroLoop`], bit for bit, with its
+//! arithmetic time-multiplexed onto one multiplier, one accumulator and one RAM, so that it fits
+//! a small FPGA (`architecture = "serial"`, `hdl/gyrofx_gyro_loop_serial.v`).
+//!
+//! # Datapath
+//!
+//! ```text
+//!  sine ROM ─► ref ─┐                       ┌─► pp ─┐
+//!  a operands ──────┴─► a limb × b (B limbs) ┘       ├─► acc ◄─ x (RAM word, setpoint, integrator…)
+//!                                                    │    │
+//!  RAM (states) ─► rd ─► prev_rd                     │    └─► quantization points ─► registers, RAM
+//! ```
+//!
+//! - **Multiplier.** Each clock it may take one 15-bit limb of an `a` operand (sign-extended;
+//!   the top limb signed, the others unsigned) and all of a `b` operand, split into
+//!   `B = ⌈(W_b − 1)/15⌉` limbs: `B` signed 16×16 products, one SB_MAC16 or DSP slice each,
+//!   registered, then summed (`pp`) on the next clock. A `W`-bit `a` takes `⌈(W − 1)/15⌉`
+//!   clocks; the accumulator adds each limb's product at its weight `2^(15·limb)`.
+//! - **Accumulator.** `acc <= x + y` ([`AccX`], [`AccY`]), wide enough for every exact sum of
+//!   the loop ([`Datapath::accumulator_width`]); partial sums wrap, the exact results fit.
+//! - **Quantization points** read the accumulator's low bits as the exact value's format
+//!   and load their register ([`Quantize`]), rounding and saturating as the parallel loop's
+//!   points do, in the same order for each value.
+//! - **RAM.** Every state: the four demodulator low-pass states, the two PI integrators, the
+//!   two lock filters, the CICs' integrators and combs, the compensators' delay lines. One
+//!   read and one write a clock; a read lands in `rd` on the next clock. Clears at a mode
+//!   switch and at reset are read gates ([`ReadGate`]), not clocks spent writing zeros.
+//! - **NCO.** One accumulator and the three references' truncation errors; a ROM read
+//!   computes the reference's phase and address.
+//!
+//! The schedule ([`Schedule`]) is derived from the loop's plan: which unit does what in each
+//! clock of a sample, the regular part every sample and the decimation part (combs,
+//! compensators, `1/SF`) every `R`-th. [`FoldedGyroLoop`] runs it clock by clock as the RTL
+//! does, which is how the tests prove the schedule against the parallel model.
+
+mod control;
+mod machine;
+mod schedule;
+#[cfg(test)]
+mod tests;
+
+pub use control::{
+    ASource, AccX, AccY, Accumulate, Align, BSource, Busy, Control, Issue, Quantize, Read,
+    ReadGate, RomRead, Write, WriteData, ADDRESS_BITS, CONTROL_BITS, LIMB_BITS,
+};
+pub use machine::FoldedGyroLoop;
+pub use schedule::{Schedule, ScheduleError, Words};
+
+use super::gyro::Plan;
+
+/// Clocks a `width`-bit signed operand takes in the multiplier: 15-bit limbs, the top one
+/// signed and up to 16 bits.
+pub fn limbs(width: u32) -> u32 {
+    width.saturating_sub(1).div_ceil(LIMB_BITS).max(1)
+}
+
+/// The widths the folded datapath needs for `plan`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Datapath {
+    /// The accumulator: every exact sum of the loop fits.
+    pub accumulator_width: u32,
+    /// A RAM word: every state fits.
+    pub ram_width: u32,
+    /// The lock filters' `z`: `W_out + s + 1` bits.
+    pub lock_width: u32,
+    /// Widest `b` operand.
+    pub b_width: u32,
+    /// Multipliers (`b` limbs).
+    pub multipliers: u32,
+    /// Widest `a` operand.
+    pub a_width: u32,
+}
+
+impl Datapath {
+    /// The widths of `plan`'s folded loop.
+    pub fn new(plan: &Plan) -> Datapath {
+        let demod = &plan.demodulator;
+        let cic = &plan.cic;
+        let lock_width = demod.output.to.width + plan.lock.shift + 1;
+        let sums = [
+            demod.product.from.width,
+            demod.state.from.width,
+            plan.agc_error.from.width,
+            plan.pll.integrator_point.from.width,
+            plan.pll.output.from.width,
+            plan.agc.integrator_point.from.width,
+            plan.agc.output.from.width,
+            plan.dac.from.width,
+            cic.register.width,
+            cic.output.from.width,
+            plan.output.from.width,
+            lock_width,
+        ];
+        let states = [
+            demod.state.to.width,
+            plan.pll.integrator.width,
+            plan.agc.integrator.width,
+            lock_width,
+            cic.register.width,
+            cic.cic.to.width,
+        ];
+        let b_width = [
+            plan.nco.output.width,
+            plan.pll.kp.format.width,
+            plan.pll.ki.format.width,
+            plan.agc.kp.format.width,
+            plan.agc.ki.format.width,
+            cic.taps[0].format.width,
+            plan.modes[0].rate_coefficient.format.width,
+        ]
+        .into_iter()
+        .max()
+        .unwrap_or(1);
+        let a_width = [
+            plan.adc.width,
+            demod.output.to.width,
+            plan.agc_error.to.width,
+            plan.agc.output.to.width,
+            cic.cic.to.width,
+            cic.output.to.width,
+        ]
+        .into_iter()
+        .max()
+        .unwrap_or(1);
+        Datapath {
+            accumulator_width: sums.into_iter().max().unwrap_or(1),
+            ram_width: states.into_iter().max().unwrap_or(1),
+            lock_width,
+            b_width,
+            multipliers: limbs(b_width),
+            a_width,
+        }
+    }
+}
+
+/// `value`'s low `width` bits as a signed number.
+pub(crate) fn sign_extend(value: i128, width: u32) -> i128 {
+    if width >= 128 {
+        return value;
+    }
+    let shift = 128 - width;
+    (value << shift) >> shift
+}

@@ -1,0 +1,198 @@
+//! The folded loop against the parallel model: the same DAC codes, lock flags and chain
+//! outputs, sample for sample.
+
+use super::*;
+use crate::gyro_loop::closed::record;
+use crate::gyro_loop::gyro::LoopSettings;
+use crate::gyro_loop::gyro::{FixedGyroLoop, Spec};
+use crate::resonator::Mode;
+use proptest::prelude::*;
+
+/// Runs `inputs` through both loops and returns the first sample where they differ.
+fn first_difference(plan: &Plan, inputs: &[([i64; 2], Mode)]) -> Option<(usize, String)> {
+    let mut parallel = FixedGyroLoop::new(plan);
+    let mut folded = FoldedGyroLoop::new(plan);
+    for (k, &(adc, mode)) in inputs.iter().enumerate() {
+        let want = parallel.step(adc, mode);
+        let got = folded.step(adc, mode);
+        if want != got || parallel.locked() != folded.locked() {
+            return Some((k, format!("parallel {want:?}, folded {got:?}")));
+        }
+    }
+    None
+}
+
+#[test]
+fn the_default_loop_folds_bit_for_bit_through_lock_and_a_switch() {
+    let spec = Spec::paper_004();
+    let plan = Plan::new(&spec).unwrap();
+    let samples = record(
+        &plan,
+        &spec.resonator,
+        &spec.front_end,
+        7,
+        10.0,
+        40_000,
+        20_000,
+    )
+    .unwrap();
+    assert!(
+        samples.iter().any(|s| s.locked),
+        "the recording never locks"
+    );
+    let inputs: Vec<_> = samples.iter().map(|s| (s.adc, s.mode)).collect();
+    assert_eq!(first_difference(&plan, &inputs), None);
+}
+
+#[test]
+fn the_default_schedule_fits_a_sample_at_24_mhz() {
+    let plan = Plan::new(&Spec::paper_004()).unwrap();
+    let schedule = Schedule::new(&plan).unwrap();
+    println!("{schedule}");
+    assert!(schedule.len() < 120, "{schedule}");
+}
+
+#[test]
+fn a_schedule_missing_one_write_is_caught() {
+    let spec = Spec::paper_004();
+    let plan = Plan::new(&spec).unwrap();
+    let samples = record(
+        &plan,
+        &spec.resonator,
+        &spec.front_end,
+        7,
+        10.0,
+        4_000,
+        2_000,
+    )
+    .unwrap();
+    let inputs: Vec<_> = samples.iter().map(|s| (s.adc, s.mode)).collect();
+    let schedule = Schedule::new(&plan).unwrap();
+    // Drop the PLL integrator's write-back: the loop then never integrates its phase error.
+    let mut broken = schedule.clone();
+    let clock = broken
+        .controls
+        .iter()
+        .position(|c| c.quantize == Quantize::PllIntegrator)
+        .unwrap();
+    broken.controls[clock].write = None;
+    let mut parallel = FixedGyroLoop::new(&plan);
+    let mut folded = FoldedGyroLoop::with_schedule(&plan, broken);
+    let differs = inputs
+        .iter()
+        .any(|&(adc, mode)| parallel.step(adc, mode) != folded.step(adc, mode));
+    assert!(
+        differs,
+        "a folded loop without the PLL's integrator matched"
+    );
+}
+
+/// Formats and settings the folded loop must hold for: widths from narrow to 64 bits, every
+/// rounding and overflow mode, latencies 0–8, 1–4 CIC stages, 1–7 taps, short decimations.
+fn settings() -> impl Strategy<Value = LoopSettings> {
+    let pick = |options: &'static [&'static str]| proptest::sample::select(options);
+    let pick_n = |options: &'static [u32]| proptest::sample::select(options);
+    (
+        (
+            pick(&["s24.23"]),
+            pick(&["s24.22", "s32.30", "s36.34"]),
+            pick(&["s44.42", "s56.54", "s64.62"]),
+            pick(&["s24.22", "s32.30", "s40.38"]),
+            4u32..=12,
+        ),
+        (
+            pick(&["s40.38", "s48.46"]),
+            pick_n(&[12u32, 18, 25]),
+            pick(&["s40.20", "s48.24"]),
+            pick(&["s24.6", "s20.4"]),
+            pick_n(&[12u32, 18, 25]),
+            pick(&["s18.0", "s16.0"]),
+        ),
+        (
+            1u32..=4,
+            pick_n(&[1u32, 3, 5, 7]),
+            pick_n(&[12u32, 18, 24]),
+            pick(&["s40.38", "s28.27"]),
+            pick(&["s32.30", "s24.22"]),
+            pick_n(&[16u32, 24, 31]),
+            pick(&["s24.14", "s32.16", "s16.8"]),
+            2u32..=30,
+        ),
+        (
+            0u32..=8,
+            4u32..=12,
+            pick_n(&[24u32, 32, 40]),
+            pick_n(&[8u32, 10, 12]),
+            pick_n(&[16u32, 18, 24]),
+            any::<bool>(),
+            pick(&["floor", "ceil", "zero", "nearest", "round", "convergent"]),
+            pick(&["wrap", "saturate"]),
+        ),
+    )
+        .prop_map(|(demod, pi, cic, rest)| {
+            let s = |text: &str| text.to_string();
+            let mut l = LoopSettings::default();
+            (l.adc_format, l.demod_product_format, l.demod_state_format) =
+                (s(demod.0), s(demod.1), s(demod.2));
+            (l.demod_output_format, l.demod_lowpass_shift) = (s(demod.3), demod.4);
+            (l.pll_integrator_format, l.pll_gain_width) = (s(pi.0), pi.1);
+            (l.agc_integrator_format, l.agc_output_format) = (s(pi.2), s(pi.3));
+            (l.agc_gain_width, l.dac_format) = (pi.4, s(pi.5));
+            (l.cic_stages, l.cic_taps, l.cic_tap_width) = (cic.0, cic.1, cic.2);
+            (l.cic_internal_format, l.cic_output_format) = (s(cic.3), s(cic.4));
+            (l.scale_coefficient_width, l.output_format) = (cic.5, s(cic.6));
+            l.decimation = cic.7;
+            (l.adc_to_dac_latency_samples, l.lock_filter_shift) = (rest.0, rest.1);
+            (l.nco_phase_bits, l.nco_address_bits, l.nco_sine_width) = (rest.2, rest.3, rest.4);
+            l.nco_error_feedback = rest.5;
+            (l.rounding, l.overflow) = (s(rest.6), s(rest.7));
+            l.lock_hold_ms = 0.05;
+            l
+        })
+}
+
+/// Cases of the random-format property: 64, or `GYROFX_FOLDED_CASES` for the offline sweep
+/// (`GYROFX_FOLDED_CASES=2000 cargo test --release -p gyrofx-model --lib
+/// the_folded_loop_matches`).
+fn folded_cases() -> u32 {
+    std::env::var("GYROFX_FOLDED_CASES")
+        .ok()
+        .and_then(|cases| cases.parse().ok())
+        .unwrap_or(64)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: folded_cases(),
+        max_global_rejects: 100_000,
+        ..ProptestConfig::default()
+    })]
+
+    /// Over random formats and settings, random ADC codes (full scale: every point saturates
+    /// or wraps now and then) and random mode switches, the folded loop gives the parallel
+    /// model's DAC codes, lock flags and chain outputs.
+    #[test]
+    fn the_folded_loop_matches_the_parallel_one_over_random_formats(
+        settings in settings(),
+        codes in proptest::collection::vec((any::<i64>(), any::<i64>(), 0u8..40), 400),
+    ) {
+        let mut spec = Spec::paper_004();
+        spec.settings = settings;
+        let plan = Plan::new(&spec);
+        prop_assume!(plan.is_ok());
+        let plan = plan.unwrap();
+        let width = plan.demodulator.input.width;
+        let mut mode = Mode::Normal;
+        let inputs: Vec<_> = codes
+            .iter()
+            .map(|&(x, y, switch)| {
+                if switch == 0 {
+                    mode = if mode == Mode::Normal { Mode::Reverse } else { Mode::Normal };
+                }
+                ([sign_extend(i128::from(x), width) as i64, sign_extend(i128::from(y), width) as i64], mode)
+            })
+            .collect();
+        let difference = first_difference(&plan, &inputs);
+        prop_assert!(difference.is_none(), "{:?} with {}", difference, Schedule::new(&plan).unwrap());
+    }
+}
