@@ -122,12 +122,16 @@ impl Datapath {
         .into_iter()
         .max()
         .unwrap_or(1);
+        let multipliers = limbs(b_width);
+        // The product of a limb and b, and (as the RTL has them) a guard bit above the widest
+        // value, so that every value sign-extends into the accumulator and a RAM word.
+        let product = 16 + LIMB_BITS * multipliers + 2;
         Datapath {
-            accumulator_width: sums.into_iter().max().unwrap_or(1),
-            ram_width: states.into_iter().max().unwrap_or(1),
+            accumulator_width: sums.into_iter().max().unwrap_or(1).max(product) + 1,
+            ram_width: states.into_iter().max().unwrap_or(1) + 1,
             lock_width,
             b_width,
-            multipliers: limbs(b_width),
+            multipliers,
             a_width,
         }
     }
