@@ -528,17 +528,42 @@ fn over_capacity(log: &str) -> Option<(String, u64, u64)> {
     })
 }
 
-/// A net's name as the report shows it: inside the block without the wrapper's path and
-/// yosys's suffixes (`kf.rate_next[23]`); a port of the block by its name (`bias_a[2]`).
+/// The cells whose names yosys appends to a net it names after one of them (`x1_reg` driving
+/// an SB_DFFESR's Q becomes `x1_reg_SB_DFFESR_Q`, a net through a CCU2C's carry
+/// `p2_s_TRELLIS_FF_Q_DI_CCU2C_S0_S1`): iCE40's `SB_` cells, ECP5's.
+const CELL_SUFFIXES: [&str; 11] = [
+    "_SB_",
+    "_TRELLIS_",
+    "_CCU2C_",
+    "_LUT4_",
+    "_L6MUX21_",
+    "_PFUMX_",
+    "_MULT18X18D_",
+    "_ALU54B_",
+    "_DP16KD_",
+    "_PDPW16KD_",
+    "_DPR16X4_",
+];
+
+/// A net's name as the report shows it: inside the block without the wrapper's path, yosys's
+/// cell suffixes and nextpnr's `$` ones (`$CCU2_COMB1`, `$TRELLIS_IO_IN`), so `kf.rate_next[23]`
+/// or `p2_s`; a port of the block by its name (`bias_a[2]`).
 fn net_name(net: &str) -> String {
     // The wrapper's own nets are named `dut.<port>`, the block's `dut.configured.<net>`.
     let inside = net
         .strip_prefix("dut.configured.")
         .or_else(|| net.strip_prefix("dut."))
         .unwrap_or(net);
-    match inside.find("_SB_") {
-        Some(cut) if cut > 0 => inside[..cut].to_string(),
-        _ => inside.to_string(),
+    // A name that starts with a suffix (yosys's `$abc$…` of a net it made itself) is kept whole.
+    let cut = CELL_SUFFIXES
+        .iter()
+        .filter_map(|suffix| inside.find(suffix))
+        .chain(inside.find('$'))
+        .filter(|&at| at > 0)
+        .min();
+    match cut {
+        Some(at) => inside[..at].to_string(),
+        None => inside.to_string(),
     }
 }
 

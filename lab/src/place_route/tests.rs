@@ -185,4 +185,29 @@ fn net_names_lose_the_wrapper_and_yosys_suffixes() {
     );
     assert_eq!(net_name("dut.combined[2]"), "combined[2]");
     assert_eq!(net_name("bias_a[0]"), "bias_a[0]");
+    // ECP5's, from nextpnr-ecp5's reports of the KF, the sequencer and the serial chain: yosys's
+    // cell suffixes, then nextpnr's own after a `$`.
+    for (net, name) in [
+        (
+            "dut.configured.p2_s_TRELLIS_FF_Q_DI_CCU2C_S0_A1_LUT4_Z_D_MULT18X18D_P19_P9_MULT18X18D_P27_P1[0]",
+            "p2_s",
+        ),
+        (
+            "dut.configured.p2_s_TRELLIS_FF_Q_4_DI_CCU2C_S1$CCU2_FCI_INT",
+            "p2_s",
+        ),
+        ("dut.configured.e[12]", "e[12]"),
+        ("dut.done_b_L6MUX21_Z_SD[1]", "done_b"),
+        ("window_done_LUT4_C_Z", "window_done"),
+        (
+            "dut.configured.engine.product_wide_TRELLIS_FF_Q_DI_MULT18X18D_P15_P24",
+            "engine.product_wide",
+        ),
+        ("capture$TRELLIS_IO_IN", "capture"),
+        ("dut.configured.x_PFUMX_Z_ALUT", "x"),
+        // A net yosys made itself is kept whole rather than cut to nothing.
+        ("dut.configured.$abc$1234$new_n56", "$abc$1234$new_n56"),
+    ] {
+        assert_eq!(net_name(net), name, "{net}");
+    }
 }
