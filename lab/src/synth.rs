@@ -388,16 +388,19 @@ fn place_route_section(placements: &[place_route::Placement]) -> String {
          Each block alone with the config's parameters, inside a harness that feeds its inputs \
          from one shift register and shifts its captured outputs out (4 pins; every path register \
          to register). LUT, FF, DSP and BRAM count the block's own cells (yosys `stat` of its \
-         module, kept apart from the harness); fits and Fmax come from nextpnr-ice40 (seed 1) on \
-         block and harness together. Xilinx: yosys `synth_xilinx` figures against a {xilinx}; no \
-         open place and route for 7-series is available here, so no Fmax. A sample needs \
-         `clocks/sample` clocks; the max sample rate is Fmax over that. Files: \
+         module, kept apart from the harness); fits and Fmax come from nextpnr (seed 1) on \
+         block and harness together: iCE40 through the system's yosys `synth_ice40` and \
+         nextpnr-ice40, ECP5 through YoWASP's yosys `synth_ecp5` and nextpnr-ecp5 (Debian has \
+         no nextpnr-ecp5). Xilinx: the system yosys's `synth_xilinx` figures against a \
+         {xilinx}; no open place and route for 7-series is available here, so no Fmax. A \
+         sample needs `clocks/sample` clocks; the max sample rate is Fmax over that. Files: \
          `{folder}/<block>/<target>/` (yosys statistics `stat.json`, nextpnr's `report.json` \
          and log; `run.sh`, run from the block's folder, re-derives them and writes yosys's \
-         log).\n\n{table}\n\
+         log).\n\n{tools}\n{table}\n\
          Critical paths (nextpnr; names inside the block, ports of the block by their name):\n\n{paths}",
         xilinx = place_route::Target::Xilinx.device().name,
         folder = place_route::FOLDER,
+        tools = place_route::tools_table(placements),
         table = place_route::table(placements),
         paths = place_route::critical_paths(placements),
     )
@@ -509,7 +512,7 @@ pub fn synthesize(
     place: &PlaceRequest,
 ) -> Result<Synthesis> {
     output_folder::check(out, Kind::Synth, replace)?;
-    place_route::check_tools(&place.targets)?;
+    let tools = place_route::check_tools(&place.targets)?;
     let roms = RomImages::new(job, provenance);
     let top = blocks::find(TOP_BLOCK).block(job, &roms);
     let gyro_loop = blocks::find(LOOP_BLOCK).block(job, &roms);
@@ -529,6 +532,7 @@ pub fn synthesize(
             &roms,
             provenance,
             place,
+            tools,
             work.path(),
         )?)
     };

