@@ -283,12 +283,15 @@ fn the_pipeline_clocks_the_guide_quotes_are_the_codes() {
     let roms = RomImages::new(&job, &provenance);
     let serial_roms = RomImages::new(&serial, &provenance);
     let page = std::fs::read_to_string(guide().join(place)).unwrap();
+    let targets: Vec<&str> = gyrofx_lab::place_route::Target::ALL
+        .iter()
+        .map(|t| t.name())
+        .collect();
     let mut rows: Vec<(String, String)> = Vec::new();
-    for line in page.lines().filter(|l| {
-        ["| ice40-up5k |", "| ice40-hx8k |", "| xilinx |"]
-            .iter()
-            .any(|t| l.starts_with(t))
-    }) {
+    for line in page
+        .lines()
+        .filter(|l| targets.iter().any(|t| l.starts_with(&format!("| {t} |"))))
+    {
         let cells: Vec<&str> = line.split('|').map(str::trim).collect();
         let (target, block, clocks) = (cells[1], cells[2], cells[10]);
         let (registered, is_serial) =
@@ -306,7 +309,9 @@ fn the_pipeline_clocks_the_guide_quotes_are_the_codes() {
         );
         rows.push((target.into(), block.into()));
     }
-    for target in ["ice40-up5k", "ice40-hx8k", "xilinx"] {
+    // Every target's rows, ECP5's among them.
+    assert!(targets.contains(&"ecp5-12f") && targets.contains(&"ecp5-25f"));
+    for target in targets {
         let listed: Vec<&str> = rows
             .iter()
             .filter(|(t, _)| t == target)
