@@ -75,17 +75,15 @@ generate
         end else begin : g_more
             assign below_half = |remainder[SHIFT-2:0];
         end
-        reg increment;
-        always @* begin
-            case (ROUNDING)
-                1: increment = any_dropped;
-                2: increment = any_dropped & negative;
-                3: increment = half_bit;
-                4: increment = half_bit & (below_half | ~negative);
-                5: increment = half_bit & (below_half | quotient[0]);
-                default: increment = 1'b0;
-            endcase
-        end
+        // (A continuous assignment, not always @*: simulators evaluate it at time 0 too, where
+        // an always @* whose inputs never change would leave it X.)
+        wire increment =
+            ROUNDING == 1 ? any_dropped
+            : ROUNDING == 2 ? any_dropped & negative
+            : ROUNDING == 3 ? half_bit
+            : ROUNDING == 4 ? half_bit & (below_half | ~negative)
+            : ROUNDING == 5 ? half_bit & (below_half | quotient[0])
+            : 1'b0;
         assign rounded = quotient + $signed({{(Q_W-1){1'b0}}, increment});
     end
 
