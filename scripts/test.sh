@@ -117,6 +117,8 @@ for module in gyrofx_mean_filter gyrofx_mean_filter_serial gyrofx_nco gyrofx_dem
 done
 verilator --lint-only -Wall --top-module gyrofx_gyro_loop hdl/gyrofx_gyro_loop.v hdl/gyrofx_nco.v \
     hdl/gyrofx_demodulator.v hdl/gyrofx_pi.v hdl/gyrofx_cic.v hdl/gyrofx_quantize.v hdl/gyrofx_spacing_check.v
+verilator --lint-only -Wall --top-module gyrofx_gyro_loop_serial hdl/gyrofx_gyro_loop_serial.v \
+    hdl/gyrofx_quantize.v hdl/gyrofx_spacing_check.v
 verilator --lint-only -Wall --top-module gyrofx_system hdl/*.v
 verilator --lint-only -Wall --top-module gyrofx_top_serial hdl/gyrofx_top_serial.v \
     hdl/gyrofx_serial_engine.v hdl/gyrofx_sequencer.v
@@ -126,7 +128,8 @@ ghdl -a --std=08 -Werror -Wunused -Wbinding -Wbody -Wspecs --workdir="$ghdl_work
     hdl/gyrofx_mem_pkg.vhd hdl/gyrofx_quantize.vhd hdl/gyrofx_spacing_check.vhd hdl/gyrofx_kf.vhd hdl/gyrofx_sequencer.vhd \
     hdl/gyrofx_bias_estimator.vhd hdl/gyrofx_calibration.vhd hdl/gyrofx_top.vhd \
     hdl/gyrofx_mean_filter.vhd hdl/gyrofx_mean_filter_serial.vhd hdl/gyrofx_nco.vhd hdl/gyrofx_demodulator.vhd hdl/gyrofx_pi.vhd \
-    hdl/gyrofx_cic.vhd hdl/gyrofx_gyro_loop.vhd hdl/gyrofx_system.vhd hdl/gyrofx_serial_engine.vhd \
+    hdl/gyrofx_cic.vhd hdl/gyrofx_gyro_loop.vhd hdl/gyrofx_gyro_loop_serial.vhd hdl/gyrofx_system.vhd \
+    hdl/gyrofx_serial_engine.vhd \
     hdl/gyrofx_top_serial.vhd hdl/gyrofx_testbench_pkg.vhd
 rm -rf "$ghdl_work"
 # Every Verilator build compiles Verilator's runtime (verilated.cpp and two more: 8.7 of a

@@ -559,9 +559,14 @@ fn rtl_defaults(file: &str) -> Vec<(String, i128)> {
             continue;
         };
         let value = value.trim().trim_end_matches([',', ';']).trim();
+        // A negative Verilog literal is a minus and a sized one (`-24'sd6641270`).
+        let (sign, value) = match value.strip_prefix('-') {
+            Some(magnitude) if magnitude.contains("'sd") => (-1, magnitude),
+            _ => (1, value),
+        };
         let parsed = if let Some((width, digits)) = value.split_once("'sd") {
             let _: u32 = width.parse().unwrap();
-            digits.parse::<i128>().ok()
+            digits.parse::<i128>().ok().map(|v| sign * v)
         } else if let Some((width, digits)) = value.split_once("x\"") {
             let width: u32 = width.parse().unwrap();
             let bits = u128::from_str_radix(digits.trim_end_matches('"'), 16).unwrap();
@@ -618,6 +623,45 @@ fn the_rtl_defaults_are_the_model_defaults() {
                     "{file}: default of {name}"
                 );
             }
+        }
+    }
+}
+
+/// The folded loop's RTL (both languages) has the parallel loop's parameters with the same
+/// defaults, and its schedule's defaults are the default config's schedule.
+#[test]
+fn the_folded_loops_rtl_defaults_are_the_parallel_loops_and_the_default_schedule() {
+    use gyrofx_model::gyro_loop::folded::Schedule;
+    use gyrofx_model::gyro_loop::gyro::{Plan as LoopPlan, Spec as LoopSpec};
+
+    let schedule = Schedule::new(&LoopPlan::new(&LoopSpec::paper_004()).unwrap()).unwrap();
+    for language in ["v", "vhd"] {
+        let parallel = rtl_defaults(&format!("gyrofx_gyro_loop.{language}"));
+        let folded = rtl_defaults(&format!("gyrofx_gyro_loop_serial.{language}"));
+        assert!(
+            parallel.len() > 60,
+            "{language}: {} defaults parsed",
+            parallel.len()
+        );
+        for (name, value) in &parallel {
+            let found = folded.iter().find(|(n, _)| n == name).map(|f| f.1);
+            assert_eq!(
+                found,
+                Some(*value),
+                "gyrofx_gyro_loop_serial.{language}: {name}"
+            );
+        }
+        for (name, value) in [
+            ("SCHEDULE_LEN", schedule.len()),
+            ("SCHEDULE_REGULAR", schedule.regular),
+            ("RAM_WORDS", schedule.words.count()),
+        ] {
+            let found = folded.iter().find(|(n, _)| n == name).map(|f| f.1);
+            assert_eq!(
+                found,
+                Some(value as i128),
+                "gyrofx_gyro_loop_serial.{language}: {name}"
+            );
         }
     }
 }

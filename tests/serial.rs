@@ -32,7 +32,13 @@ fn manifest(out: &str) -> serde_json::Value {
 /// against the C model through DPI-C (live, its samples spaced by the block's latency), and
 /// one expected bit flipped from sample `from` on fails every simulator at that sample.
 fn passes_everywhere_and_a_flipped_bit_fails(out: &str, block: &str, lines: u64, from: usize) {
-    for sim in SIMULATORS {
+    passes_and_a_flipped_bit_fails(out, block, lines, from, &SIMULATORS);
+}
+
+/// As [`passes_everywhere_and_a_flipped_bit_fails`], the whole vectors in `full` only: every
+/// simulator still runs the testbench up to the flipped bit.
+fn passes_and_a_flipped_bit_fails(out: &str, block: &str, lines: u64, from: usize, full: &[&str]) {
+    for sim in full {
         let log = ok(&["verify", "--out", out, "--sim", sim, "--blocks", block]);
         assert!(log.contains(&format!("PASS n={lines}")), "{sim}: {log}");
     }
@@ -189,6 +195,38 @@ fn the_serial_mean_filter_passes_its_vectors_in_every_simulator_and_a_flipped_bi
     assert!(!folder.join("tb_gyrofx_mean_filter.v").exists());
     let lines = m["blocks"]["mean_filter"]["vectors"].as_u64().unwrap();
     passes_everywhere_and_a_flipped_bit_fails(&out, "mean_filter", lines, 600);
+}
+
+/// `architecture = "serial"` folds the gyro loop (`gyrofx_gyro_loop_serial`): the parallel
+/// loop's vectors (gyro A's closed loop through lock and a switch) pass bit-exact in Verilator
+/// and GHDL and against the C model through DPI-C at the schedule's spacing, and a flipped bit
+/// fails them and Icarus, after the samples before it passed.
+#[test]
+fn the_folded_gyro_loop_passes_the_loop_vectors_in_every_simulator_and_a_flipped_bit_fails() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = generate(dir.path(), SERIAL);
+    let m = manifest(&out);
+    let gyro_loop = &m["gyro_loop"];
+    assert_eq!(gyro_loop["architecture"], "serial");
+    // The outputs load at the schedule's last clock, the clock after which the next sample may
+    // come; the decimating sample is the longest.
+    let schedule = &gyro_loop["schedule"];
+    let clocks = schedule["clocks"].as_u64().unwrap();
+    assert!(schedule["regular_clocks"].as_u64().unwrap() < clocks);
+    assert_eq!(gyro_loop["latency_clocks"].as_u64().unwrap(), clocks + 1);
+    assert_eq!(
+        gyro_loop["min_clocks_per_sample"].as_u64().unwrap(),
+        clocks + 1
+    );
+    let folder = std::path::Path::new(&out).join("gyro_loop");
+    assert!(folder.join("tb_gyrofx_gyro_loop_serial.v").exists());
+    assert!(folder.join("tb_gyrofx_gyro_loop_serial.vhd").exists());
+    assert!(folder.join("gyro_loop_schedule.mem").exists());
+    assert!(!folder.join("tb_gyrofx_gyro_loop.v").exists());
+    let lines = m["blocks"]["gyro_loop"]["vectors"].as_u64().unwrap();
+    // 40 000 samples of 110 clocks: Icarus (90 s) runs the Verilog Verilator proves whole up to
+    // the flipped bit only; GHDL runs the VHDL twin whole.
+    passes_and_a_flipped_bit_fails(&out, "gyro_loop", lines, 700, &["verilator", "ghdl"]);
 }
 
 /// The sequential mean filter at other windows, formats and modes: an odd window, a window of

@@ -83,6 +83,30 @@ fn the_chain_and_loop_synthesize_place_and_route_and_their_netlists_pass_the_vec
     loop_netlist.join().unwrap();
 }
 
+/// `architecture = "serial"`: `synth` synthesizes the folded gyro loop (and the serial chain),
+/// and the folded loop's netlist passes the loop's 40 000 vectors in Verilator, sample for
+/// sample at the schedule's spacing.
+#[test]
+fn the_folded_loops_netlist_passes_the_loop_vectors() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = write_config(dir.path(), "serial.toml", "architecture = \"serial\"\n");
+    let synth = dir.path().join("synth");
+    let log = ok(&[
+        "synth",
+        "--out",
+        synth.to_str().unwrap(),
+        "--config",
+        &config,
+    ]);
+    assert!(log.contains("synthesis check passed"), "{log}");
+    let [_, netlist] = gyrofx_lab::synth::netlist_files("gyrofx_gyro_loop_serial");
+    assert!(
+        synth.join("gyro_loop").join(&netlist).is_file(),
+        "no folded loop netlist {netlist}"
+    );
+    the_loop_netlist_passes_the_vectors(dir.path(), &config, &synth);
+}
+
 /// The resources in the manifest and report, the wider chain's cost, and the check failing on
 /// a latch or a missing module without writing anything.
 fn wider_formats_cost_more_and_latches_fail(dir: &Path, narrow: &Path) {

@@ -2,7 +2,7 @@
 //! in compile order (a unit before its users), and the sources one module needs.
 
 /// The reference RTL, embedded so that every package is self-contained.
-pub const RTL_SOURCES: [(&str, &str); 17] = [
+pub const RTL_SOURCES: [(&str, &str); 18] = [
     (
         "gyrofx_quantize.v",
         include_str!("../../hdl/gyrofx_quantize.v"),
@@ -51,6 +51,10 @@ pub const RTL_SOURCES: [(&str, &str); 17] = [
     (
         "gyrofx_gyro_loop.v",
         include_str!("../../hdl/gyrofx_gyro_loop.v"),
+    ),
+    (
+        "gyrofx_gyro_loop_serial.v",
+        include_str!("../../hdl/gyrofx_gyro_loop_serial.v"),
     ),
     ("gyrofx_system.v", include_str!("../../hdl/gyrofx_system.v")),
 ];
@@ -124,7 +128,7 @@ pub fn vhdl_sources_of(module: &str) -> Vec<&'static (&'static str, &'static str
 
 /// The reference RTL in VHDL-2008, in compile order (packages first), and the package the VHDL
 /// testbenches share (last: simulation only).
-pub const VHDL_SOURCES: [(&str, &str); 19] = [
+pub const VHDL_SOURCES: [(&str, &str); 20] = [
     (
         "gyrofx_mem_pkg.vhd",
         include_str!("../../hdl/gyrofx_mem_pkg.vhd"),
@@ -169,6 +173,10 @@ pub const VHDL_SOURCES: [(&str, &str); 19] = [
     (
         "gyrofx_gyro_loop.vhd",
         include_str!("../../hdl/gyrofx_gyro_loop.vhd"),
+    ),
+    (
+        "gyrofx_gyro_loop_serial.vhd",
+        include_str!("../../hdl/gyrofx_gyro_loop_serial.vhd"),
     ),
     (
         "gyrofx_system.vhd",
@@ -264,6 +272,7 @@ mod tests {
         );
         let system = names("gyrofx_system");
         let left_out = [
+            "gyrofx_gyro_loop_serial.vhd",
             "gyrofx_mean_filter.vhd",
             "gyrofx_mean_filter_serial.vhd",
             "gyrofx_serial_engine.vhd",

@@ -254,6 +254,43 @@ impl Rom {
         }
     }
 
+    /// The folded gyro loop's schedule (`gyrofx_gyro_loop_serial`): one control word per clock
+    /// after a sample's `ce`, the fields of `gyrofx_model::gyro_loop::folded::Control`.
+    pub fn gyro_loop_schedule(schedule: &gyro_loop::folded::Schedule) -> Rom {
+        // MSB first, as a ROM word packs its fields.
+        let layout: Vec<(&str, u32)> = gyro_loop::folded::FIELDS.iter().rev().copied().collect();
+        Rom {
+            name: "gyro_loop_schedule".into(),
+            description: format!(
+                "folded gyro-loop schedule: {} control words from 0, one a clock ({} every sample, all in a decimating one)",
+                schedule.len(),
+                schedule.regular
+            ),
+            fields: layout
+                .iter()
+                .map(|&(name, width)| Field {
+                    name: name.into(),
+                    format: Format {
+                        signed: false,
+                        width,
+                        frac: 0,
+                    },
+                })
+                .collect(),
+            codes: schedule
+                .controls
+                .iter()
+                .map(|c| c.fields().iter().rev().map(|v| i128::from(*v)).collect())
+                .collect(),
+            notes: schedule
+                .controls
+                .iter()
+                .enumerate()
+                .map(|(t, c)| format!("clock {t}: {c}"))
+                .collect(),
+        }
+    }
+
     /// Bits in a word.
     pub fn width(&self) -> u32 {
         self.fields.iter().map(|f| f.format.width).sum()

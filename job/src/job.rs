@@ -38,6 +38,8 @@ pub struct Job {
     pub recording: Option<std::sync::Arc<Recording>>,
     /// The chain compiled for `gyrofx_top_serial`, with `architecture = "serial"`.
     pub serial: Option<gyrofx_model::serial::Program>,
+    /// The gyro loop's schedule for `gyrofx_gyro_loop_serial`, with `architecture = "serial"`.
+    pub loop_schedule: Option<gyrofx_model::gyro_loop::folded::Schedule>,
 }
 
 /// Designs one filter per bandwidth of `settings` at `fs_hz` for the noise model (°/√h, °/h/√h).
@@ -97,6 +99,7 @@ impl Job {
         let mut job = self.clone();
         if job.serial.is_none() {
             job.serial = Some(compile_serial(&job.chain)?);
+            job.loop_schedule = Some(schedule_loop(&job.gyro_loops)?);
             job.config.architecture = "serial".into();
             job.settings.architecture = crate::config::Architecture::Serial;
         }
@@ -132,14 +135,11 @@ impl Job {
             Some(_) => Some(crate::system::chain_plan(&settings.estimator, &chain.kf)?),
             None => None,
         };
-        let serial = match settings.architecture {
-            crate::config::Architecture::Parallel => None,
-            crate::config::Architecture::Serial => Some(
-                gyrofx_model::serial::compile(&chain).map_err(|e| Error::Config {
-                    field: "architecture".into(),
-                    value: "\"serial\"".into(),
-                    allowed: e.to_string(),
-                })?,
+        let (serial, loop_schedule) = match settings.architecture {
+            crate::config::Architecture::Parallel => (None, None),
+            crate::config::Architecture::Serial => (
+                Some(compile_serial(&chain)?),
+                Some(schedule_loop(&gyro_loops)?),
             ),
         };
         Ok(Job {
@@ -152,6 +152,7 @@ impl Job {
             system_chain,
             recording: None,
             serial,
+            loop_schedule,
         })
     }
 
@@ -264,6 +265,16 @@ impl RateSource {
 /// The chain's serial program; a chain it cannot hold is a config error on `architecture`.
 fn compile_serial(chain: &chain::Plan) -> Result<gyrofx_model::serial::Program> {
     gyrofx_model::serial::compile(chain).map_err(|e| Error::Config {
+        field: "architecture".into(),
+        value: "\"serial\"".into(),
+        allowed: e.to_string(),
+    })
+}
+
+/// The folded gyro loop's schedule (both gyros' loops share their structure); a loop it cannot
+/// fold is a config error on `architecture`.
+fn schedule_loop(loops: &[GyroLoop; 2]) -> Result<gyrofx_model::gyro_loop::folded::Schedule> {
+    gyrofx_model::gyro_loop::folded::Schedule::new(&loops[0].plan).map_err(|e| Error::Config {
         field: "architecture".into(),
         value: "\"serial\"".into(),
         allowed: e.to_string(),

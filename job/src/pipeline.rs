@@ -56,6 +56,18 @@ pub const TOP: Pipeline = ESTIMATOR;
 /// `gyrofx_gyro_loop`: four register stages, one ADC sample in flight.
 pub const GYRO_LOOP: Pipeline = Pipeline::new(4, 4);
 
+/// The gyro loop as `job` builds it: [`GYRO_LOOP`], or `gyrofx_gyro_loop_serial`, whose
+/// schedule's last word loads the outputs the clock after it acts (the next `ce` no sooner).
+pub fn gyro_loop(job: &Job) -> Pipeline {
+    match &job.loop_schedule {
+        Some(schedule) => {
+            let latency = schedule.len() as u32 + 1;
+            Pipeline::new(latency, latency)
+        }
+        None => GYRO_LOOP,
+    }
+}
+
 /// `gyrofx_system`: the loop's four stages, then the chain's (`gyrofx_top`).
 pub const SYSTEM: Pipeline = Pipeline::new(
     GYRO_LOOP.latency_clocks + TOP.latency_clocks,

@@ -18,7 +18,7 @@ use crate::place_route;
 use crate::place_route::PlaceRequest;
 use crate::toolchain::Tool;
 use gyrofx_codegen::design::{
-    configured_name, connections, design_files, sources, CONFIGURED_FILE, LOOP_TOP,
+    configured_name, connections, design_files, sources, CONFIGURED_FILE,
 };
 use gyrofx_codegen::output_folder::{self, Kind, Replace};
 use gyrofx_codegen::package::Package;
@@ -367,13 +367,14 @@ fn report(
 ) -> String {
     format!(
         "<!-- {} -->\n# Synthesis check: {}\n\n{}\n\
-         # Synthesis check: {LOOP_TOP} (gyro A; files in `{LOOP_FOLDER}/`)\n\n{}\n\
+         # Synthesis check: {} (gyro A; files in `{LOOP_FOLDER}/`)\n\n{}\n\
          An estimate before place and route: the ROMs are small enough to map to LUTs, and \
          `synth_xilinx` splits a product wider than 25x18 over several DSP48E1s. A sensor \
          board runs two loops beside the chain.\n",
         provenance.line("").trim_start(),
         top.module,
         report_section(top, &synthesis.chain),
+        gyro_loop.module,
         report_section(gyro_loop, &synthesis.gyro_loop),
     ) + &place_route_section(&synthesis.placements)
 }
@@ -599,7 +600,7 @@ pub fn synthesize(
         "parameters": parameters_of(&top),
         "resources": synthesis.chain,
         "gyro_loop": {
-            "top": LOOP_TOP,
+            "top": gyro_loop.module,
             "gyro": "a",
             "folder": LOOP_FOLDER,
             "parameters": parameters_of(&gyro_loop),
@@ -607,7 +608,7 @@ pub fn synthesize(
         },
     "netlists": [
             {"block": TOP_BLOCK, "module": top.module, "files": netlist_files(top.module)},
-            {"block": LOOP_BLOCK, "module": LOOP_TOP, "files": netlist_files(LOOP_TOP).map(|f| format!("{LOOP_FOLDER}/{f}"))},
+            {"block": LOOP_BLOCK, "module": gyro_loop.module, "files": netlist_files(gyro_loop.module).map(|f| format!("{LOOP_FOLDER}/{f}"))},
         ],
         "netlist_cells": "yosys's internal gate library: simulate with its simcells.v",
         "place_and_route": synthesis.placements,

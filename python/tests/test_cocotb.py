@@ -78,6 +78,14 @@ def test_the_serial_blocks_pass_it_and_a_flipped_bit_fails_it(tmp_path):
     assert f", min_clocks_per_sample={spacing})\n" in (folder / "cocotb" / "test_mean_filter.py").read_text()
     assert_passes(make(folder, "cocotb-mean_filter", GYROFX_COCOTB_SAMPLES="1000"))
     assert_fails(make(folder, "cocotb-mean_filter", GYROFX_COCOTB_SAMPLES="1000", GYROFX_COCOTB_FLIP_EXPECTED="40"), 1)
+    # The folded gyro loop: the next sample after its schedule's clocks.
+    loop = manifest["gyro_loop"]
+    assert loop["architecture"] == "serial"
+    spacing = loop["min_clocks_per_sample"]
+    assert 4 < spacing <= 120
+    assert f", min_clocks_per_sample={spacing})\n" in (folder / "cocotb" / "test_gyro_loop.py").read_text()
+    assert_passes(make(folder, "cocotb-gyro_loop", GYROFX_COCOTB_SAMPLES="300"))
+    assert_fails(make(folder, "cocotb-gyro_loop", GYROFX_COCOTB_SAMPLES="300", GYROFX_COCOTB_FLIP_EXPECTED="40"), 1)
 
 
 @pytest.mark.parametrize("block", BLOCKS)

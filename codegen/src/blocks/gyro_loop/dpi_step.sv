@@ -6,11 +6,12 @@
             check_call(gyrofx_gyro_loop_step(gyro_loop, longint'(adc_x), longint'(adc_y), int'(mode),
                 dac_x_model, dac_y_model, locked_model, valid, stream_model, quadrature_model));
             if (valid == 1) expect_stream(stream_model, quadrature_model);
-            // The outputs show 3 clocks after the edge that takes the sample (ce every 4th clock).
+            // The outputs show @settle@ clocks after the edge that takes the sample; the next
+            // sample may come then.
             @(posedge clk);
             @(negedge clk);
             ce = 1'b0;
-            repeat (3) @(posedge clk);
+            repeat (@settle@) @(posedge clk);
             #1;
             compare(longint'(dac_x), flip_next(dac_x_model), "dac_x");
             compare(longint'(dac_y), dac_y_model, "dac_y");

@@ -32,6 +32,12 @@ pub struct GyroLoop;
 pub const SINE_ROM: &str = "gyro_loop_nco_sine";
 /// Name of the CICs' compensator ROM.
 pub const TAPS_ROM: &str = "gyro_loop_cic_taps";
+/// Name of the folded loop's schedule ROM.
+pub const SCHEDULE_ROM: &str = "gyro_loop_schedule";
+
+/// The module with `architecture = "serial"`: the loop folded onto one multiplier, one
+/// accumulator and one RAM (`hdl/gyrofx_gyro_loop_serial.v`, `gyrofx_model::gyro_loop::folded`).
+pub const SERIAL_MODULE: &str = "gyrofx_gyro_loop_serial";
 
 /// Seconds of normal mode from reset in the vectors (the loop locks in about 80 ms).
 pub const NORMAL_S: f64 = 0.1;
@@ -247,12 +253,21 @@ impl RtlBlock for GyroLoop {
         "one gyro's drive/sense loop: NCOs, demodulators, PLL, AGC, CICs, mode switch"
     }
 
+    /// `gyrofx_gyro_loop_serial` is placed beside it.
+    fn placement(&self) -> super::Placement {
+        super::Placement::WithSerial("gyro_loop_serial")
+    }
+
     fn roms(&self, job: &Job) -> Vec<Rom> {
         let plan = &job.gyro_loops[0].plan;
-        vec![
+        let mut roms = vec![
             Rom::gyro_loop_sine(&plan.nco),
             Rom::gyro_loop_cic(&plan.cic),
-        ]
+        ];
+        if let Some(schedule) = &job.loop_schedule {
+            roms.push(Rom::gyro_loop_schedule(schedule));
+        }
+        roms
     }
 
     fn block(&self, job: &Job, roms: &RomImages) -> Block {
@@ -277,10 +292,38 @@ impl RtlBlock for GyroLoop {
         );
         block.dpi = Some(DPI);
         block.cocotb_test = Some(include_str!("cocotb_test.py"));
-        block.pipeline = pipeline::GYRO_LOOP;
+        block.pipeline = pipeline::gyro_loop(job);
         block.params = parameters(plan, &roms.entry(SINE_ROM).0, &roms.entry(TAPS_ROM).0);
         block.roms.push(roms.entry(SINE_ROM));
         block.roms.push(roms.entry(TAPS_ROM));
+        if let Some(schedule) = &job.loop_schedule {
+            block.module = SERIAL_MODULE;
+            block.title = "one gyro's drive/sense loop, folded onto one multiplier, one accumulator and one RAM";
+            let rom = roms.entry(SCHEDULE_ROM);
+            block.params.extend([
+                Param::string(
+                    "SCHEDULE_FILE",
+                    &rom.0,
+                    "the schedule ROM image (control words)",
+                ),
+                Param::integer(
+                    "SCHEDULE_LEN",
+                    schedule.len() as i64,
+                    "control words: clocks of a decimating sample",
+                ),
+                Param::integer(
+                    "SCHEDULE_REGULAR",
+                    schedule.regular as i64,
+                    "clocks of every sample",
+                ),
+                Param::integer(
+                    "RAM_WORDS",
+                    schedule.words.count() as i64,
+                    "RAM words: the loop's states",
+                ),
+            ]);
+            block.roms.push(rom);
+        }
         block
     }
 
@@ -306,8 +349,17 @@ impl RtlBlock for GyroLoop {
                 "adc_rate_hz": plan.adc_rate_hz,
                 "decimation": plan.cic.decimation,
                 "latency_samples": plan.latency,
-                "latency_clocks": pipeline::GYRO_LOOP.latency_clocks,
-                "min_clocks_per_sample": pipeline::GYRO_LOOP.min_clocks_per_sample,
+                "architecture": if job.loop_schedule.is_some() { "serial" } else { "parallel" },
+                "latency_clocks": pipeline::gyro_loop(job).latency_clocks,
+                "min_clocks_per_sample": pipeline::gyro_loop(job).min_clocks_per_sample,
+                "schedule": job.loop_schedule.as_ref().map(|s| json!({
+                    "clocks": s.len(),
+                    "regular_clocks": s.regular,
+                    "ram_words": s.words.count(),
+                    "templates": s.placements.iter().map(|p| json!({
+                        "name": p.name, "first": p.first, "last": p.last,
+                    })).collect::<Vec<_>>(),
+                })),
                 "formats": {
                     "adc": plan.adc.to_string(),
                     "nco": plan.nco.output.to_string(),
@@ -424,6 +476,9 @@ const DPI: DpiParts = DpiParts {
 };
 
 /// One sample of the DPI-C testbench's stimulus loop.
-fn dpi_step(_block: &Block) -> String {
-    include_str!("dpi_step.sv").trim_end().to_string()
+fn dpi_step(block: &Block) -> String {
+    crate::text::fill(
+        include_str!("dpi_step.sv").trim_end(),
+        &[("settle", &block.settle_clocks().to_string())],
+    )
 }

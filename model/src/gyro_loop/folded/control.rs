@@ -25,13 +25,14 @@
 //! | 49–55 | `write_address` | its word |
 //! | 56–58 | `data` | [`WriteData`]: what is written |
 //! | 59–62 | `quantize` | [`Quantize`]: the quantization point that fires |
+//! | 63 | `spare` | 0 |
 
 /// Width of a limb of the multiplier's operands, bits: `15` unsigned bits fit a signed 16×16
 /// multiplier (one SB_MAC16, one DSP48 slice) with a zero sign bit.
 pub const LIMB_BITS: u32 = 15;
 
 /// Width of the control word, bits.
-pub const CONTROL_BITS: u32 = 63;
+pub const CONTROL_BITS: u32 = 64;
 
 /// Width of a RAM address field, bits.
 pub const ADDRESS_BITS: u32 = 7;
@@ -341,33 +342,82 @@ pub struct Control {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Busy(pub &'static str);
 
+/// The control word's fields, least significant first: name and width in bits (the
+/// [module doc](self)'s table; 64 bits in all).
+pub const FIELDS: [(&str, u32); 20] = [
+    ("rom", 3),
+    ("advance", 1),
+    ("a", 4),
+    ("limb", 3),
+    ("top", 1),
+    ("b", 3),
+    ("tap", 4),
+    ("x", 4),
+    ("y", 4),
+    ("product_limb", 3),
+    ("align", 3),
+    ("read", 1),
+    ("read_address", ADDRESS_BITS),
+    ("gate", 3),
+    ("seen", 4),
+    ("write", 1),
+    ("write_address", ADDRESS_BITS),
+    ("data", 3),
+    ("quantize", 4),
+    ("spare", 1),
+];
+
 impl Control {
-    /// The control word's bits ([module doc](self)).
+    /// Each field's value, in [`FIELDS`] order.
+    pub fn fields(&self) -> [u64; 20] {
+        let issue = self.issue.unwrap_or(Issue {
+            a: ASource::None,
+            limb: 0,
+            top: false,
+            b: BSource::Reference,
+            tap: 0,
+        });
+        let acc = self.accumulate.unwrap_or_default();
+        let read = self.read.map_or((0, 0, 0, 0), |r| {
+            (1, u64::from(r.address), r.gate.code(), u64::from(r.seen))
+        });
+        let write = self
+            .write
+            .map_or((0, 0, 0), |w| (1, u64::from(w.address), w.data.code()));
+        [
+            self.rom.code(),
+            u64::from(self.advance),
+            issue.a.code(),
+            u64::from(issue.limb),
+            u64::from(issue.top),
+            issue.b.code(),
+            u64::from(issue.tap),
+            acc.x.code(),
+            acc.y.code(),
+            u64::from(acc.product_limb),
+            acc.align.code(),
+            read.0,
+            read.1,
+            read.2,
+            read.3,
+            write.0,
+            write.1,
+            write.2,
+            self.quantize.code(),
+            0,
+        ]
+    }
+
+    /// The control word's bits: [`Control::fields`] packed as [`FIELDS`] lays them out.
     pub fn encode(&self) -> u64 {
-        let mut word = self.rom.code() | u64::from(self.advance) << 3;
-        if let Some(issue) = self.issue {
-            word |= issue.a.code() << 4
-                | u64::from(issue.limb) << 8
-                | u64::from(issue.top) << 11
-                | issue.b.code() << 12
-                | u64::from(issue.tap) << 15;
+        let mut word = 0u64;
+        let mut offset = 0;
+        for (value, (_, width)) in self.fields().into_iter().zip(FIELDS) {
+            debug_assert!(value < 1 << width, "a field wider than its {width} bits");
+            word |= value << offset;
+            offset += width;
         }
-        if let Some(acc) = self.accumulate {
-            word |= acc.x.code() << 19
-                | acc.y.code() << 23
-                | u64::from(acc.product_limb) << 27
-                | acc.align.code() << 30;
-        }
-        if let Some(read) = self.read {
-            word |= 1 << 33
-                | u64::from(read.address) << 34
-                | read.gate.code() << 41
-                | u64::from(read.seen) << 44;
-        }
-        if let Some(write) = self.write {
-            word |= 1 << 48 | u64::from(write.address) << 49 | write.data.code() << 56;
-        }
-        word | self.quantize.code() << 59
+        word
     }
 
     /// This clock's units and `other`'s together, or the first unit both use.
@@ -401,5 +451,47 @@ impl Control {
             write: one(self.write, other.write, "RAM write port")?,
             quantize,
         })
+    }
+}
+
+impl std::fmt::Display for Control {
+    /// One line: the units this clock uses (`rom DriveSin; issue AdcDrive[0]×Reference; …`).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut parts: Vec<String> = Vec::new();
+        if self.rom != RomRead::None {
+            parts.push(format!("rom {:?}", self.rom));
+        }
+        if self.advance {
+            parts.push("advance".into());
+        }
+        if let Some(i) = self.issue {
+            let tap = if i.b == BSource::Tap {
+                format!("{}", i.tap)
+            } else {
+                String::new()
+            };
+            parts.push(format!("{:?}[{}]×{:?}{tap}", i.a, i.limb, i.b));
+        }
+        if let Some(a) = self.accumulate {
+            let limb = if a.y == AccY::Product {
+                format!("{}", a.product_limb)
+            } else {
+                String::new()
+            };
+            parts.push(format!("acc {:?}+{:?}{limb}", a.x, a.y));
+        }
+        if let Some(r) = self.read {
+            parts.push(format!("read {} {:?}", r.address, r.gate));
+        }
+        if let Some(w) = self.write {
+            parts.push(format!("write {} {:?}", w.address, w.data));
+        }
+        if self.quantize != Quantize::None {
+            parts.push(format!("{:?}", self.quantize));
+        }
+        if parts.is_empty() {
+            parts.push("idle".into());
+        }
+        write!(f, "{}", parts.join("; "))
     }
 }

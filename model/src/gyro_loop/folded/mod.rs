@@ -41,7 +41,7 @@ mod tests;
 
 pub use control::{
     ASource, AccX, AccY, Accumulate, Align, BSource, Busy, Control, Issue, Quantize, Read,
-    ReadGate, RomRead, Write, WriteData, ADDRESS_BITS, CONTROL_BITS, LIMB_BITS,
+    ReadGate, RomRead, Write, WriteData, ADDRESS_BITS, CONTROL_BITS, FIELDS, LIMB_BITS,
 };
 pub use machine::FoldedGyroLoop;
 pub use schedule::{Schedule, ScheduleError, Words};

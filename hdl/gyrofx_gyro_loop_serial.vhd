@@ -1,0 +1,1125 @@
+-- Language: VHDL-2008
+
+-- gyrofx_gyro_loop_serial — the gyro loop of gyrofx_gyro_loop, folded: its arithmetic runs
+-- one operation at a time on one multiplier, one accumulator and one RAM, under a schedule.
+--
+-- Purpose: the VHDL twin of gyrofx_gyro_loop_serial.v (same generics, ports, ROM images,
+--   schedule and timing): the same loop as gyrofx_gyro_loop, bit for bit (same ports, same
+--   generics, same vectors), in a fraction of the parallel design's multipliers and logic,
+--   for a small FPGA (architecture = "serial"). Bit-exact with
+--   gyrofx_model::gyro_loop::FixedGyroLoop; the schedule is
+--   gyrofx_model::gyro_loop::folded::Schedule, proven there clock by clock (FoldedGyroLoop)
+--   and documented in docs/blocks/gyro_loop.md.
+--
+-- Datapath (per clock, as the schedule's control word says; fields in
+--   gyrofx_model::gyro_loop::folded::Control):
+--     sine ROM read:  ref <= +/-ROM[address of acc_nco + offset + residue], a cosine read
+--                     also stores that reference's truncation error (error feedback)
+--     multiplier:     prod_j <= limb_k(a) * b_limb_j (j < B_LIMBS, signed 16x16 each),
+--                     pp <= sum_j prod_j << 15j          (a 15-bit limb of a times all of b)
+--     accumulator:    acc <= x + y                       (x: acc, 0, RAM word, setpoint, PI
+--                     integrator aligned; y: pp << 15k, -RAM word, p, -I, I, ...)
+--     RAM:            rd <= ram[read address] (0, or the PLL preset, when its gate says);
+--                     ram[write address] <= acc, a quantized acc, rd or c
+--     quantization:   one point a clock loads its register from acc (gyrofx_quantize at
+--                     the formats of the parallel loop's point)
+--   Every sample runs the schedule's first SCHEDULE_REGULAR words; a decimating one (every
+--   CIC_DECIMATION-th) all SCHEDULE_LEN.
+--
+-- Pipeline: ce takes the sample (inputs, mode, switch clears); the schedule's word t acts
+--   t + 1 clocks after ce. dac_x, dac_y and locked load at the schedule's DAC and lock
+--   words; rate, quadrature and out_valid (one clock) at its end. The next ce may come
+--   SCHEDULE_LEN + 1 clocks after ce (gyrofx_job::pipeline). A clock with rst high clears
+--   every register of the loop's state and stops the schedule; the RAM keeps its words,
+--   which the next samples' read gates ignore until they are written again (as in the
+--   Verilog, the control word, the sine ROM's, the multiplier's and the RAM's read registers
+--   are not cleared: nothing reads them before the next sample's schedule loads them).
+--
+-- ROMs: NCO_ROM_FILE (quarter-wave sine), CIC_ROM_FILE (compensator taps), SCHEDULE_FILE
+--   (SCHEDULE_LEN control words of 64 bits, one 16-digit hex word a line), read by
+--   gyrofx_mem_pkg at elaboration, which wants exactly that many words in each file. A
+--   schedule or tap address beyond its ROM's words and a RAM address beyond RAM_WORDS read
+--   zero, and a RAM write there is dropped (the Verilog model reads X): a schedule from
+--   gyrofx makes no such access. The RAM and every register start at zero (the Verilog
+--   model's products hold X until the first clock).
+
+library ieee;
+use ieee.std_logic_1164.all;
+use ieee.numeric_std.all;
+
+use work.gyrofx_mem_pkg.all;
+
+entity gyrofx_gyro_loop_serial is
+    generic (
+        -- NCOs: phase bits, quarter-wave ROM address bits, sine width, truncation error feedback
+        NCO_PHASE_W : positive := 32;
+        NCO_ADDR_W : positive := 10;
+        NCO_SIN_W : positive := 18;
+        NCO_ERROR_FEEDBACK : natural := 1;
+        -- demodulators (both): ADC, reference, product, state and output formats, low-pass shift
+        DEMOD_ADC_W : positive := 24;
+        DEMOD_ADC_F : integer := 23;
+        DEMOD_REF_W : positive := 18;
+        DEMOD_REF_F : integer := 17;
+        DEMOD_PROD_W : positive := 36;
+        DEMOD_PROD_F : integer := 34;
+        DEMOD_STATE_W : positive := 44;
+        DEMOD_STATE_F : integer := 42;
+        DEMOD_OUT_W : positive := 32;
+        DEMOD_OUT_F : integer := 30;
+        DEMOD_SHIFT : positive := 8;
+        -- PLL: error, gains, integrator and output (the NCO word, s NCO_PHASE_W.NCO_PHASE_W)
+        PLL_ERR_W : positive := 32;
+        PLL_ERR_F : integer := 30;
+        PLL_KP_W : positive := 18;
+        PLL_KP_F : integer := 27;
+        PLL_KI_W : positive := 18;
+        PLL_KI_F : integer := 38;
+        PLL_INT_W : positive := 40;
+        PLL_INT_F : integer := 38;
+        PLL_OUT_W : positive := 32;
+        PLL_OUT_F : integer := 32;
+        PLL_KP : std_logic_vector := 18x"10625";
+        PLL_KI : std_logic_vector := 18x"17795";
+        PLL_INT_MIN : std_logic_vector := 40x"292cd0c7b";
+        PLL_INT_MAX : std_logic_vector := 40x"2a786ac8d";
+        -- AGC: error, gains, integrator and output (DAC LSB)
+        AGC_ERR_W : positive := 32;
+        AGC_ERR_F : integer := 30;
+        AGC_KP_W : positive := 18;
+        AGC_KP_F : integer := 1;
+        AGC_KI_W : positive := 18;
+        AGC_KI_F : integer := 11;
+        AGC_INT_W : positive := 40;
+        AGC_INT_F : integer := 20;
+        AGC_OUT_W : positive := 24;
+        AGC_OUT_F : integer := 6;
+        AGC_KP : std_logic_vector := 18x"19a9a";
+        AGC_KI : std_logic_vector := 18x"12624";
+        AGC_INT_MIN : std_logic_vector := 40x"0";
+        AGC_INT_MAX : std_logic_vector := 40x"1ffff00000";
+        -- CICs (both): input, stages, decimation, delay, shift, scaled output, taps, output
+        CIC_IN_W : positive := 32;
+        CIC_IN_F : integer := 30;
+        CIC_STAGES : positive := 3;
+        CIC_DECIMATION : positive := 1000;
+        CIC_DELAY : positive := 1;
+        CIC_SHIFT : natural := 30;
+        CIC_MID_W : positive := 40;
+        CIC_MID_F : integer := 38;
+        CIC_TAPS : positive := 5;
+        CIC_COEF_W : positive := 18;
+        CIC_COEF_F : integer := 16;
+        CIC_OUT_W : positive := 32;
+        CIC_OUT_F : integer := 30;
+        -- DAC codes, rate/quadrature output (deg/s) and the 1/SF coefficients' format
+        DAC_W : positive := 18;
+        DAC_F : integer := 0;
+        OUT_W : positive := 24;
+        OUT_F : integer := 14;
+        COEF_W : positive := 24;
+        COEF_F : integer := 6;
+        -- ADC-to-DAC latency, samples (0..8)
+        LATENCY : natural := 1;
+        -- lock detector: filter shift and the samples both errors must stay inside
+        LOCK_SHIFT : positive := 9;
+        LOCK_HOLD : natural := 2000;
+        -- per mode (_N normal, _R reverse): AGC setpoint (demodulator output format),
+        -- nominal NCO word and PLL preset, DAC and sense reference offsets (cycles,
+        -- u NCO_PHASE_W.NCO_PHASE_W), 1/SF of the rate and quadrature, lock limits
+        SETPOINT_N : std_logic_vector := 32x"cccc666";
+        SETPOINT_R : std_logic_vector := 32x"cccc666";
+        FREQ_WORD_N : std_logic_vector := 32x"a7d5617";
+        FREQ_WORD_R : std_logic_vector := 32x"a6bf8ce";
+        PLL_PRESET_N : std_logic_vector := 40x"29f5585a4";
+        PLL_PRESET_R : std_logic_vector := 40x"29afe3365";
+        DAC_OFFSET_N : std_logic_vector := 32x"fd38ab7";
+        DAC_OFFSET_R : std_logic_vector := 32x"fbb6e38";
+        SENSE_OFFSET_N : std_logic_vector := 32x"4f56436e";
+        SENSE_OFFSET_R : std_logic_vector := 32x"afd6e2bb";
+        RATE_COEF_N : std_logic_vector := 24x"63db80";
+        RATE_COEF_R : std_logic_vector := 24x"9aa98a";
+        QUAD_COEF_N : std_logic_vector := 24x"9c2480";
+        QUAD_COEF_R : std_logic_vector := 24x"9aa98a";
+        LOCK_Q_N : std_logic_vector := 64x"b70271b";
+        LOCK_Q_R : std_logic_vector := 64x"b70271b";
+        LOCK_A_N : std_logic_vector := 64x"68db574";
+        LOCK_A_R : std_logic_vector := 64x"68db574";
+        -- rounding: 0 floor, 1 ceil, 2 zero, 3 nearest, 4 round, 5 convergent
+        ROUNDING : natural := 3;
+        -- overflow: 0 wrap, 1 saturate
+        SATURATE : natural := 1;
+        -- ROM images (hex, one word per line)
+        NCO_ROM_FILE : string := "gyro_loop_nco_sine.mem";
+        CIC_ROM_FILE : string := "gyro_loop_cic_taps.mem";
+        -- the schedule: image, words, words of a sample that does not decimate, RAM words
+        SCHEDULE_FILE : string := "gyro_loop_schedule.mem";
+        SCHEDULE_LEN : positive := 109;
+        SCHEDULE_REGULAR : positive := 53;
+        RAM_WORDS : positive := 28
+    );
+    port (
+        clk        : in  std_logic;
+        rst        : in  std_logic;
+        ce         : in  std_logic;
+        mode       : in  std_logic;
+        adc_x      : in  signed(DEMOD_ADC_W - 1 downto 0);
+        adc_y      : in  signed(DEMOD_ADC_W - 1 downto 0);
+        dac_x      : out signed(DAC_W - 1 downto 0);
+        dac_y      : out signed(DAC_W - 1 downto 0);
+        rate       : out signed(OUT_W - 1 downto 0);
+        quadrature : out signed(OUT_W - 1 downto 0);
+        out_valid  : out std_logic;
+        locked     : out std_logic
+    );
+end entity;
+
+architecture rtl of gyrofx_gyro_loop_serial is
+
+    -- `bits` as a code of `width` bits; another length stops the elaboration.
+    function code_of(name : string; bits : std_logic_vector; width : positive)
+        return std_logic_vector is
+        variable result : std_logic_vector(width - 1 downto 0) := (others => '0');
+    begin
+        assert bits'length = width
+            report "gyrofx_gyro_loop_serial: " & name & " has " & integer'image(bits'length)
+                & " bits; " & integer'image(width) & " are needed"
+            severity failure;
+        if bits'length = width then
+            result := bits;
+        end if;
+        return result;
+    end function;
+
+    -- The largest of `values` (the Verilog's nested max2).
+    function largest(values : integer_vector) return integer is
+        variable result : integer := values(values'left);
+    begin
+        for i in values'range loop
+            result := maximum(result, values(i));
+        end loop;
+        return result;
+    end function;
+
+    -- ceil(log2(value)), 0 for value 1.
+    function ceil_log2(value : positive) return natural is
+        variable bits : natural := 0;
+    begin
+        while 2 ** bits < value loop
+            bits := bits + 1;
+        end loop;
+        return bits;
+    end function;
+
+    -- ceil(log2(rm^stage_count)), exact (gyrofx_cic's register growth).
+    function growth_bits(stage_count : positive; rm : positive) return natural is
+        variable gain : unsigned(255 downto 0) := to_unsigned(1, 256);
+        variable bound : unsigned(255 downto 0) := to_unsigned(1, 256);
+        variable bits : natural := 0;
+    begin
+        for s in 1 to stage_count loop
+            gain := resize(gain * to_unsigned(rm, 32), 256);
+        end loop;
+        while bound < gain loop
+            bound := shift_left(bound, 1);
+            bits := bits + 1;
+        end loop;
+        return bits;
+    end function;
+
+    -- Clocks a width-bit signed operand takes: 15-bit limbs, the top one up to 16 bits signed.
+    function limbs(width : positive) return positive is
+    begin
+        return maximum((width - 1 + 14) / 15, 1);
+    end function;
+
+    -- ---- the exact formats of the parallel loop's points (its blocks' constants) ----
+    -- demodulator: 2 * adc * ref, the low-pass update
+    constant X_W : positive := DEMOD_ADC_W + DEMOD_REF_W;
+    constant X_F : integer := DEMOD_ADC_F + DEMOD_REF_F - 1;
+    constant U_W : positive := DEMOD_STATE_W + DEMOD_SHIFT + 1;
+    constant U_F : integer := DEMOD_STATE_F + DEMOD_SHIFT;
+    constant DEMOD_ALIGN : integer := DEMOD_STATE_F - DEMOD_PROD_F;
+    -- AGC error: setpoint - I
+    constant EA_W : positive := DEMOD_OUT_W + 1;
+    -- PI (gyrofx_pi): v + ki * e at UPD_F, kp * e + v at SUM_F
+    constant PLL_INT_I : integer := PLL_INT_W - PLL_INT_F;
+    constant PLL_KIE_W : positive := PLL_KI_W + PLL_ERR_W;
+    constant PLL_KIE_F : integer := PLL_KI_F + PLL_ERR_F;
+    constant PLL_UPD_F : integer := maximum(PLL_INT_F, PLL_KIE_F);
+    constant PLL_UPD_W : positive := maximum(PLL_INT_I, PLL_KIE_W - PLL_KIE_F) + 1 + PLL_UPD_F;
+    constant PLL_RND_W : positive := maximum(PLL_INT_I, PLL_KIE_W - PLL_KIE_F) + 2 + PLL_INT_F;
+    constant PLL_KPE_W : positive := PLL_KP_W + PLL_ERR_W;
+    constant PLL_KPE_F : integer := PLL_KP_F + PLL_ERR_F;
+    constant PLL_SUM_F : integer := maximum(PLL_INT_F, PLL_KPE_F);
+    constant PLL_SUM_W : positive := maximum(PLL_INT_I, PLL_KPE_W - PLL_KPE_F) + 1 + PLL_SUM_F;
+    constant AGC_INT_I : integer := AGC_INT_W - AGC_INT_F;
+    constant AGC_KIE_W : positive := AGC_KI_W + AGC_ERR_W;
+    constant AGC_KIE_F : integer := AGC_KI_F + AGC_ERR_F;
+    constant AGC_UPD_F : integer := maximum(AGC_INT_F, AGC_KIE_F);
+    constant AGC_UPD_W : positive := maximum(AGC_INT_I, AGC_KIE_W - AGC_KIE_F) + 1 + AGC_UPD_F;
+    constant AGC_RND_W : positive := maximum(AGC_INT_I, AGC_KIE_W - AGC_KIE_F) + 2 + AGC_INT_F;
+    constant AGC_KPE_W : positive := AGC_KP_W + AGC_ERR_W;
+    constant AGC_KPE_F : integer := AGC_KP_F + AGC_ERR_F;
+    constant AGC_SUM_F : integer := maximum(AGC_INT_F, AGC_KPE_F);
+    constant AGC_SUM_W : positive := maximum(AGC_INT_I, AGC_KPE_W - AGC_KPE_F) + 1 + AGC_SUM_F;
+    -- DAC: amplitude * cos
+    constant DRIVE_W : positive := AGC_OUT_W + NCO_SIN_W;
+    constant DRIVE_F : integer := AGC_OUT_F + NCO_SIN_W - 1;
+    -- CIC (gyrofx_cic): registers, the compensator's sum
+    constant REG_W : positive := CIC_IN_W + growth_bits(CIC_STAGES, CIC_DECIMATION * CIC_DELAY);
+    constant FIR_W : positive := CIC_MID_W + CIC_COEF_W + ceil_log2(CIC_TAPS);
+    constant FIR_F : integer := CIC_MID_F + CIC_COEF_F;
+    -- rate and quadrature: 1/SF * CIC output
+    constant RATE_W : positive := CIC_OUT_W + COEF_W;
+    constant RATE_F : integer := CIC_OUT_F + COEF_F;
+    -- lock filters
+    constant Z_W : positive := DEMOD_OUT_W + LOCK_SHIFT + 1;
+
+    -- ---- the datapath's widths ----
+    -- b operands: the references, the four PI gains, the taps, the 1/SF coefficients
+    constant B_W : positive :=
+        largest((NCO_SIN_W, COEF_W, CIC_COEF_W, PLL_KP_W, PLL_KI_W, AGC_KP_W, AGC_KI_W));
+    constant B_LIMBS : positive := limbs(B_W);
+    constant B_EXT_W : positive := 15 * B_LIMBS + 2;
+    -- a limb times all of b, summed: 16 + B_EXT_W bits
+    constant PP_W : positive := 16 + B_EXT_W;
+    -- (Each one bit wider than its widest value, so that every value sign-extends into it.)
+    constant ACC_W : positive := largest((X_W, U_W, EA_W, DRIVE_W, PLL_UPD_W, PLL_SUM_W,
+        AGC_UPD_W, AGC_SUM_W, REG_W, FIR_W, RATE_W, Z_W, PP_W)) + 1;
+    constant RAM_W : positive :=
+        largest((DEMOD_STATE_W, PLL_INT_W, AGC_INT_W, Z_W, REG_W, CIC_MID_W)) + 1;
+    -- a operands: ADC codes, the demodulator output (PLL error), the AGC error and output, the
+    -- CIC output (and its delay line), the compensator output
+    constant A_W : positive :=
+        largest((DEMOD_ADC_W, DEMOD_OUT_W, AGC_ERR_W, AGC_OUT_W, CIC_MID_W, CIC_OUT_W));
+    constant A_LIMBS : positive := limbs(A_W);
+    constant A_EXT_W : positive := 15 * A_LIMBS + 2;
+    -- the PI products' extra alignments (0 unless a product has fewer fraction bits than its sum)
+    constant PLL_KI_ALIGN : natural := PLL_UPD_F - PLL_KIE_F;
+    constant PLL_KP_ALIGN : natural := PLL_SUM_F - PLL_KPE_F;
+    constant AGC_KI_ALIGN : natural := AGC_UPD_F - AGC_KIE_F;
+    constant AGC_KP_ALIGN : natural := AGC_SUM_F - AGC_KPE_F;
+    -- the PI integrators aligned to their update and output sums
+    constant PLL_UPD_SHIFT : natural := PLL_UPD_F - PLL_INT_F;
+    constant PLL_SUM_SHIFT : natural := PLL_SUM_F - PLL_INT_F;
+    constant AGC_UPD_SHIFT : natural := AGC_UPD_F - AGC_INT_F;
+    constant AGC_SUM_SHIFT : natural := AGC_SUM_F - AGC_INT_F;
+    constant T_W : positive := NCO_ADDR_W + 2;
+    constant R_W : positive := maximum(NCO_PHASE_W - T_W, 1);
+    constant DELAY_N : positive := maximum(LATENCY, 1);
+    constant MOST_SEEN : natural := maximum(CIC_TAPS - 1, CIC_DELAY);
+    -- (The Verilog's ceil_log2(CIC_DECIMATION): at least 1 bit here, as in gyrofx_cic.)
+    constant CNT_W : positive := maximum(ceil_log2(CIC_DECIMATION), 1);
+    constant PC_W : positive := maximum(ceil_log2(SCHEDULE_LEN), 1);
+    constant RAM_ADDR_W : positive := maximum(ceil_log2(RAM_WORDS), 1);
+    constant TAP_ADDR_W : positive := maximum(ceil_log2(CIC_TAPS), 1);
+    constant V_W : positive := maximum(PLL_INT_W, AGC_INT_W);
+
+    constant PLL_KP_C : signed(PLL_KP_W - 1 downto 0) :=
+        signed(code_of("PLL_KP", PLL_KP, PLL_KP_W));
+    constant PLL_KI_C : signed(PLL_KI_W - 1 downto 0) :=
+        signed(code_of("PLL_KI", PLL_KI, PLL_KI_W));
+    constant PLL_INT_MIN_C : signed(PLL_INT_W - 1 downto 0) :=
+        signed(code_of("PLL_INT_MIN", PLL_INT_MIN, PLL_INT_W));
+    constant PLL_INT_MAX_C : signed(PLL_INT_W - 1 downto 0) :=
+        signed(code_of("PLL_INT_MAX", PLL_INT_MAX, PLL_INT_W));
+    constant AGC_KP_C : signed(AGC_KP_W - 1 downto 0) :=
+        signed(code_of("AGC_KP", AGC_KP, AGC_KP_W));
+    constant AGC_KI_C : signed(AGC_KI_W - 1 downto 0) :=
+        signed(code_of("AGC_KI", AGC_KI, AGC_KI_W));
+    constant AGC_INT_MIN_C : signed(AGC_INT_W - 1 downto 0) :=
+        signed(code_of("AGC_INT_MIN", AGC_INT_MIN, AGC_INT_W));
+    constant AGC_INT_MAX_C : signed(AGC_INT_W - 1 downto 0) :=
+        signed(code_of("AGC_INT_MAX", AGC_INT_MAX, AGC_INT_W));
+    constant SETPOINT_N_C : signed(DEMOD_OUT_W - 1 downto 0) :=
+        signed(code_of("SETPOINT_N", SETPOINT_N, DEMOD_OUT_W));
+    constant SETPOINT_R_C : signed(DEMOD_OUT_W - 1 downto 0) :=
+        signed(code_of("SETPOINT_R", SETPOINT_R, DEMOD_OUT_W));
+    constant FREQ_WORD_N_C : unsigned(NCO_PHASE_W - 1 downto 0) :=
+        unsigned(code_of("FREQ_WORD_N", FREQ_WORD_N, NCO_PHASE_W));
+    constant FREQ_WORD_R_C : unsigned(NCO_PHASE_W - 1 downto 0) :=
+        unsigned(code_of("FREQ_WORD_R", FREQ_WORD_R, NCO_PHASE_W));
+    constant PLL_PRESET_N_C : signed(PLL_INT_W - 1 downto 0) :=
+        signed(code_of("PLL_PRESET_N", PLL_PRESET_N, PLL_INT_W));
+    constant PLL_PRESET_R_C : signed(PLL_INT_W - 1 downto 0) :=
+        signed(code_of("PLL_PRESET_R", PLL_PRESET_R, PLL_INT_W));
+    constant DAC_OFFSET_N_C : unsigned(NCO_PHASE_W - 1 downto 0) :=
+        unsigned(code_of("DAC_OFFSET_N", DAC_OFFSET_N, NCO_PHASE_W));
+    constant DAC_OFFSET_R_C : unsigned(NCO_PHASE_W - 1 downto 0) :=
+        unsigned(code_of("DAC_OFFSET_R", DAC_OFFSET_R, NCO_PHASE_W));
+    constant SENSE_OFFSET_N_C : unsigned(NCO_PHASE_W - 1 downto 0) :=
+        unsigned(code_of("SENSE_OFFSET_N", SENSE_OFFSET_N, NCO_PHASE_W));
+    constant SENSE_OFFSET_R_C : unsigned(NCO_PHASE_W - 1 downto 0) :=
+        unsigned(code_of("SENSE_OFFSET_R", SENSE_OFFSET_R, NCO_PHASE_W));
+    constant RATE_COEF_N_C : signed(COEF_W - 1 downto 0) :=
+        signed(code_of("RATE_COEF_N", RATE_COEF_N, COEF_W));
+    constant RATE_COEF_R_C : signed(COEF_W - 1 downto 0) :=
+        signed(code_of("RATE_COEF_R", RATE_COEF_R, COEF_W));
+    constant QUAD_COEF_N_C : signed(COEF_W - 1 downto 0) :=
+        signed(code_of("QUAD_COEF_N", QUAD_COEF_N, COEF_W));
+    constant QUAD_COEF_R_C : signed(COEF_W - 1 downto 0) :=
+        signed(code_of("QUAD_COEF_R", QUAD_COEF_R, COEF_W));
+    constant LOCK_Q_N_C : signed(63 downto 0) := signed(code_of("LOCK_Q_N", LOCK_Q_N, 64));
+    constant LOCK_Q_R_C : signed(63 downto 0) := signed(code_of("LOCK_Q_R", LOCK_Q_R, 64));
+    constant LOCK_A_N_C : signed(63 downto 0) := signed(code_of("LOCK_A_N", LOCK_A_N, 64));
+    constant LOCK_A_R_C : signed(63 downto 0) := signed(code_of("LOCK_A_R", LOCK_A_R, 64));
+
+    -- The PI integrators' limits at the rounded update's width, for the clamps.
+    constant PLL_LOW : signed(PLL_RND_W - 1 downto 0) := resize(PLL_INT_MIN_C, PLL_RND_W);
+    constant PLL_HIGH : signed(PLL_RND_W - 1 downto 0) := resize(PLL_INT_MAX_C, PLL_RND_W);
+    constant AGC_LOW : signed(AGC_RND_W - 1 downto 0) := resize(AGC_INT_MIN_C, AGC_RND_W);
+    constant AGC_HIGH : signed(AGC_RND_W - 1 downto 0) := resize(AGC_INT_MAX_C, AGC_RND_W);
+    -- The schedule's last word of a regular and of a decimating sample; the count's last.
+    constant REGULAR_END : unsigned(PC_W - 1 downto 0) := to_unsigned(SCHEDULE_REGULAR - 1, PC_W);
+    constant DECIMATING_END : unsigned(PC_W - 1 downto 0) := to_unsigned(SCHEDULE_LEN - 1, PC_W);
+    constant LAST_COUNT : unsigned(CNT_W - 1 downto 0) := to_unsigned(CIC_DECIMATION - 1, CNT_W);
+    -- The Verilog's MOST_SEEN[3:0]: the seen count is 4 bits, as the control word's field.
+    constant SEEN_LIMIT : unsigned(3 downto 0) := to_unsigned(MOST_SEEN mod 16, 4);
+    -- Half a bin in phase LSB: the top bit of the carried error.
+    function top_bit_only return signed is
+        variable bin : signed(R_W - 1 downto 0) := (others => '0');
+    begin
+        bin(R_W - 1) := '1';
+        return bin;
+    end function;
+    constant HALF_BIN : signed(R_W - 1 downto 0) := top_bit_only;
+
+    constant SCHEDULE : word_array(0 to SCHEDULE_LEN - 1)(63 downto 0) :=
+        read_mem(SCHEDULE_FILE, SCHEDULE_LEN, 64);
+    constant NCO_ROM : word_array(0 to 2 ** NCO_ADDR_W - 1)(NCO_SIN_W - 1 downto 0) :=
+        read_mem(NCO_ROM_FILE, 2 ** NCO_ADDR_W, NCO_SIN_W);
+    constant TAPS_ROM : word_array(0 to CIC_TAPS - 1)(CIC_COEF_W - 1 downto 0) :=
+        read_mem(CIC_ROM_FILE, CIC_TAPS, CIC_COEF_W);
+
+    type ram_array is array (0 to RAM_WORDS - 1) of std_logic_vector(RAM_W - 1 downto 0);
+    type residue_array is array (0 to 2) of signed(R_W - 1 downto 0);
+    type limb_array is array (0 to B_LIMBS - 1) of signed(15 downto 0);
+    type product_array is array (0 to B_LIMBS - 1) of signed(31 downto 0);
+    type delay_array is array (0 to DELAY_N - 1) of signed(DAC_W - 1 downto 0);
+
+    -- ---- control: the schedule ROM, the sample's flags ----
+    signal busy_reg : std_logic := '0';
+    signal pc_reg : unsigned(PC_W - 1 downto 0) := (others => '0');
+    signal control_reg : std_logic_vector(63 downto 0) := (others => '0');
+    signal mode_reg : std_logic := '1';
+    signal start_reg : std_logic := '1';
+    signal switching_reg : std_logic := '0';
+    signal first_reg : std_logic := '0';
+    signal decimate_reg : std_logic := '0';
+    signal count_reg : unsigned(CNT_W - 1 downto 0) := (others => '0');
+    signal seen_reg : unsigned(3 downto 0) := (others => '0');
+    signal adc_x_reg : signed(DEMOD_ADC_W - 1 downto 0) := (others => '0');
+    signal adc_y_reg : signed(DEMOD_ADC_W - 1 downto 0) := (others => '0');
+    signal switching : std_logic;
+    signal schedule_end : unsigned(PC_W - 1 downto 0);
+    signal last_word : std_logic;
+    signal fetch : std_logic;
+    signal fetch_address : unsigned(PC_W - 1 downto 0);
+
+    -- The control word's fields (gyrofx_model::gyro_loop::folded::Control): a fixed layout,
+    -- whose widest fields a small loop does not use in full (bit 63 is spare).
+    signal rom_field : unsigned(2 downto 0);
+    signal advance_field : std_logic;
+    signal a_field : unsigned(3 downto 0);
+    signal limb_field : unsigned(2 downto 0);
+    signal top_field : std_logic;
+    signal b_field : unsigned(2 downto 0);
+    signal tap_field : unsigned(3 downto 0);
+    signal x_field : unsigned(3 downto 0);
+    signal y_field : unsigned(3 downto 0);
+    signal product_limb_field : unsigned(2 downto 0);
+    signal align_field : unsigned(2 downto 0);
+    signal read_field : std_logic;
+    signal read_address_field : unsigned(6 downto 0);
+    signal gate_field : unsigned(2 downto 0);
+    signal seen_field : unsigned(3 downto 0);
+    signal write_field : std_logic;
+    signal write_address_field : unsigned(6 downto 0);
+    signal data_field : unsigned(2 downto 0);
+    signal quantize_field : unsigned(3 downto 0);
+    signal rom_en : std_logic;
+    signal accumulate_en : std_logic;
+    signal read_en : std_logic;
+    signal write_en : std_logic;
+    signal point : unsigned(3 downto 0);
+
+    -- ---- NCO: one accumulator, three references' truncation errors, the sine ROM ----
+    signal nco_acc_reg : unsigned(NCO_PHASE_W - 1 downto 0) := (others => '0');
+    signal freq_reg : unsigned(NCO_PHASE_W - 1 downto 0) := (others => '0');
+    signal residue_reg : residue_array := (others => (others => '0'));
+    signal ref_magnitude_reg : std_logic_vector(NCO_SIN_W - 1 downto 0) := (others => '0');
+    signal ref_negative_reg : std_logic := '0';
+    signal nco_index : natural range 0 to 2;
+    signal cosine : std_logic;
+    signal nco_offset : unsigned(NCO_PHASE_W - 1 downto 0);
+    signal phase_exact : unsigned(NCO_PHASE_W - 1 downto 0);
+    signal phase : unsigned(NCO_PHASE_W - 1 downto 0);
+    signal t_sin : unsigned(T_W - 1 downto 0);
+    signal t : unsigned(T_W - 1 downto 0);
+    signal rom_address : unsigned(NCO_ADDR_W - 1 downto 0);
+    signal freq_sample : unsigned(NCO_PHASE_W - 1 downto 0);
+    signal reference : signed(NCO_SIN_W - 1 downto 0);
+
+    -- ---- RAM of states ----
+    signal ram : ram_array := (others => (others => '0'));
+    signal ram_data_reg : std_logic_vector(RAM_W - 1 downto 0) := (others => '0');
+    -- How the read register reads: 0 (a cleared word), the PLL preset, or the word.
+    signal read_zero_reg : std_logic := '0';
+    signal read_preset_reg : std_logic := '0';
+    signal previous_rd_reg : signed(RAM_W - 1 downto 0) := (others => '0');
+    signal preset_value : signed(PLL_INT_W - 1 downto 0);
+    signal preset_clamped : signed(PLL_INT_W - 1 downto 0);
+    signal rd : signed(RAM_W - 1 downto 0);
+    signal read_zero : std_logic;
+    signal read_preset : std_logic;
+    signal read_address : unsigned(RAM_ADDR_W - 1 downto 0);
+    signal write_address : unsigned(RAM_ADDR_W - 1 downto 0);
+    signal write_data : signed(RAM_W - 1 downto 0);
+
+    -- ---- multiplier: a 15-bit limb of a times all of b ----
+    signal drive_q_reg : signed(DEMOD_OUT_W - 1 downto 0) := (others => '0');
+    signal amplitude_error_reg : signed(AGC_ERR_W - 1 downto 0) := (others => '0');
+    signal amplitude_reg : signed(AGC_OUT_W - 1 downto 0) := (others => '0');
+    signal c_reg : signed(CIC_MID_W - 1 downto 0) := (others => '0');
+    signal cic_output_reg : signed(CIC_OUT_W - 1 downto 0) := (others => '0');
+    signal product_reg : product_array := (others => (others => '0'));
+    signal pp_reg : signed(PP_W - 1 downto 0) := (others => '0');
+    signal adc_drive : signed(DEMOD_ADC_W - 1 downto 0);
+    signal adc_sense : signed(DEMOD_ADC_W - 1 downto 0);
+    signal a_value : signed(A_EXT_W - 1 downto 0);
+    signal a_shifted : signed(A_EXT_W - 1 downto 0);
+    signal a_limb : signed(15 downto 0);
+    signal tap_address : unsigned(TAP_ADDR_W - 1 downto 0);
+    signal tap : signed(CIC_COEF_W - 1 downto 0);
+    signal rate_coef : signed(COEF_W - 1 downto 0);
+    signal quad_coef : signed(COEF_W - 1 downto 0);
+    signal b_value : signed(B_EXT_W - 1 downto 0);
+    signal b_limb : limb_array;
+
+    -- ---- accumulator: acc <= x + y ----
+    signal acc_reg : signed(ACC_W - 1 downto 0) := (others => '0');
+    signal p_reg : signed(DEMOD_PROD_W - 1 downto 0) := (others => '0');
+    signal y_reg : signed(DEMOD_STATE_W - 1 downto 0) := (others => '0');
+    signal v_reg : signed(V_W - 1 downto 0) := (others => '0');
+    signal demod_output : signed(DEMOD_OUT_W - 1 downto 0);
+    signal setpoint : signed(DEMOD_OUT_W - 1 downto 0);
+    signal x_value : signed(ACC_W - 1 downto 0);
+    signal pp_weighted : signed(ACC_W - 1 downto 0);
+    signal y_value : signed(ACC_W - 1 downto 0);
+    signal y_negate : std_logic;
+    signal acc_next : signed(ACC_W - 1 downto 0);
+
+    -- ---- quantization points, at the parallel loop's formats ----
+    signal p_next : signed(DEMOD_PROD_W - 1 downto 0);
+    signal y_next : signed(DEMOD_STATE_W - 1 downto 0);
+    signal error_next : signed(DEMOD_OUT_W - 1 downto 0);
+    signal pll_rounded : signed(PLL_RND_W - 1 downto 0);
+    signal pll_out : signed(PLL_OUT_W - 1 downto 0);
+    signal agc_rounded : signed(AGC_RND_W - 1 downto 0);
+    signal agc_out : signed(AGC_OUT_W - 1 downto 0);
+    signal drive : signed(DAC_W - 1 downto 0);
+    signal c_next : signed(CIC_MID_W - 1 downto 0);
+    signal cic_output_next : signed(CIC_OUT_W - 1 downto 0);
+    signal rate_next : signed(OUT_W - 1 downto 0);
+    signal pll_clamped : signed(PLL_RND_W - 1 downto 0);
+    signal pll_v_next : signed(PLL_INT_W - 1 downto 0);
+    signal agc_clamped : signed(AGC_RND_W - 1 downto 0);
+    signal agc_v_next : signed(AGC_INT_W - 1 downto 0);
+    signal z : signed(Z_W - 1 downto 0);
+    signal z_abs : signed(65 downto 0);
+    signal lock_limit : signed(63 downto 0);
+    signal within_limit : std_logic;
+
+    -- ---- the sample, the registers the points load, the outputs ----
+    signal delay_reg : delay_array := (others => (others => '0'));
+    signal dac_now : signed(DAC_W - 1 downto 0);
+    signal dac_x_reg : signed(DAC_W - 1 downto 0) := (others => '0');
+    signal dac_y_reg : signed(DAC_W - 1 downto 0) := (others => '0');
+    signal rate_reg : signed(OUT_W - 1 downto 0) := (others => '0');
+    signal quad_reg : signed(OUT_W - 1 downto 0) := (others => '0');
+    signal out_valid_reg : std_logic := '0';
+    signal inside_q_reg : std_logic := '0';
+    signal lock_count_reg : unsigned(31 downto 0) := (others => '0');
+    signal locked_reg : std_logic := '0';
+    signal lock_count_next : unsigned(31 downto 0);
+
+begin
+
+    assert CIC_DELAY = 1
+        report "gyrofx_gyro_loop_serial: the folded loop's CICs have a differential delay of 1, "
+            & "not " & integer'image(CIC_DELAY)
+        severity failure;
+    assert AGC_ERR_W = DEMOD_OUT_W and AGC_ERR_F = DEMOD_OUT_F and PLL_ERR_W = DEMOD_OUT_W
+        report "gyrofx_gyro_loop_serial: the PI errors' formats must be the demodulator output's"
+        severity failure;
+    assert RAM_WORDS <= 128 and SCHEDULE_REGULAR <= SCHEDULE_LEN
+        report "gyrofx_gyro_loop_serial: RAM_WORDS (" & integer'image(RAM_WORDS)
+            & ") must be <= 128 and SCHEDULE_REGULAR (" & integer'image(SCHEDULE_REGULAR)
+            & ") <= SCHEDULE_LEN (" & integer'image(SCHEDULE_LEN) & ")"
+        severity failure;
+    assert CIC_TAPS <= 15 and A_LIMBS <= 8 and CIC_DECIMATION >= 2
+        report "gyrofx_gyro_loop_serial: the schedule's fields hold CIC_TAPS <= 15 ("
+            & integer'image(CIC_TAPS) & ") and operands of <= 8 limbs ("
+            & integer'image(A_LIMBS) & "); CIC_DECIMATION (" & integer'image(CIC_DECIMATION)
+            & ") must be >= 2"
+        severity failure;
+    -- (gyrofx_demodulator's check: the product aligns to the state by a left shift.)
+    assert DEMOD_ALIGN >= 0
+        report "gyrofx_gyro_loop_serial: DEMOD_STATE_F (" & integer'image(DEMOD_STATE_F)
+            & ") must be >= DEMOD_PROD_F (" & integer'image(DEMOD_PROD_F) & ")"
+        severity failure;
+
+    -- ---- control: the schedule ROM, the sample's flags ----
+    switching <= '1' when mode /= mode_reg or start_reg = '1' else '0';
+    schedule_end <= DECIMATING_END when decimate_reg = '1' else REGULAR_END;
+    last_word <= '1' when busy_reg = '1' and pc_reg = schedule_end else '0';
+    -- A word is fetched the clock before it acts: word 0 at ce, word t + 1 while t acts.
+    fetch <= (ce and not rst) or (busy_reg and not last_word);
+    fetch_address <= (others => '0') when ce = '1' else pc_reg + 1;
+
+    schedule_rom : process (clk)
+    begin
+        if rising_edge(clk) then
+            if fetch = '1' then
+                if to_integer(fetch_address) < SCHEDULE_LEN then
+                    control_reg <= SCHEDULE(to_integer(fetch_address));
+                else
+                    control_reg <= (others => '0');
+                end if;
+            end if;
+        end if;
+    end process;
+
+    rom_field <= unsigned(control_reg(2 downto 0));
+    advance_field <= control_reg(3);
+    a_field <= unsigned(control_reg(7 downto 4));
+    limb_field <= unsigned(control_reg(10 downto 8));
+    top_field <= control_reg(11);
+    b_field <= unsigned(control_reg(14 downto 12));
+    tap_field <= unsigned(control_reg(18 downto 15));
+    x_field <= unsigned(control_reg(22 downto 19));
+    y_field <= unsigned(control_reg(26 downto 23));
+    product_limb_field <= unsigned(control_reg(29 downto 27));
+    align_field <= unsigned(control_reg(32 downto 30));
+    read_field <= control_reg(33);
+    read_address_field <= unsigned(control_reg(40 downto 34));
+    gate_field <= unsigned(control_reg(43 downto 41));
+    seen_field <= unsigned(control_reg(47 downto 44));
+    write_field <= control_reg(48);
+    write_address_field <= unsigned(control_reg(55 downto 49));
+    data_field <= unsigned(control_reg(58 downto 56));
+    quantize_field <= unsigned(control_reg(62 downto 59));
+
+    -- The word acts only while the schedule runs: the last one stays in control_reg after it.
+    rom_en <= '1' when busy_reg = '1' and rom_field /= 0 else '0';
+    accumulate_en <= '1' when busy_reg = '1' and (x_field /= 0 or y_field /= 0) else '0';
+    read_en <= busy_reg and read_field;
+    write_en <= busy_reg and write_field;
+    point <= quantize_field when busy_reg = '1' else (others => '0');
+
+    -- ---- NCO: one accumulator, three references' truncation errors, the sine ROM ----
+    -- rom_field: 1 drive sin, 2 drive cos, 3 transmit cos, 4 sense sin, 5 sense cos.
+    nco_index <= 1 when rom_field = 3 else 2 when rom_field >= 4 else 0;
+    cosine <= '1' when rom_field = 2 or rom_field = 3 or rom_field = 5 else '0';
+    nco_offset <= (others => '0') when nco_index = 0 else
+                  DAC_OFFSET_N_C when nco_index = 1 and mode_reg = '1' else
+                  DAC_OFFSET_R_C when nco_index = 1 else
+                  SENSE_OFFSET_N_C when mode_reg = '1' else
+                  SENSE_OFFSET_R_C;
+    phase_exact <= nco_acc_reg + nco_offset;
+    -- With error feedback the reference's carried error joins the phase (sign-extended, mod
+    -- one cycle).
+    phase <= phase_exact + unsigned(resize(residue_reg(nco_index), NCO_PHASE_W))
+        when NCO_ERROR_FEEDBACK /= 0 else phase_exact;
+    t_sin <= phase(NCO_PHASE_W - 1 downto NCO_PHASE_W - T_W);
+    -- The cosine: the same at a quarter cycle on.
+    t <= t_sin + to_unsigned(2 ** NCO_ADDR_W, T_W) when cosine = '1' else t_sin;
+    rom_address <= not t(NCO_ADDR_W - 1 downto 0) when t(NCO_ADDR_W) = '1'
+                   else t(NCO_ADDR_W - 1 downto 0);
+    -- The first sample of a mode runs at its nominal word, the others at the PLL's last output.
+    freq_sample <= FREQ_WORD_N_C when switching_reg = '1' and mode_reg = '1' else
+                   FREQ_WORD_R_C when switching_reg = '1' else
+                   freq_reg;
+
+    sine_rom : process (clk)
+    begin
+        if rising_edge(clk) then
+            if rom_en = '1' then
+                ref_magnitude_reg <= NCO_ROM(to_integer(rom_address));
+            end if;
+        end if;
+    end process;
+
+    reference <= -signed(ref_magnitude_reg) when ref_negative_reg = '1'
+                 else signed(ref_magnitude_reg);
+
+    -- ---- RAM of states ----
+    preset_value <= PLL_PRESET_N_C when mode_reg = '1' else PLL_PRESET_R_C;
+    preset_clamped <= PLL_INT_MIN_C when preset_value < PLL_INT_MIN_C else
+                      PLL_INT_MAX_C when preset_value > PLL_INT_MAX_C else
+                      preset_value;
+    rd <= (others => '0') when read_zero_reg = '1' else
+          resize(preset_clamped, RAM_W) when read_preset_reg = '1' else
+          signed(ram_data_reg);
+    -- gate_field: 1 switch, 2 preset, 3 first sample, 4 fewer than seen decimations.
+    read_zero <= '1' when (gate_field = 1 and switching_reg = '1')
+                          or (gate_field = 3 and first_reg = '1')
+                          or (gate_field = 4 and seen_reg < seen_field) else '0';
+    read_preset <= '1' when gate_field = 2 and switching_reg = '1' else '0';
+
+    -- ---- multiplier: a 15-bit limb of a times all of b ----
+    adc_drive <= adc_x_reg when mode_reg = '1' else adc_y_reg;
+    adc_sense <= adc_y_reg when mode_reg = '1' else adc_x_reg;
+
+    -- Every a operand sign-extended to A_EXT_W bits (the RAM word holds a CIC output c).
+    a_operand : process (all)
+    begin
+        case to_integer(a_field) is
+            when 1 => a_value <= resize(adc_drive, A_EXT_W);
+            when 2 => a_value <= resize(adc_sense, A_EXT_W);
+            when 3 => a_value <= resize(drive_q_reg, A_EXT_W);
+            when 4 => a_value <= resize(amplitude_error_reg, A_EXT_W);
+            when 5 => a_value <= resize(amplitude_reg, A_EXT_W);
+            when 6 => a_value <= resize(c_reg, A_EXT_W);
+            when 7 => a_value <= resize(rd(CIC_MID_W - 1 downto 0), A_EXT_W);
+            when 8 => a_value <= resize(cic_output_reg, A_EXT_W);
+            when others => a_value <= (others => '0');
+        end case;
+    end process;
+    a_shifted <= shift_right(a_value, 15 * to_integer(limb_field));
+    a_limb <= a_shifted(15 downto 0) when top_field = '1' else '0' & a_shifted(14 downto 0);
+
+    -- (tap_field[TAP_ADDR_W-1:0] in the Verilog: the same bits up to 16 taps.)
+    tap_address <= resize(tap_field, TAP_ADDR_W);
+    tap <= signed(TAPS_ROM(to_integer(tap_address))) when to_integer(tap_address) < CIC_TAPS
+           else (others => '0');
+    rate_coef <= RATE_COEF_N_C when mode_reg = '1' else RATE_COEF_R_C;
+    quad_coef <= QUAD_COEF_N_C when mode_reg = '1' else QUAD_COEF_R_C;
+
+    -- (Its top bit, a guard bit, is never a limb's.)
+    b_operand : process (all)
+    begin
+        case to_integer(b_field) is
+            when 0 => b_value <= resize(reference, B_EXT_W);
+            when 1 => b_value <= resize(PLL_KI_C, B_EXT_W);
+            when 2 => b_value <= resize(PLL_KP_C, B_EXT_W);
+            when 3 => b_value <= resize(AGC_KI_C, B_EXT_W);
+            when 4 => b_value <= resize(AGC_KP_C, B_EXT_W);
+            when 5 => b_value <= resize(tap, B_EXT_W);
+            when 6 => b_value <= resize(rate_coef, B_EXT_W);
+            when others => b_value <= resize(quad_coef, B_EXT_W);
+        end case;
+    end process;
+
+    -- Limb j of b: 15 unsigned bits, the top one signed; each product one 16x16.
+    g_b_limbs : for j in 0 to B_LIMBS - 1 generate
+        g_top : if j = B_LIMBS - 1 generate
+            b_limb(j) <= b_value(15 * j + 15 downto 15 * j);
+        end generate;
+        g_low : if j < B_LIMBS - 1 generate
+            b_limb(j) <= '0' & b_value(15 * j + 14 downto 15 * j);
+        end generate;
+    end generate;
+
+    -- The products registered, then summed at their limbs' weights into pp (the Verilog's
+    -- chain of one adder per limb, in one expression).
+    multiplier : process (clk)
+        variable sum : signed(PP_W - 1 downto 0);
+    begin
+        if rising_edge(clk) then
+            sum := resize(product_reg(0), PP_W);
+            for j in 1 to B_LIMBS - 1 loop
+                sum := sum + shift_left(resize(product_reg(j), PP_W), 15 * j);
+            end loop;
+            pp_reg <= sum;
+            for j in 0 to B_LIMBS - 1 loop
+                product_reg(j) <= a_limb * b_limb(j);
+            end loop;
+        end if;
+    end process;
+
+    -- ---- accumulator: acc <= x + y ----
+    setpoint <= SETPOINT_N_C when mode_reg = '1' else SETPOINT_R_C;
+
+    x_operand : process (all)
+    begin
+        case to_integer(x_field) is
+            when 1 => x_value <= (others => '0');
+            when 2 => x_value <= resize(rd, ACC_W);
+            when 3 => x_value <= shift_left(resize(rd, ACC_W), DEMOD_SHIFT);
+            when 4 => x_value <= resize(setpoint, ACC_W);
+            when 5 => x_value <= shift_left(resize(rd, ACC_W), PLL_UPD_SHIFT);
+            when 6 => x_value <= shift_left(resize(v_reg, ACC_W), PLL_SUM_SHIFT);
+            when 7 => x_value <= shift_left(resize(rd, ACC_W), AGC_UPD_SHIFT);
+            when 8 => x_value <= shift_left(resize(v_reg, ACC_W), AGC_SUM_SHIFT);
+            when others => x_value <= acc_reg;
+        end case;
+    end process;
+
+    -- The product arriving now, at its PI's alignment and its limb's weight. As in the
+    -- Verilog's loop, a limb k matches product_limb_field at k's low 3 bits.
+    product_weight : process (all)
+        variable aligned : signed(ACC_W - 1 downto 0);
+        variable weighted : signed(ACC_W - 1 downto 0);
+    begin
+        case to_integer(align_field) is
+            when 1 => aligned := shift_left(resize(pp_reg, ACC_W), PLL_KI_ALIGN);
+            when 2 => aligned := shift_left(resize(pp_reg, ACC_W), PLL_KP_ALIGN);
+            when 3 => aligned := shift_left(resize(pp_reg, ACC_W), AGC_KI_ALIGN);
+            when 4 => aligned := shift_left(resize(pp_reg, ACC_W), AGC_KP_ALIGN);
+            when others => aligned := resize(pp_reg, ACC_W);
+        end case;
+        weighted := aligned;
+        for k in 1 to A_LIMBS - 1 loop
+            if product_limb_field = to_unsigned(k mod 8, 3) then
+                weighted := shift_left(aligned, 15 * k);
+            end if;
+        end loop;
+        pp_weighted <= weighted;
+    end process;
+
+    -- y, and whether it enters negated (x + not y + 1).
+    y_operand : process (all)
+    begin
+        y_negate <= '0';
+        case to_integer(y_field) is
+            when 1 => y_value <= pp_weighted;
+            when 2 =>
+                y_value <= resize(rd, ACC_W);
+                y_negate <= '1';
+            when 3 => y_value <= shift_left(resize(p_reg, ACC_W), DEMOD_ALIGN);
+            when 4 =>
+                y_value <= resize(demod_output, ACC_W);
+                y_negate <= '1';
+            when 5 => y_value <= resize(demod_output, ACC_W);
+            when 6 => y_value <= resize(previous_rd_reg, ACC_W);
+            when 7 =>
+                y_value <= shift_right(resize(rd, ACC_W), LOCK_SHIFT);
+                y_negate <= '1';
+            when 8 => y_value <= resize(drive_q_reg, ACC_W);
+            when 9 => y_value <= resize(amplitude_error_reg, ACC_W);
+            when others => y_value <= (others => '0');
+        end case;
+    end process;
+
+    -- One adder: a subtraction is x + not y with a carry in of 1.
+    acc_next <= x_value + y_value when y_negate = '0'
+                else x_value + (not y_value) + signed'("01");
+
+    -- ---- quantization points, at the parallel loop's formats ----
+    quantize_product : entity work.gyrofx_quantize
+        generic map (
+            IN_W => X_W, IN_F => X_F, OUT_W => DEMOD_PROD_W, OUT_F => DEMOD_PROD_F,
+            ROUNDING => ROUNDING, SATURATE => SATURATE
+        )
+        port map (value_in => acc_reg(X_W - 1 downto 0), value_out => p_next, overflow => open);
+
+    quantize_state : entity work.gyrofx_quantize
+        generic map (
+            IN_W => U_W, IN_F => U_F, OUT_W => DEMOD_STATE_W, OUT_F => DEMOD_STATE_F,
+            ROUNDING => ROUNDING, SATURATE => SATURATE
+        )
+        port map (value_in => acc_reg(U_W - 1 downto 0), value_out => y_next, overflow => open);
+
+    quantize_output : entity work.gyrofx_quantize
+        generic map (
+            IN_W => DEMOD_STATE_W, IN_F => DEMOD_STATE_F, OUT_W => DEMOD_OUT_W,
+            OUT_F => DEMOD_OUT_F, ROUNDING => ROUNDING, SATURATE => SATURATE
+        )
+        port map (value_in => y_reg, value_out => demod_output, overflow => open);
+
+    quantize_agc_error : entity work.gyrofx_quantize
+        generic map (
+            IN_W => EA_W, IN_F => DEMOD_OUT_F, OUT_W => DEMOD_OUT_W, OUT_F => DEMOD_OUT_F,
+            ROUNDING => ROUNDING, SATURATE => SATURATE
+        )
+        port map (
+            value_in => acc_reg(EA_W - 1 downto 0), value_out => error_next, overflow => open
+        );
+
+    quantize_pll_integrator : entity work.gyrofx_quantize
+        generic map (
+            IN_W => PLL_UPD_W, IN_F => PLL_UPD_F, OUT_W => PLL_RND_W, OUT_F => PLL_INT_F,
+            ROUNDING => ROUNDING, SATURATE => 0
+        )
+        port map (
+            value_in => acc_reg(PLL_UPD_W - 1 downto 0), value_out => pll_rounded, overflow => open
+        );
+
+    quantize_pll_output : entity work.gyrofx_quantize
+        generic map (
+            IN_W => PLL_SUM_W, IN_F => PLL_SUM_F, OUT_W => PLL_OUT_W, OUT_F => PLL_OUT_F,
+            ROUNDING => ROUNDING, SATURATE => SATURATE
+        )
+        port map (
+            value_in => acc_reg(PLL_SUM_W - 1 downto 0), value_out => pll_out, overflow => open
+        );
+
+    quantize_agc_integrator : entity work.gyrofx_quantize
+        generic map (
+            IN_W => AGC_UPD_W, IN_F => AGC_UPD_F, OUT_W => AGC_RND_W, OUT_F => AGC_INT_F,
+            ROUNDING => ROUNDING, SATURATE => 0
+        )
+        port map (
+            value_in => acc_reg(AGC_UPD_W - 1 downto 0), value_out => agc_rounded, overflow => open
+        );
+
+    quantize_agc_output : entity work.gyrofx_quantize
+        generic map (
+            IN_W => AGC_SUM_W, IN_F => AGC_SUM_F, OUT_W => AGC_OUT_W, OUT_F => AGC_OUT_F,
+            ROUNDING => ROUNDING, SATURATE => SATURATE
+        )
+        port map (
+            value_in => acc_reg(AGC_SUM_W - 1 downto 0), value_out => agc_out, overflow => open
+        );
+
+    quantize_dac : entity work.gyrofx_quantize
+        generic map (
+            IN_W => DRIVE_W, IN_F => DRIVE_F, OUT_W => DAC_W, OUT_F => DAC_F,
+            ROUNDING => ROUNDING, SATURATE => SATURATE
+        )
+        port map (value_in => acc_reg(DRIVE_W - 1 downto 0), value_out => drive, overflow => open);
+
+    quantize_cic : entity work.gyrofx_quantize
+        generic map (
+            IN_W => REG_W, IN_F => CIC_IN_F + CIC_SHIFT, OUT_W => CIC_MID_W, OUT_F => CIC_MID_F,
+            ROUNDING => ROUNDING, SATURATE => SATURATE
+        )
+        port map (value_in => acc_reg(REG_W - 1 downto 0), value_out => c_next, overflow => open);
+
+    quantize_compensator : entity work.gyrofx_quantize
+        generic map (
+            IN_W => FIR_W, IN_F => FIR_F, OUT_W => CIC_OUT_W, OUT_F => CIC_OUT_F,
+            ROUNDING => ROUNDING, SATURATE => SATURATE
+        )
+        port map (
+            value_in => acc_reg(FIR_W - 1 downto 0), value_out => cic_output_next, overflow => open
+        );
+
+    quantize_rate : entity work.gyrofx_quantize
+        generic map (
+            IN_W => RATE_W, IN_F => RATE_F, OUT_W => OUT_W, OUT_F => OUT_F,
+            ROUNDING => ROUNDING, SATURATE => SATURATE
+        )
+        port map (
+            value_in => acc_reg(RATE_W - 1 downto 0), value_out => rate_next, overflow => open
+        );
+
+    -- The PI integrators' clamps: the limits bound the result, so its low INT_W bits are exact.
+    pll_clamped <= PLL_LOW when pll_rounded < PLL_LOW else
+                   PLL_HIGH when pll_rounded > PLL_HIGH else
+                   pll_rounded;
+    pll_v_next <= pll_clamped(PLL_INT_W - 1 downto 0);
+    agc_clamped <= AGC_LOW when agc_rounded < AGC_LOW else
+                   AGC_HIGH when agc_rounded > AGC_HIGH else
+                   agc_rounded;
+    agc_v_next <= agc_clamped(AGC_INT_W - 1 downto 0);
+
+    -- The lock filters' check |z| < limit, in 66 bits (Z_W <= 64, 64-bit limits). The Verilog
+    -- compares with the limit's 66-bit sign extension as an unsigned number (a concatenation):
+    -- the same for the limits gyrofx writes (positive); kept, so that a negative one reads
+    -- as the Verilog's does.
+    z <= acc_reg(Z_W - 1 downto 0);
+    z_abs <= abs(resize(z, 66));
+    lock_limit <= LOCK_Q_N_C when quantize_field = 14 and mode_reg = '1' else
+                  LOCK_Q_R_C when quantize_field = 14 else
+                  LOCK_A_N_C when mode_reg = '1' else
+                  LOCK_A_R_C;
+    within_limit <= '1' when unsigned(z_abs) < unsigned(resize(lock_limit, 66)) else '0';
+
+    -- ---- RAM writes (and its registered read, before this clock's write) ----
+    read_address <= read_address_field(RAM_ADDR_W - 1 downto 0);
+    write_address <= write_address_field(RAM_ADDR_W - 1 downto 0);
+
+    ram_data : process (all)
+    begin
+        case to_integer(data_field) is
+            when 1 => write_data <= resize(z, RAM_W);
+            when 2 => write_data <= resize(y_next, RAM_W);
+            when 3 => write_data <= resize(pll_v_next, RAM_W);
+            when 4 => write_data <= resize(agc_v_next, RAM_W);
+            when 5 => write_data <= rd;
+            when 6 => write_data <= resize(c_reg, RAM_W);
+            -- The accumulator wrapped to the CIC registers' width.
+            when others => write_data <= resize(acc_reg(REG_W - 1 downto 0), RAM_W);
+        end case;
+    end process;
+
+    states_ram : process (clk)
+    begin
+        if rising_edge(clk) then
+            if write_en = '1' and to_integer(write_address) < RAM_WORDS then
+                ram(to_integer(write_address)) <= std_logic_vector(write_data);
+            end if;
+            if read_en = '1' then
+                if to_integer(read_address) < RAM_WORDS then
+                    ram_data_reg <= ram(to_integer(read_address));
+                else
+                    ram_data_reg <= (others => '0');
+                end if;
+            end if;
+        end if;
+    end process;
+
+    -- ---- the sample, the registers the points load, the outputs ----
+    -- The DAC code of sample k is output at sample k + LATENCY; delay_reg(j) holds sample
+    -- k-1-j's.
+    dac_now <= drive when LATENCY = 0 else delay_reg(DELAY_N - 1);
+    lock_count_next <= (others => '0') when inside_q_reg = '0' or within_limit = '0' else
+                       to_unsigned(LOCK_HOLD, 32) when lock_count_reg >= LOCK_HOLD else
+                       lock_count_reg + 1;
+
+    -- Later assignments win, as with the Verilog's nonblocking ones: a point's load over the
+    -- sample's clears, rst over everything.
+    registers : process (clk)
+    begin
+        if rising_edge(clk) then
+            out_valid_reg <= '0';
+            previous_rd_reg <= rd;
+
+            if ce = '1' then
+                busy_reg <= '1';
+                pc_reg <= (others => '0');
+                mode_reg <= mode;
+                start_reg <= '0';
+                switching_reg <= switching;
+                first_reg <= start_reg;
+                adc_x_reg <= adc_x;
+                adc_y_reg <= adc_y;
+                if count_reg = LAST_COUNT then
+                    decimate_reg <= '1';
+                    count_reg <= (others => '0');
+                else
+                    decimate_reg <= '0';
+                    count_reg <= count_reg + 1;
+                end if;
+                if switching = '1' then
+                    lock_count_reg <= (others => '0');
+                    delay_reg <= (others => (others => '0'));
+                end if;
+            elsif busy_reg = '1' then
+                if last_word = '1' then
+                    busy_reg <= '0';
+                    if decimate_reg = '1' and seen_reg < SEEN_LIMIT then
+                        seen_reg <= seen_reg + 1;
+                    end if;
+                else
+                    pc_reg <= pc_reg + 1;
+                end if;
+            end if;
+
+            if rom_en = '1' then
+                ref_negative_reg <= t(T_W - 1);
+                if cosine = '1' and NCO_ERROR_FEEDBACK /= 0 then
+                    -- What is left below the truncation, less half a bin: its top bit
+                    -- inverted, read as signed.
+                    residue_reg(nco_index) <= signed(phase(R_W - 1 downto 0)) xor HALF_BIN;
+                end if;
+            end if;
+            if busy_reg = '1' and advance_field = '1' then
+                nco_acc_reg <= nco_acc_reg + freq_sample;
+            end if;
+            if read_en = '1' then
+                read_zero_reg <= read_zero;
+                read_preset_reg <= read_preset;
+            end if;
+            if accumulate_en = '1' then
+                acc_reg <= acc_next;
+            end if;
+
+            case to_integer(point) is
+                when 1 => p_reg <= p_next;
+                when 2 => y_reg <= y_next;
+                when 3 => drive_q_reg <= demod_output;
+                when 4 => amplitude_error_reg <= error_next;
+                when 5 => v_reg <= resize(pll_v_next, V_W);
+                when 6 => freq_reg <= unsigned(pll_out(NCO_PHASE_W - 1 downto 0));
+                when 7 => v_reg <= resize(agc_v_next, V_W);
+                when 8 => amplitude_reg <= agc_out;
+                when 9 =>
+                    if mode_reg = '1' then
+                        dac_x_reg <= dac_now;
+                        dac_y_reg <= (others => '0');
+                    else
+                        dac_x_reg <= (others => '0');
+                        dac_y_reg <= dac_now;
+                    end if;
+                    delay_reg(0) <= drive;
+                    for j in 1 to DELAY_N - 1 loop
+                        delay_reg(j) <= delay_reg(j - 1);
+                    end loop;
+                when 10 => c_reg <= c_next;
+                when 11 => cic_output_reg <= cic_output_next;
+                when 12 => rate_reg <= rate_next;
+                when 13 =>
+                    quad_reg <= rate_next;
+                    out_valid_reg <= '1';
+                when 14 => inside_q_reg <= within_limit;
+                when 15 =>
+                    lock_count_reg <= lock_count_next;
+                    if lock_count_next >= LOCK_HOLD then
+                        locked_reg <= '1';
+                    else
+                        locked_reg <= '0';
+                    end if;
+                when others =>
+                    null;
+            end case;
+
+            if rst = '1' then
+                busy_reg <= '0';
+                pc_reg <= (others => '0');
+                mode_reg <= '1';
+                start_reg <= '1';
+                switching_reg <= '0';
+                first_reg <= '0';
+                decimate_reg <= '0';
+                count_reg <= (others => '0');
+                seen_reg <= (others => '0');
+                adc_x_reg <= (others => '0');
+                adc_y_reg <= (others => '0');
+                nco_acc_reg <= (others => '0');
+                freq_reg <= (others => '0');
+                residue_reg <= (others => (others => '0'));
+                read_zero_reg <= '0';
+                read_preset_reg <= '0';
+                acc_reg <= (others => '0');
+                p_reg <= (others => '0');
+                y_reg <= (others => '0');
+                v_reg <= (others => '0');
+                drive_q_reg <= (others => '0');
+                amplitude_error_reg <= (others => '0');
+                amplitude_reg <= (others => '0');
+                c_reg <= (others => '0');
+                cic_output_reg <= (others => '0');
+                delay_reg <= (others => (others => '0'));
+                dac_x_reg <= (others => '0');
+                dac_y_reg <= (others => '0');
+                rate_reg <= (others => '0');
+                quad_reg <= (others => '0');
+                out_valid_reg <= '0';
+                inside_q_reg <= '0';
+                lock_count_reg <= (others => '0');
+                locked_reg <= '0';
+            end if;
+        end if;
+    end process;
+
+    dac_x <= dac_x_reg;
+    dac_y <= dac_y_reg;
+    rate <= rate_reg;
+    quadrature <= quad_reg;
+    out_valid <= out_valid_reg;
+    locked <= locked_reg;
+
+    -- pragma translate_off
+    -- Simulation only: a sample takes the schedule's clocks (gyrofx_job::pipeline); a sooner
+    -- ce stops the simulation, naming this instance.
+    spacing_check : entity work.gyrofx_spacing_check
+        generic map (
+            MIN_CLOCKS_PER_SAMPLE => SCHEDULE_LEN + 1, BLOCK_NAME => "gyrofx_gyro_loop_serial"
+        )
+        port map (clk => clk, rst => rst, ce => ce);
+    -- pragma translate_on
+end architecture;
