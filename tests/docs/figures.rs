@@ -225,6 +225,13 @@ fn the_pipeline_clocks_the_guide_quotes_are_the_codes() {
             mean_filter_serial.latency_clocks
         ),
     );
+    assert_quotes(
+        config,
+        &format!(
+            "the loop's ADC samples every {} clocks by default",
+            pipeline::gyro_loop(&serial).min_clocks_per_sample
+        ),
+    );
     let place = "how-to/place-and-route.md";
     assert_quotes(
         place,
@@ -1033,4 +1040,43 @@ fn the_readme_states_the_rust_version_the_workspace_needs() {
         .and_then(|rest| rest.strip_suffix('"'))
         .expect("Cargo.toml has a rust-version");
     assert_quotes("README.md", &format!("(Rust {version} or later)"));
+}
+
+/// The folded gyro loop's page quotes the default config's schedule (each template's clocks, the
+/// regular and decimating lengths) and pipeline as the model derives them.
+#[test]
+fn the_folded_loop_schedule_the_page_quotes_is_the_models() {
+    use gyrofx_job::config::Config;
+    use gyrofx_job::job::Job;
+    use gyrofx_job::pipeline;
+
+    let serial = Job::new(Config::embedded())
+        .unwrap()
+        .serial_variant()
+        .unwrap();
+    let schedule = serial.loop_schedule.as_ref().unwrap();
+    let page =
+        std::fs::read_to_string(super::repository().join("docs/blocks/gyro_loop.md")).unwrap();
+    for p in &schedule.placements {
+        let row = format!("| {} | {}–{} |", p.name, p.first, p.last);
+        assert!(
+            page.contains(&row),
+            "docs/blocks/gyro_loop.md should have the row {row}"
+        );
+    }
+    let pipeline = pipeline::gyro_loop(&serial);
+    for quote in [
+        format!("Every sample runs the first {} clocks", schedule.regular),
+        format!("all\n{} clocks.", schedule.len()).replace('\n', " "),
+        format!(
+            "`latency_clocks` = `min_clocks_per_sample` = {} on the default",
+            pipeline.latency_clocks
+        ),
+    ] {
+        let flat = page.split_whitespace().collect::<Vec<_>>().join(" ");
+        assert!(
+            flat.contains(&quote),
+            "docs/blocks/gyro_loop.md should say {quote:?}"
+        );
+    }
 }
