@@ -22,25 +22,29 @@ fn first_difference(plan: &Plan, inputs: &[([i64; 2], Mode)]) -> Option<(usize, 
     None
 }
 
-#[test]
-fn the_default_loop_folds_bit_for_bit_through_lock_and_a_switch() {
+/// The default plan and the ADC codes and modes of its closed loop at 10 °/s from reset,
+/// `samples` long with the switch to reverse mode half way; whether the loop locked.
+fn default_closed_loop(samples: usize) -> (Plan, Vec<([i64; 2], Mode)>, bool) {
     let spec = Spec::paper_004();
     let plan = Plan::new(&spec).unwrap();
-    let samples = record(
+    let run = record(
         &plan,
         &spec.resonator,
         &spec.front_end,
         7,
         10.0,
-        40_000,
-        20_000,
-    )
-    .unwrap();
-    assert!(
-        samples.iter().any(|s| s.locked),
-        "the recording never locks"
+        samples,
+        samples / 2,
     );
-    let inputs: Vec<_> = samples.iter().map(|s| (s.adc, s.mode)).collect();
+    let run = run.unwrap();
+    let locked = run.iter().any(|s| s.locked);
+    (plan, run.iter().map(|s| (s.adc, s.mode)).collect(), locked)
+}
+
+#[test]
+fn the_default_loop_folds_bit_for_bit_through_lock_and_a_switch() {
+    let (plan, inputs, locked) = default_closed_loop(40_000);
+    assert!(locked, "the recording never locks");
     assert_eq!(first_difference(&plan, &inputs), None);
 }
 
@@ -54,19 +58,7 @@ fn the_default_schedule_fits_a_sample_at_24_mhz() {
 
 #[test]
 fn a_schedule_missing_one_write_is_caught() {
-    let spec = Spec::paper_004();
-    let plan = Plan::new(&spec).unwrap();
-    let samples = record(
-        &plan,
-        &spec.resonator,
-        &spec.front_end,
-        7,
-        10.0,
-        4_000,
-        2_000,
-    )
-    .unwrap();
-    let inputs: Vec<_> = samples.iter().map(|s| (s.adc, s.mode)).collect();
+    let (plan, inputs, _) = default_closed_loop(4_000);
     let schedule = Schedule::new(&plan).unwrap();
     // Drop the PLL integrator's write-back: the loop then never integrates its phase error.
     let mut broken = schedule.clone();
