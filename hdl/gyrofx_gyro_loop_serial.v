@@ -281,6 +281,8 @@ localparam integer R_W = (NCO_PHASE_W > T_W) ? NCO_PHASE_W - T_W : 1;
 localparam integer DELAY_N = LATENCY > 0 ? LATENCY : 1;
 localparam integer MOST_SEEN = CIC_TAPS - 1 > CIC_DELAY ? CIC_TAPS - 1 : CIC_DELAY;
 localparam integer CNT_W = ceil_log2(CIC_DECIMATION);
+// The lock count: 0 ..= LOCK_HOLD.
+localparam integer COUNT_W = LOCK_HOLD > 0 ? ceil_log2(LOCK_HOLD + 1) : 1;
 localparam integer PC_W = SCHEDULE_LEN > 1 ? ceil_log2(SCHEDULE_LEN) : 1;
 localparam integer RAM_ADDR_W = RAM_WORDS > 1 ? ceil_log2(RAM_WORDS) : 1;
 localparam integer TAP_ADDR_W = CIC_TAPS > 1 ? ceil_log2(CIC_TAPS) : 1;
@@ -699,13 +701,32 @@ wire signed [AGC_RND_W-1:0] agc_clamped =
 /* verilator lint_on UNUSEDSIGNAL */
 wire signed [AGC_INT_W-1:0] agc_v_next = agc_clamped[AGC_INT_W-1:0];
 
-// The lock filters' check |z| < limit, in 66 bits (Z_W <= 64, 64-bit limits).
+// The lock filters' check |z| < limit as -limit < z < limit: two comparisons side by side, not
+// a negation then one, in Z_W + 2 bits. |z| < 2^(Z_W-1), so a limit clipped to +-2^Z_W decides
+// as the 64-bit one does.
+localparam integer CMP_W = Z_W + 2;
+function signed [CMP_W-1:0] clipped;
+    input signed [63:0] limit;
+    reg signed [66:0] wide;
+    reg signed [66:0] cap;
+    begin
+        wide = {{3{limit[63]}}, limit};
+        cap = 67'sd1 <<< Z_W;
+        wide = wide > cap ? cap : (wide < -cap ? -cap : wide);
+        clipped = wide[CMP_W-1:0];
+    end
+endfunction
+localparam signed [CMP_W-1:0] LIMIT_Q_N = clipped(LOCK_Q_N);
+localparam signed [CMP_W-1:0] LIMIT_Q_R = clipped(LOCK_Q_R);
+localparam signed [CMP_W-1:0] LIMIT_A_N = clipped(LOCK_A_N);
+localparam signed [CMP_W-1:0] LIMIT_A_R = clipped(LOCK_A_R);
 wire signed [Z_W-1:0] z = acc_reg[Z_W-1:0];
-wire signed [65:0] z_wide = {{(66-Z_W){z[Z_W-1]}}, z};
-wire signed [65:0] z_abs = z_wide < 66'sd0 ? -z_wide : z_wide;
-wire signed [63:0] lock_limit = quantize_field == 4'd14 ? (mode_reg ? LOCK_Q_N : LOCK_Q_R)
-                                                        : (mode_reg ? LOCK_A_N : LOCK_A_R);
-wire within_limit = z_abs < {{2{lock_limit[63]}}, lock_limit};
+wire signed [CMP_W-1:0] z_cmp = {{2{z[Z_W-1]}}, z};
+wire signed [CMP_W-1:0] lock_limit = quantize_field == 4'd14 ? (mode_reg ? LIMIT_Q_N : LIMIT_Q_R)
+                                                           : (mode_reg ? LIMIT_A_N : LIMIT_A_R);
+wire signed [CMP_W-1:0] lock_floor = quantize_field == 4'd14 ? (mode_reg ? -LIMIT_Q_N : -LIMIT_Q_R)
+                                                           : (mode_reg ? -LIMIT_A_N : -LIMIT_A_R);
+wire within_limit = z_cmp < lock_limit && z_cmp > lock_floor;
 
 // ---- RAM writes ---------------------------------------------------------------------------
 wire signed [RAM_W-1:0] write_data =
@@ -735,11 +756,18 @@ reg signed [OUT_W-1:0] rate_reg = {OUT_W{1'b0}};
 reg signed [OUT_W-1:0] quad_reg = {OUT_W{1'b0}};
 reg out_valid_reg = 1'b0;
 reg inside_q_reg = 1'b0;
-reg [31:0] lock_count_reg = 32'd0;
+// Both filters' check, registered at the second one's point: the count and locked load on the
+// clock after it, so that no clock runs the comparison and the count's increment in series.
+reg inside_reg = 1'b0;
+reg count_pending_reg = 1'b0;
+reg [COUNT_W-1:0] lock_count_reg = {COUNT_W{1'b0}};
 reg locked_reg = 1'b0;
-wire [31:0] lock_hold = LOCK_HOLD;
-wire [31:0] lock_count_next = inside_q_reg && within_limit
-    ? (lock_count_reg >= lock_hold ? lock_hold : lock_count_reg + 32'd1) : 32'd0;
+/* verilator lint_off UNUSEDSIGNAL */
+wire [31:0] lock_hold_word = LOCK_HOLD;
+/* verilator lint_on UNUSEDSIGNAL */
+wire [COUNT_W-1:0] lock_hold = lock_hold_word[COUNT_W-1:0];
+wire [COUNT_W-1:0] lock_count_next = inside_reg
+    ? (lock_count_reg >= lock_hold ? lock_hold : lock_count_reg + 1'b1) : {COUNT_W{1'b0}};
 
 integer i;
 initial begin
@@ -764,7 +792,7 @@ always @(posedge clk) begin
         decimate_reg <= count_reg == last_count[CNT_W-1:0];
         count_reg <= count_reg == last_count[CNT_W-1:0] ? {CNT_W{1'b0}} : count_reg + 1'b1;
         if (switching) begin
-            lock_count_reg <= 32'd0;
+            lock_count_reg <= {COUNT_W{1'b0}};
             for (i = 0; i < DELAY_N; i = i + 1) begin
                 delay_reg[i] <= {DAC_W{1'b0}};
             end
@@ -822,13 +850,15 @@ always @(posedge clk) begin
             out_valid_reg <= 1'b1;
         end
         4'd14: inside_q_reg <= within_limit;
-        4'd15: begin
-            lock_count_reg <= lock_count_next;
-            locked_reg <= lock_count_next >= lock_hold;
-        end
+        4'd15: inside_reg <= inside_q_reg && within_limit;
         default: begin
         end
     endcase
+    count_pending_reg <= point == 4'd15;
+    if (count_pending_reg) begin
+        lock_count_reg <= lock_count_next;
+        locked_reg <= lock_count_next >= lock_hold;
+    end
 
     if (rst) begin
         busy_reg <= 1'b0;
@@ -867,7 +897,9 @@ always @(posedge clk) begin
         quad_reg <= {OUT_W{1'b0}};
         out_valid_reg <= 1'b0;
         inside_q_reg <= 1'b0;
-        lock_count_reg <= 32'd0;
+        inside_reg <= 1'b0;
+        count_pending_reg <= 1'b0;
+        lock_count_reg <= {COUNT_W{1'b0}};
         locked_reg <= 1'b0;
     end
 end

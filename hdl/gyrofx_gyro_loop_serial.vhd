@@ -365,6 +365,27 @@ architecture rtl of gyrofx_gyro_loop_serial is
     constant LOCK_A_N_C : signed(63 downto 0) := signed(code_of("LOCK_A_N", LOCK_A_N, 64));
     constant LOCK_A_R_C : signed(63 downto 0) := signed(code_of("LOCK_A_R", LOCK_A_R, 64));
 
+    -- The lock filters' check |z| < limit as -limit < z < limit, in Z_W + 2 bits: |z| <
+    -- 2^(Z_W-1), so a limit clipped to +-2^Z_W decides as the 64-bit one does.
+    constant CMP_W : positive := Z_W + 2;
+    function clipped(limit : signed(63 downto 0)) return signed is
+        variable wide : signed(66 downto 0) := resize(limit, 67);
+        constant CAP : signed(66 downto 0) := shift_left(to_signed(1, 67), Z_W);
+    begin
+        if wide > CAP then
+            wide := CAP;
+        elsif wide < -CAP then
+            wide := -CAP;
+        end if;
+        return wide(CMP_W - 1 downto 0);
+    end function;
+    constant LIMIT_Q_N : signed(CMP_W - 1 downto 0) := clipped(LOCK_Q_N_C);
+    constant LIMIT_Q_R : signed(CMP_W - 1 downto 0) := clipped(LOCK_Q_R_C);
+    constant LIMIT_A_N : signed(CMP_W - 1 downto 0) := clipped(LOCK_A_N_C);
+    constant LIMIT_A_R : signed(CMP_W - 1 downto 0) := clipped(LOCK_A_R_C);
+    -- The lock count: 0 ..= LOCK_HOLD.
+    constant COUNT_W : positive := maximum(ceil_log2(LOCK_HOLD + 1), 1);
+
     -- The PI integrators' limits at the rounded update's width, for the clamps.
     constant PLL_LOW : signed(PLL_RND_W - 1 downto 0) := resize(PLL_INT_MIN_C, PLL_RND_W);
     constant PLL_HIGH : signed(PLL_RND_W - 1 downto 0) := resize(PLL_INT_MAX_C, PLL_RND_W);
@@ -527,8 +548,9 @@ architecture rtl of gyrofx_gyro_loop_serial is
     signal agc_clamped : signed(AGC_RND_W - 1 downto 0);
     signal agc_v_next : signed(AGC_INT_W - 1 downto 0);
     signal z : signed(Z_W - 1 downto 0);
-    signal z_abs : signed(65 downto 0);
-    signal lock_limit : signed(63 downto 0);
+    signal z_cmp : signed(CMP_W - 1 downto 0);
+    signal lock_limit : signed(CMP_W - 1 downto 0);
+    signal lock_floor : signed(CMP_W - 1 downto 0);
     signal within_limit : std_logic;
 
     -- ---- the sample, the registers the points load, the outputs ----
@@ -540,9 +562,13 @@ architecture rtl of gyrofx_gyro_loop_serial is
     signal quad_reg : signed(OUT_W - 1 downto 0) := (others => '0');
     signal out_valid_reg : std_logic := '0';
     signal inside_q_reg : std_logic := '0';
-    signal lock_count_reg : unsigned(31 downto 0) := (others => '0');
+    -- Both filters' check, registered at the second one's point: the count and locked load on
+    -- the clock after it, so that no clock runs the comparison and the increment in series.
+    signal inside_reg : std_logic := '0';
+    signal count_pending_reg : std_logic := '0';
+    signal lock_count_reg : unsigned(COUNT_W - 1 downto 0) := (others => '0');
     signal locked_reg : std_logic := '0';
-    signal lock_count_next : unsigned(31 downto 0);
+    signal lock_count_next : unsigned(COUNT_W - 1 downto 0);
 
 begin
 
@@ -916,17 +942,18 @@ begin
                    agc_rounded;
     agc_v_next <= agc_clamped(AGC_INT_W - 1 downto 0);
 
-    -- The lock filters' check |z| < limit, in 66 bits (Z_W <= 64, 64-bit limits). The Verilog
-    -- compares with the limit's 66-bit sign extension as an unsigned number (a concatenation):
-    -- the same for the limits gyrofx writes (positive); kept, so that a negative one reads
-    -- as the Verilog's does.
+    -- The lock filters' check, -limit < z < limit (CMP_W, LIMIT_*).
     z <= acc_reg(Z_W - 1 downto 0);
-    z_abs <= abs(resize(z, 66));
-    lock_limit <= LOCK_Q_N_C when quantize_field = 14 and mode_reg = '1' else
-                  LOCK_Q_R_C when quantize_field = 14 else
-                  LOCK_A_N_C when mode_reg = '1' else
-                  LOCK_A_R_C;
-    within_limit <= '1' when unsigned(z_abs) < unsigned(resize(lock_limit, 66)) else '0';
+    z_cmp <= resize(z, CMP_W);
+    lock_limit <= LIMIT_Q_N when quantize_field = 14 and mode_reg = '1' else
+                  LIMIT_Q_R when quantize_field = 14 else
+                  LIMIT_A_N when mode_reg = '1' else
+                  LIMIT_A_R;
+    lock_floor <= -LIMIT_Q_N when quantize_field = 14 and mode_reg = '1' else
+                  -LIMIT_Q_R when quantize_field = 14 else
+                  -LIMIT_A_N when mode_reg = '1' else
+                  -LIMIT_A_R;
+    within_limit <= '1' when z_cmp < lock_limit and z_cmp > lock_floor else '0';
 
     -- ---- RAM writes (and its registered read, before this clock's write) ----
     read_address <= read_address_field(RAM_ADDR_W - 1 downto 0);
@@ -966,8 +993,8 @@ begin
     -- The DAC code of sample k is output at sample k + LATENCY; delay_reg(j) holds sample
     -- k-1-j's.
     dac_now <= drive when LATENCY = 0 else delay_reg(DELAY_N - 1);
-    lock_count_next <= (others => '0') when inside_q_reg = '0' or within_limit = '0' else
-                       to_unsigned(LOCK_HOLD, 32) when lock_count_reg >= LOCK_HOLD else
+    lock_count_next <= (others => '0') when inside_reg = '0' else
+                       to_unsigned(LOCK_HOLD, COUNT_W) when lock_count_reg >= LOCK_HOLD else
                        lock_count_reg + 1;
 
     -- Later assignments win, as with the Verilog's nonblocking ones: a point's load over the
@@ -1056,16 +1083,23 @@ begin
                     quad_reg <= rate_next;
                     out_valid_reg <= '1';
                 when 14 => inside_q_reg <= within_limit;
-                when 15 =>
-                    lock_count_reg <= lock_count_next;
-                    if lock_count_next >= LOCK_HOLD then
-                        locked_reg <= '1';
-                    else
-                        locked_reg <= '0';
-                    end if;
+                when 15 => inside_reg <= inside_q_reg and within_limit;
                 when others =>
                     null;
             end case;
+            if point = 15 then
+                count_pending_reg <= '1';
+            else
+                count_pending_reg <= '0';
+            end if;
+            if count_pending_reg = '1' then
+                lock_count_reg <= lock_count_next;
+                if lock_count_next >= LOCK_HOLD then
+                    locked_reg <= '1';
+                else
+                    locked_reg <= '0';
+                end if;
+            end if;
 
             if rst = '1' then
                 busy_reg <= '0';
@@ -1100,6 +1134,8 @@ begin
                 quad_reg <= (others => '0');
                 out_valid_reg <= '0';
                 inside_q_reg <= '0';
+                inside_reg <= '0';
+                count_pending_reg <= '0';
                 lock_count_reg <= (others => '0');
                 locked_reg <= '0';
             end if;
