@@ -1071,7 +1071,7 @@ pub unsafe extern "C" fn gyrofx_gyro_loop_new(
         new(plan, |job| {
             GyrofxGyroLoop(
                 golden::GyroLoop::new(&job.gyro_loops[index].plan),
-                pipeline::GYRO_LOOP,
+                pipeline::gyro_loop(job),
             )
         })
     }

@@ -142,11 +142,12 @@ impl Plan {
         ChainFloat::new(&self.job.chain, ideal)
     }
 
-    /// One gyro's digital loop (`gyrofx_gyro_loop`): gyro `"a"` (the block's vectors and RTL
+    /// One gyro's digital loop (`gyrofx_gyro_loop`, or `gyrofx_gyro_loop_serial`'s timing with
+    /// `architecture = "serial"`): gyro `"a"` (the block's vectors and RTL
     /// parameters) or `"b"`.
     #[pyo3(signature = (gyro = "a"))]
     fn gyro_loop(&self, gyro: &str) -> PyResult<GyroLoop> {
-        Ok(GyroLoop::new(&self.gyro(gyro)?.plan, pipeline::GYRO_LOOP))
+        Ok(GyroLoop::new(&self.gyro(gyro)?.plan, pipeline::gyro_loop(&self.job)))
     }
 
     /// The loop's float twin, gyro `"a"` or `"b"`.
