@@ -210,7 +210,8 @@ class Plan:
     def chain(self) -> Chain: ...
     def chain_float(self, ideal: bool = False) -> ChainFloat: ...
     def gyro_loop(self, gyro: str = "a") -> GyroLoop:
-        """Gyro "a"'s (the block's vectors) or "b"'s digital loop."""
+        """Gyro "a"'s (the block's vectors) or "b"'s digital loop; its ``latency_clocks`` and
+        ``min_clocks_per_sample`` are the folded loop's with ``architecture = "serial"``."""
     def gyro_loop_float(self, gyro: str = "a") -> GyroLoopFloat: ...
     def system(self) -> System:
         """Both loops and the chain (resonator plants only)."""
