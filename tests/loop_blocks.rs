@@ -665,3 +665,57 @@ fn the_folded_loops_rtl_defaults_are_the_parallel_loops_and_the_default_schedule
         }
     }
 }
+
+/// Each `<field>_field` the folded loop's RTL (both languages) slices out of the control word is
+/// the field of the model's layout (`folded::FIELDS`: name, width, offset from bit 0), and every
+/// field the layout has is sliced (but the spare bit, always 0), so a moved or resized field
+/// fails here.
+#[test]
+fn the_folded_loops_rtl_slices_the_models_control_word_fields() {
+    use gyrofx_model::gyro_loop::folded::FIELDS;
+
+    let mut offset = 0;
+    let layout: Vec<(String, u32, u32)> = FIELDS
+        .iter()
+        .map(|&(name, width)| {
+            offset += width;
+            (name.to_string(), offset - 1, offset - width)
+        })
+        .filter(|(name, ..)| name != "spare")
+        .collect();
+    for language in ["v", "vhd"] {
+        let text =
+            std::fs::read_to_string(hdl(&format!("gyrofx_gyro_loop_serial.{language}"))).unwrap();
+        let mut sliced = Vec::new();
+        for line in text.lines() {
+            let Some((left, right)) = line.split_once("control_reg") else {
+                continue;
+            };
+            let Some(name) = left
+                .split_whitespace()
+                .find_map(|word| word.strip_suffix("_field"))
+            else {
+                continue;
+            };
+            let bounds: String = right
+                .chars()
+                .skip(1)
+                .take_while(|c| *c != ']' && *c != ')')
+                .collect();
+            let numbers: Vec<u32> = bounds
+                .split(|c: char| !c.is_ascii_digit())
+                .filter(|s| !s.is_empty())
+                .map(|s| s.parse().unwrap())
+                .collect();
+            let (high, low) = match numbers[..] {
+                [bit] => (bit, bit),
+                [high, low] => (high, low),
+                _ => panic!("{language}: {line}"),
+            };
+            if name != "spare" {
+                sliced.push((name.to_string(), high, low));
+            }
+        }
+        assert_eq!(sliced, layout, "gyrofx_gyro_loop_serial.{language}");
+    }
+}

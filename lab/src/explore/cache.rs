@@ -137,11 +137,14 @@ impl Costs {
     }
 }
 
-/// The module name of `design` of `job` (the chain's follows its `architecture`).
+/// The module name of `design` of `job` (the chain's and the loop's follow its `architecture`).
 fn module(job: &Job, design: Design) -> &'static str {
     match design {
         Design::Chain if job.serial.is_some() => "gyrofx_top_serial",
         Design::Chain => synth::TOP,
+        Design::GyroLoop if job.loop_schedule.is_some() => {
+            gyrofx_codegen::blocks::gyro_loop::SERIAL_MODULE
+        }
         Design::GyroLoop => gyrofx_codegen::design::LOOP_TOP,
     }
 }

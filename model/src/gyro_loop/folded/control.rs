@@ -27,9 +27,10 @@
 //! | 59–62 | `quantize` | [`Quantize`]: the quantization point that fires |
 //! | 63 | `spare` | 0 |
 
-/// Width of a limb of the multiplier's operands, bits: `15` unsigned bits fit a signed 16×16
-/// multiplier (one SB_MAC16, one DSP48 slice) with a zero sign bit.
-pub const LIMB_BITS: u32 = 15;
+/// Width of a limb of the multiplier's operands, bits: the serial chain's, for the same reason
+/// (15 unsigned bits fit a signed 16×16 multiplier, one SB_MAC16 or DSP48 slice, with a zero
+/// sign bit).
+pub use crate::serial::isa::LIMB_BITS;
 
 /// Width of the control word, bits.
 pub const CONTROL_BITS: u32 = 64;

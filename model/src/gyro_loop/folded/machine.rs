@@ -281,11 +281,6 @@ impl FoldedGyroLoop {
         &self.schedule
     }
 
-    /// The datapath's widths.
-    pub fn datapath(&self) -> Datapath {
-        self.datapath
-    }
-
     /// The lock flag.
     pub fn locked(&self) -> bool {
         self.locked

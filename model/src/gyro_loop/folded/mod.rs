@@ -54,21 +54,15 @@ pub fn limbs(width: u32) -> u32 {
     width.saturating_sub(1).div_ceil(LIMB_BITS).max(1)
 }
 
-/// The widths the folded datapath needs for `plan`.
+/// The widths the folded datapath needs for `plan`, as the RTL derives them from its
+/// parameters.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Datapath {
-    /// The accumulator: every exact sum of the loop fits.
+    /// The accumulator: every exact sum of the loop and a limb's product fit, with a guard bit
+    /// (so that every value sign-extends into it in Verilog-2001).
     pub accumulator_width: u32,
-    /// A RAM word: every state fits.
-    pub ram_width: u32,
     /// The lock filters' `z`: `W_out + s + 1` bits.
     pub lock_width: u32,
-    /// Widest `b` operand.
-    pub b_width: u32,
-    /// Multipliers (`b` limbs).
-    pub multipliers: u32,
-    /// Widest `a` operand.
-    pub a_width: u32,
 }
 
 impl Datapath {
@@ -91,14 +85,6 @@ impl Datapath {
             plan.output.from.width,
             lock_width,
         ];
-        let states = [
-            demod.state.to.width,
-            plan.pll.integrator.width,
-            plan.agc.integrator.width,
-            lock_width,
-            cic.register.width,
-            cic.cic.to.width,
-        ];
         let b_width = [
             plan.nco.output.width,
             plan.pll.kp.format.width,
@@ -107,32 +93,16 @@ impl Datapath {
             plan.agc.ki.format.width,
             cic.taps[0].format.width,
             plan.modes[0].rate_coefficient.format.width,
+            plan.modes[0].quadrature_coefficient.format.width,
         ]
         .into_iter()
         .max()
         .unwrap_or(1);
-        let a_width = [
-            plan.adc.width,
-            demod.output.to.width,
-            plan.agc_error.to.width,
-            plan.agc.output.to.width,
-            cic.cic.to.width,
-            cic.output.to.width,
-        ]
-        .into_iter()
-        .max()
-        .unwrap_or(1);
-        let multipliers = limbs(b_width);
-        // The product of a limb and b, and (as the RTL has them) a guard bit above the widest
-        // value, so that every value sign-extends into the accumulator and a RAM word.
-        let product = 16 + LIMB_BITS * multipliers + 2;
+        // A limb's product with all of b: 16 bits times b's limbs and a guard bit.
+        let product = 16 + LIMB_BITS * limbs(b_width) + 2;
         Datapath {
             accumulator_width: sums.into_iter().max().unwrap_or(1).max(product) + 1,
-            ram_width: states.into_iter().max().unwrap_or(1) + 1,
             lock_width,
-            b_width,
-            multipliers,
-            a_width,
         }
     }
 }

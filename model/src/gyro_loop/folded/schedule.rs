@@ -11,6 +11,7 @@ use super::control::{
     RomRead, Write, WriteData, ADDRESS_BITS,
 };
 use super::limbs;
+use crate::gyro_loop::cic::{MAX_STAGES, MAX_TAPS};
 use crate::gyro_loop::gyro::Plan;
 
 /// The RAM's words: where each state lives.
@@ -74,17 +75,16 @@ impl Words {
     }
 }
 
+// The most states a plan has (eight words of the demodulators, PIs and lock filters, then per
+// CIC its integrators, combs and delay line) fit a control word's address.
+const _: () = assert!(
+    8 + 2 * (2 * MAX_STAGES + MAX_TAPS - 1) <= 1 << ADDRESS_BITS,
+    "a plan's states outgrow the control word's RAM address"
+);
+
 /// Why a plan has no folded schedule.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum ScheduleError {
-    /// The states need more RAM words than a control word can address.
-    #[error("the folded loop needs {words} RAM words; a control word addresses {limit}")]
-    Words {
-        /// Words needed.
-        words: usize,
-        /// Words addressable.
-        limit: usize,
-    },
     /// The loop's CICs have a differential delay of 1; the schedule has no other.
     #[error("the folded loop's CICs need a differential delay of 1, not {0}")]
     DifferentialDelay(u32),
@@ -632,7 +632,7 @@ impl Schedule {
     /// The schedule of `plan`'s folded loop.
     ///
     /// # Errors
-    /// [`ScheduleError`] when the states need more RAM words than a control word addresses.
+    /// [`ScheduleError`] for a CIC whose differential delay is not 1.
     pub fn new(plan: &Plan) -> Result<Schedule, ScheduleError> {
         let cic_plan = &plan.cic;
         let taps = cic_plan.taps.len();
@@ -642,13 +642,6 @@ impl Schedule {
             ));
         }
         let words = Words::new(cic_plan.stages as usize, taps);
-        let limit = 1usize << ADDRESS_BITS;
-        if words.count() > limit {
-            return Err(ScheduleError::Words {
-                words: words.count(),
-                limit,
-            });
-        }
         let widths = Widths {
             adc: plan.demodulator.input.width,
             demod_output: plan.demodulator.output.to.width,
