@@ -147,7 +147,10 @@ impl Plan {
     /// parameters) or `"b"`.
     #[pyo3(signature = (gyro = "a"))]
     fn gyro_loop(&self, gyro: &str) -> PyResult<GyroLoop> {
-        Ok(GyroLoop::new(&self.gyro(gyro)?.plan, pipeline::gyro_loop(&self.job)))
+        Ok(GyroLoop::new(
+            &self.gyro(gyro)?.plan,
+            pipeline::gyro_loop(&self.job),
+        ))
     }
 
     /// The loop's float twin, gyro `"a"` or `"b"`.
