@@ -18,14 +18,21 @@
  *   gyrofx_model::gyro_loop::folded::Control):
  *     sine ROM read:  ref <= +/-ROM[address of acc_nco + offset + residue], a cosine read
  *                     also stores that reference's truncation error (error feedback)
- *     multiplier:     prod_j <= limb_k(a) * b_limb_j (j < B_LIMBS, signed 16x16 each),
- *                     pp <= sum_j prod_j << 15j          (a 15-bit limb of a times all of b)
- *     accumulator:    acc <= x + y                       (x: acc, 0, RAM word, setpoint, PI
- *                     integrator aligned; y: pp << 15k, -RAM word, p, -I, I, ...)
+ *     multiplier:     a_limb <= limb_k(a), b <= b           (operand registers; the issue)
+ *                     prod_j <= a_limb * b_limb_j         (j < B_LIMBS, signed 16x16 each)
+ *                     pp <= (sum_j prod_j << 15j) << (15k + the PI's alignment)
+ *                     (a 15-bit limb of a times all of b, at its weight, three clocks
+ *                     after its issue; the weight travels with it)
+ *     accumulator:    acc <= x + y                        (x: acc, 0, RAM word, setpoint, PI
+ *                     integrator aligned; y: pp, -RAM word, p, -I, I, ...)
  *     RAM:            rd <= ram[read address] (0, or the PLL preset, when its gate says);
  *                     ram[write address] <= acc, a quantized acc, rd or c
  *     quantization:   one point a clock loads its register from acc (gyrofx_quantize at
- *                     the formats of the parallel loop's point)
+ *                     the formats of the parallel loop's point); the demodulator's output
+ *                     point reads the state register y every clock into its own register
+ *     (Every multiplexer into the multiplier, the multiplier and every quantizer end in a
+ *     register before the accumulator's adder: the schedule, not the logic, takes the
+ *     clocks.)
  *   Every sample runs the schedule's first SCHEDULE_REGULAR words; a decimating one (every
  *   CIC_DECIMATION-th) all SCHEDULE_LEN.
  *
@@ -144,8 +151,8 @@ module gyrofx_gyro_loop_serial #(
     parameter CIC_ROM_FILE = "gyro_loop_cic_taps.mem",
     // the schedule: image, words, words of a sample that does not decimate, RAM words
     parameter SCHEDULE_FILE = "gyro_loop_schedule.mem",
-    parameter integer SCHEDULE_LEN = 109,
-    parameter integer SCHEDULE_REGULAR = 53,
+    parameter integer SCHEDULE_LEN = 114,
+    parameter integer SCHEDULE_REGULAR = 54,
     parameter integer RAM_WORDS = 28
 ) (
     input  wire                           clk,
@@ -356,17 +363,15 @@ wire [2:0] b_field = control_reg[14:12];
 wire [3:0] tap_field = control_reg[18:15];
 wire [3:0] x_field = control_reg[22:19];
 wire [3:0] y_field = control_reg[26:23];
-wire [2:0] product_limb_field = control_reg[29:27];
-wire [2:0] align_field = control_reg[32:30];
-wire read_field = control_reg[33];
-wire [6:0] read_address_field = control_reg[40:34];
-wire [2:0] gate_field = control_reg[43:41];
-wire [3:0] seen_field = control_reg[47:44];
-wire write_field = control_reg[48];
-wire [6:0] write_address_field = control_reg[55:49];
-wire [2:0] data_field = control_reg[58:56];
-wire [3:0] quantize_field = control_reg[62:59];
-wire spare_field = control_reg[63];
+wire read_field = control_reg[27];
+wire [6:0] read_address_field = control_reg[34:28];
+wire [2:0] gate_field = control_reg[37:35];
+wire [3:0] seen_field = control_reg[41:38];
+wire write_field = control_reg[42];
+wire [6:0] write_address_field = control_reg[49:43];
+wire [2:0] data_field = control_reg[52:50];
+wire [3:0] quantize_field = control_reg[56:53];
+wire [6:0] spare_field = control_reg[63:57];
 /* verilator lint_on UNUSEDSIGNAL */
 
 wire rom_en = busy_reg && rom_field != 3'd0;
@@ -467,7 +472,9 @@ wire signed [A_EXT_W-1:0] a_c = {{(A_EXT_W-CIC_MID_W){c_reg[CIC_MID_W-1]}}, c_re
 wire signed [A_EXT_W-1:0] a_line = {{(A_EXT_W-CIC_MID_W){rd[CIC_MID_W-1]}}, rd[CIC_MID_W-1:0]};
 wire signed [A_EXT_W-1:0] a_cic_output =
     {{(A_EXT_W-CIC_OUT_W){cic_output_reg[CIC_OUT_W-1]}}, cic_output_reg};
-// (Continuous assignments, not always @*: a simulator evaluates them at time 0 too.)
+// (Continuous assignments, not always @*: a simulator evaluates them at time 0 too. The top
+// bit, a guard bit, is never a limb's.)
+/* verilator lint_off UNUSEDSIGNAL */
 wire signed [A_EXT_W-1:0] a_value =
     a_field == 4'd1 ? a_adc_drive
     : a_field == 4'd2 ? a_adc_sense
@@ -478,10 +485,23 @@ wire signed [A_EXT_W-1:0] a_value =
     : a_field == 4'd7 ? a_line
     : a_field == 4'd8 ? a_cic_output
     : {A_EXT_W{1'b0}};
-/* verilator lint_off UNUSEDSIGNAL */
-wire signed [A_EXT_W-1:0] a_shifted = a_value >>> (15 * limb_field);
 /* verilator lint_on UNUSEDSIGNAL */
-wire signed [15:0] a_limb = top_field ? a_shifted[15:0] : {1'b0, a_shifted[14:0]};
+// Limb k of a: a chain of A_LIMBS choices (bits 15k .. 15k + 15), not a barrel shifter.
+genvar n;
+generate
+    for (n = 0; n < A_LIMBS; n = n + 1) begin : g_limb
+        wire [15:0] bits;
+        if (n == 0) begin : g_first
+            assign bits = a_value[15:0];
+        end else begin : g_next
+            assign bits = limb_field == n ? a_value[15 * n + 15:15 * n] : g_limb[n-1].bits;
+        end
+    end
+endgenerate
+/* verilator lint_off UNUSEDSIGNAL */
+wire [15:0] a_limb_bits = g_limb[A_LIMBS-1].bits;
+/* verilator lint_on UNUSEDSIGNAL */
+wire signed [15:0] a_limb = top_field ? $signed(a_limb_bits) : $signed({1'b0, a_limb_bits[14:0]});
 
 wire signed [CIC_COEF_W-1:0] tap = taps_rom[tap_field[TAP_ADDR_W-1:0]];
 wire signed [COEF_W-1:0] rate_coef = mode_reg ? RATE_COEF_N : RATE_COEF_R;
@@ -499,21 +519,37 @@ wire signed [B_EXT_W-1:0] b_value =
     : {{(B_EXT_W-COEF_W){quad_coef[COEF_W-1]}}, quad_coef};
 /* verilator lint_on UNUSEDSIGNAL */
 
-reg signed [PP_W-1:0] pp_reg = {PP_W{1'b0}};
+// The operand registers, and the product's weight with them: the limb and the PI alignment
+// its b takes (b_field 1..4: PLL ki, PLL kp, AGC ki, AGC kp).
+reg signed [15:0] a_limb_reg = 16'sd0;
+reg signed [B_EXT_W-2:0] b_reg = {(B_EXT_W-1){1'b0}};
+reg [2:0] limb_reg = 3'd0;
+reg [2:0] align_reg = 3'd0;
+reg [2:0] product_limb_reg = 3'd0;
+reg [2:0] product_align_reg = 3'd0;
+always @(posedge clk) begin
+    a_limb_reg <= a_limb;
+    b_reg <= b_value[B_EXT_W-2:0];
+    limb_reg <= limb_field;
+    align_reg <= (b_field >= 3'd1 && b_field <= 3'd4) ? b_field : 3'd0;
+    product_limb_reg <= limb_reg;
+    product_align_reg <= align_reg;
+end
+
 genvar j;
 generate
     for (j = 0; j < B_LIMBS; j = j + 1) begin : g_multiplier
         // Limb j of b: 15 unsigned bits, the top one signed; each product one 16x16.
         wire signed [15:0] b_limb;
         if (j == B_LIMBS - 1) begin : g_top
-            assign b_limb = b_value[15 * j + 15:15 * j];
+            assign b_limb = b_reg[15 * j + 15:15 * j];
         end else begin : g_low
-            assign b_limb = {1'b0, b_value[15 * j + 14:15 * j]};
+            assign b_limb = {1'b0, b_reg[15 * j + 14:15 * j]};
         end
         // No initial value: the DSP's output register has none; it loads 0 in the first clock.
         reg signed [31:0] product_reg;
         always @(posedge clk) begin
-            product_reg <= a_limb * b_limb;
+            product_reg <= a_limb_reg * b_limb;
         end
         wire signed [PP_W-1:0] product_wide = {{(PP_W-32){product_reg[31]}}, product_reg};
         // The products summed at their limbs' weights, one stage per limb.
@@ -526,8 +562,32 @@ generate
     end
 endgenerate
 
+wire signed [PP_W-1:0] product_sum = g_multiplier[B_LIMBS-1].sum;
+wire signed [ACC_W-1:0] product_acc = {{(ACC_W-PP_W){product_sum[PP_W-1]}}, product_sum};
+
+// The product at its PI's alignment, then at its limb's weight (limb 0 unshifted).
+wire signed [ACC_W-1:0] product_aligned =
+    product_align_reg == 3'd1 ? product_acc <<< PLL_KI_ALIGN
+    : product_align_reg == 3'd2 ? product_acc <<< PLL_KP_ALIGN
+    : product_align_reg == 3'd3 ? product_acc <<< AGC_KI_ALIGN
+    : product_align_reg == 3'd4 ? product_acc <<< AGC_KP_ALIGN
+    : product_acc;
+genvar k;
+generate
+    for (k = 0; k < A_LIMBS; k = k + 1) begin : g_weight
+        wire signed [ACC_W-1:0] weighted;
+        if (k == 0) begin : g_first
+            assign weighted = product_aligned;
+        end else begin : g_next
+            assign weighted = product_limb_reg == k ? product_aligned <<< (15 * k)
+                                                    : g_weight[k-1].weighted;
+        end
+    end
+endgenerate
+
+reg signed [ACC_W-1:0] pp_reg = {ACC_W{1'b0}};
 always @(posedge clk) begin
-    pp_reg <= g_multiplier[B_LIMBS-1].sum;
+    pp_reg <= g_weight[A_LIMBS-1].weighted;
 end
 
 // ---- accumulator: acc <= x + y -------------------------------------------------------------
@@ -543,11 +603,15 @@ wire signed [ACC_W-1:0] v_acc = {{(ACC_W-V_W){v_reg[V_W-1]}}, v_reg};
 wire signed [DEMOD_OUT_W-1:0] setpoint = mode_reg ? SETPOINT_N : SETPOINT_R;
 wire signed [ACC_W-1:0] setpoint_acc = {{(ACC_W-DEMOD_OUT_W){setpoint[DEMOD_OUT_W-1]}}, setpoint};
 wire signed [ACC_W-1:0] p_acc = {{(ACC_W-DEMOD_PROD_W){p_reg[DEMOD_PROD_W-1]}}, p_reg};
-wire signed [ACC_W-1:0] output_acc = {{(ACC_W-DEMOD_OUT_W){demod_output[DEMOD_OUT_W-1]}}, demod_output};
+// Q_O of the state register, registered: the value of the clock before.
+reg signed [DEMOD_OUT_W-1:0] output_reg = {DEMOD_OUT_W{1'b0}};
+always @(posedge clk) begin
+    output_reg <= demod_output;
+end
+wire signed [ACC_W-1:0] output_acc = {{(ACC_W-DEMOD_OUT_W){output_reg[DEMOD_OUT_W-1]}}, output_reg};
 wire signed [ACC_W-1:0] drive_q_acc = {{(ACC_W-DEMOD_OUT_W){drive_q_reg[DEMOD_OUT_W-1]}}, drive_q_reg};
 wire signed [ACC_W-1:0] error_acc =
     {{(ACC_W-AGC_ERR_W){amplitude_error_reg[AGC_ERR_W-1]}}, amplitude_error_reg};
-wire signed [ACC_W-1:0] pp_acc = {{(ACC_W-PP_W){pp_reg[PP_W-1]}}, pp_reg};
 
 wire signed [ACC_W-1:0] x_value =
     x_field == 4'd1 ? {ACC_W{1'b0}}
@@ -560,31 +624,9 @@ wire signed [ACC_W-1:0] x_value =
     : x_field == 4'd8 ? v_acc <<< (AGC_SUM_F - AGC_INT_F)
     : acc_reg;
 
-// The product arriving now, at its limb's weight and its PI's alignment.
-wire signed [ACC_W-1:0] pp_aligned =
-    align_field == 3'd1 ? pp_acc <<< PLL_KI_ALIGN
-    : align_field == 3'd2 ? pp_acc <<< PLL_KP_ALIGN
-    : align_field == 3'd3 ? pp_acc <<< AGC_KI_ALIGN
-    : align_field == 3'd4 ? pp_acc <<< AGC_KP_ALIGN
-    : pp_acc;
-// At limb k's weight: a chain of A_LIMBS choices (limb 0 unshifted).
-genvar k;
-generate
-    for (k = 0; k < A_LIMBS; k = k + 1) begin : g_weight
-        wire signed [ACC_W-1:0] weighted;
-        if (k == 0) begin : g_first
-            assign weighted = pp_aligned;
-        end else begin : g_next
-            assign weighted = product_limb_field == k ? pp_aligned <<< (15 * k)
-                                                      : g_weight[k-1].weighted;
-        end
-    end
-endgenerate
-wire signed [ACC_W-1:0] pp_weighted = g_weight[A_LIMBS-1].weighted;
-
 // y, and whether it enters negated (x + ~y + 1).
 wire signed [ACC_W-1:0] y_value =
-    y_field == 4'd1 ? pp_weighted
+    y_field == 4'd1 ? pp_reg
     : y_field == 4'd2 ? rd_acc
     : y_field == 4'd3 ? p_acc <<< DEMOD_ALIGN
     : (y_field == 4'd4 || y_field == 4'd5) ? output_acc
@@ -828,7 +870,7 @@ always @(posedge clk) begin
     case (point)
         4'd1: p_reg <= p_next;
         4'd2: y_reg <= y_next;
-        4'd3: drive_q_reg <= demod_output;
+        4'd3: drive_q_reg <= output_reg;
         4'd4: amplitude_error_reg <= error_next;
         4'd5: v_reg <= {{(V_W-PLL_INT_W+1){pll_v_next[PLL_INT_W-1]}}, pll_v_next[PLL_INT_W-2:0]};
         4'd6: freq_reg <= pll_out[NCO_PHASE_W-1:0];

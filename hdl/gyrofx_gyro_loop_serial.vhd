@@ -15,14 +15,21 @@
 --   gyrofx_model::gyro_loop::folded::Control):
 --     sine ROM read:  ref <= +/-ROM[address of acc_nco + offset + residue], a cosine read
 --                     also stores that reference's truncation error (error feedback)
---     multiplier:     prod_j <= limb_k(a) * b_limb_j (j < B_LIMBS, signed 16x16 each),
---                     pp <= sum_j prod_j << 15j          (a 15-bit limb of a times all of b)
---     accumulator:    acc <= x + y                       (x: acc, 0, RAM word, setpoint, PI
---                     integrator aligned; y: pp << 15k, -RAM word, p, -I, I, ...)
+--     multiplier:     a_limb <= limb_k(a), b <= b           (operand registers; the issue)
+--                     prod_j <= a_limb * b_limb_j         (j < B_LIMBS, signed 16x16 each)
+--                     pp <= (sum_j prod_j << 15j) << (15k + the PI's alignment)
+--                     (a 15-bit limb of a times all of b, at its weight, three clocks
+--                     after its issue; the weight travels with it)
+--     accumulator:    acc <= x + y                        (x: acc, 0, RAM word, setpoint, PI
+--                     integrator aligned; y: pp, -RAM word, p, -I, I, ...)
 --     RAM:            rd <= ram[read address] (0, or the PLL preset, when its gate says);
 --                     ram[write address] <= acc, a quantized acc, rd or c
 --     quantization:   one point a clock loads its register from acc (gyrofx_quantize at
---                     the formats of the parallel loop's point)
+--                     the formats of the parallel loop's point); the demodulator's output
+--                     point reads the state register y every clock into its own register
+--     (Every multiplexer into the multiplier, the multiplier and every quantizer end in a
+--     register before the accumulator's adder: the schedule, not the logic, takes the
+--     clocks.)
 --   Every sample runs the schedule's first SCHEDULE_REGULAR words; a decimating one (every
 --   CIC_DECIMATION-th) all SCHEDULE_LEN.
 --
@@ -154,8 +161,8 @@ entity gyrofx_gyro_loop_serial is
         CIC_ROM_FILE : string := "gyro_loop_cic_taps.mem";
         -- the schedule: image, words, words of a sample that does not decimate, RAM words
         SCHEDULE_FILE : string := "gyro_loop_schedule.mem";
-        SCHEDULE_LEN : positive := 109;
-        SCHEDULE_REGULAR : positive := 53;
+        SCHEDULE_LEN : positive := 114;
+        SCHEDULE_REGULAR : positive := 54;
         RAM_WORDS : positive := 28
     );
     port (
@@ -439,7 +446,7 @@ architecture rtl of gyrofx_gyro_loop_serial is
     signal fetch_address : unsigned(PC_W - 1 downto 0);
 
     -- The control word's fields (gyrofx_model::gyro_loop::folded::Control): a fixed layout,
-    -- whose widest fields a small loop does not use in full (bit 63 is spare).
+    -- whose widest fields a small loop does not use in full (bits 63 to 57 are spare).
     signal rom_field : unsigned(2 downto 0);
     signal advance_field : std_logic;
     signal a_field : unsigned(3 downto 0);
@@ -449,8 +456,6 @@ architecture rtl of gyrofx_gyro_loop_serial is
     signal tap_field : unsigned(3 downto 0);
     signal x_field : unsigned(3 downto 0);
     signal y_field : unsigned(3 downto 0);
-    signal product_limb_field : unsigned(2 downto 0);
-    signal align_field : unsigned(2 downto 0);
     signal read_field : std_logic;
     signal read_address_field : unsigned(6 downto 0);
     signal gate_field : unsigned(2 downto 0);
@@ -504,12 +509,19 @@ architecture rtl of gyrofx_gyro_loop_serial is
     signal amplitude_reg : signed(AGC_OUT_W - 1 downto 0) := (others => '0');
     signal c_reg : signed(CIC_MID_W - 1 downto 0) := (others => '0');
     signal cic_output_reg : signed(CIC_OUT_W - 1 downto 0) := (others => '0');
+    -- The operand registers, and the product's weight with them (the limb and the PI
+    -- alignment its b takes), one clock on beside the products.
+    signal a_limb_reg : signed(15 downto 0) := (others => '0');
+    signal b_reg : signed(B_EXT_W - 2 downto 0) := (others => '0');
+    signal limb_reg : unsigned(2 downto 0) := (others => '0');
+    signal align_reg : unsigned(2 downto 0) := (others => '0');
+    signal product_limb_reg : unsigned(2 downto 0) := (others => '0');
+    signal product_align_reg : unsigned(2 downto 0) := (others => '0');
     signal product_reg : product_array := (others => (others => '0'));
-    signal pp_reg : signed(PP_W - 1 downto 0) := (others => '0');
+    signal pp_reg : signed(ACC_W - 1 downto 0) := (others => '0');
     signal adc_drive : signed(DEMOD_ADC_W - 1 downto 0);
     signal adc_sense : signed(DEMOD_ADC_W - 1 downto 0);
     signal a_value : signed(A_EXT_W - 1 downto 0);
-    signal a_shifted : signed(A_EXT_W - 1 downto 0);
     signal a_limb : signed(15 downto 0);
     signal tap_address : unsigned(TAP_ADDR_W - 1 downto 0);
     signal tap : signed(CIC_COEF_W - 1 downto 0);
@@ -524,9 +536,10 @@ architecture rtl of gyrofx_gyro_loop_serial is
     signal y_reg : signed(DEMOD_STATE_W - 1 downto 0) := (others => '0');
     signal v_reg : signed(V_W - 1 downto 0) := (others => '0');
     signal demod_output : signed(DEMOD_OUT_W - 1 downto 0);
+    -- Q_O of the state register, registered: the value of the clock before.
+    signal output_reg : signed(DEMOD_OUT_W - 1 downto 0) := (others => '0');
     signal setpoint : signed(DEMOD_OUT_W - 1 downto 0);
     signal x_value : signed(ACC_W - 1 downto 0);
-    signal pp_weighted : signed(ACC_W - 1 downto 0);
     signal y_value : signed(ACC_W - 1 downto 0);
     signal y_negate : std_logic;
     signal acc_next : signed(ACC_W - 1 downto 0);
@@ -626,16 +639,14 @@ begin
     tap_field <= unsigned(control_reg(18 downto 15));
     x_field <= unsigned(control_reg(22 downto 19));
     y_field <= unsigned(control_reg(26 downto 23));
-    product_limb_field <= unsigned(control_reg(29 downto 27));
-    align_field <= unsigned(control_reg(32 downto 30));
-    read_field <= control_reg(33);
-    read_address_field <= unsigned(control_reg(40 downto 34));
-    gate_field <= unsigned(control_reg(43 downto 41));
-    seen_field <= unsigned(control_reg(47 downto 44));
-    write_field <= control_reg(48);
-    write_address_field <= unsigned(control_reg(55 downto 49));
-    data_field <= unsigned(control_reg(58 downto 56));
-    quantize_field <= unsigned(control_reg(62 downto 59));
+    read_field <= control_reg(27);
+    read_address_field <= unsigned(control_reg(34 downto 28));
+    gate_field <= unsigned(control_reg(37 downto 35));
+    seen_field <= unsigned(control_reg(41 downto 38));
+    write_field <= control_reg(42);
+    write_address_field <= unsigned(control_reg(49 downto 43));
+    data_field <= unsigned(control_reg(52 downto 50));
+    quantize_field <= unsigned(control_reg(56 downto 53));
 
     -- The word acts only while the schedule runs: the last one stays in control_reg after it.
     rom_en <= '1' when busy_reg = '1' and rom_field /= 0 else '0';
@@ -713,8 +724,23 @@ begin
             when others => a_value <= (others => '0');
         end case;
     end process;
-    a_shifted <= shift_right(a_value, 15 * to_integer(limb_field));
-    a_limb <= a_shifted(15 downto 0) when top_field = '1' else '0' & a_shifted(14 downto 0);
+    -- Limb k of a: bits 15k .. 15k + 15 (the Verilog's chain of A_LIMBS choices: a limb
+    -- field beyond A_LIMBS - 1 selects limb 0, which no schedule issues).
+    a_limb_select : process (all)
+        variable bits : signed(15 downto 0);
+    begin
+        bits := a_value(15 downto 0);
+        for n in 1 to A_LIMBS - 1 loop
+            if limb_field = to_unsigned(n, 3) then
+                bits := a_value(15 * n + 15 downto 15 * n);
+            end if;
+        end loop;
+        if top_field = '1' then
+            a_limb <= bits;
+        else
+            a_limb <= '0' & bits(14 downto 0);
+        end if;
+    end process;
 
     -- (tap_field[TAP_ADDR_W-1:0] in the Verilog: the same bits up to 16 taps.)
     tap_address <= resize(tap_field, TAP_ADDR_W);
@@ -741,27 +767,55 @@ begin
     -- Limb j of b: 15 unsigned bits, the top one signed; each product one 16x16.
     g_b_limbs : for j in 0 to B_LIMBS - 1 generate
         g_top : if j = B_LIMBS - 1 generate
-            b_limb(j) <= b_value(15 * j + 15 downto 15 * j);
+            b_limb(j) <= b_reg(15 * j + 15 downto 15 * j);
         end generate;
         g_low : if j < B_LIMBS - 1 generate
-            b_limb(j) <= '0' & b_value(15 * j + 14 downto 15 * j);
+            b_limb(j) <= '0' & b_reg(15 * j + 14 downto 15 * j);
         end generate;
     end generate;
 
-    -- The products registered, then summed at their limbs' weights into pp (the Verilog's
-    -- chain of one adder per limb, in one expression).
+    -- The operands registered; the products registered; then summed at b's limbs' weights
+    -- (the Verilog's chain of one adder per limb, in one expression), aligned for a PI and
+    -- weighted by a's limb into pp. As in the Verilog's loop, a limb k matches
+    -- product_limb_reg at k's low 3 bits.
     multiplier : process (clk)
         variable sum : signed(PP_W - 1 downto 0);
+        variable aligned : signed(ACC_W - 1 downto 0);
+        variable weighted : signed(ACC_W - 1 downto 0);
     begin
         if rising_edge(clk) then
             sum := resize(product_reg(0), PP_W);
             for j in 1 to B_LIMBS - 1 loop
                 sum := sum + shift_left(resize(product_reg(j), PP_W), 15 * j);
             end loop;
-            pp_reg <= sum;
-            for j in 0 to B_LIMBS - 1 loop
-                product_reg(j) <= a_limb * b_limb(j);
+            case to_integer(product_align_reg) is
+                when 1 => aligned := shift_left(resize(sum, ACC_W), PLL_KI_ALIGN);
+                when 2 => aligned := shift_left(resize(sum, ACC_W), PLL_KP_ALIGN);
+                when 3 => aligned := shift_left(resize(sum, ACC_W), AGC_KI_ALIGN);
+                when 4 => aligned := shift_left(resize(sum, ACC_W), AGC_KP_ALIGN);
+                when others => aligned := resize(sum, ACC_W);
+            end case;
+            weighted := aligned;
+            for k in 1 to A_LIMBS - 1 loop
+                if product_limb_reg = to_unsigned(k mod 8, 3) then
+                    weighted := shift_left(aligned, 15 * k);
+                end if;
             end loop;
+            pp_reg <= weighted;
+            for j in 0 to B_LIMBS - 1 loop
+                product_reg(j) <= a_limb_reg * b_limb(j);
+            end loop;
+            product_limb_reg <= limb_reg;
+            product_align_reg <= align_reg;
+            a_limb_reg <= a_limb;
+            b_reg <= b_value(B_EXT_W - 2 downto 0);
+            limb_reg <= limb_field;
+            if b_field >= 1 and b_field <= 4 then
+                align_reg <= b_field;
+            else
+                align_reg <= (others => '0');
+            end if;
+            output_reg <= demod_output;
         end if;
     end process;
 
@@ -783,42 +837,20 @@ begin
         end case;
     end process;
 
-    -- The product arriving now, at its PI's alignment and its limb's weight. As in the
-    -- Verilog's loop, a limb k matches product_limb_field at k's low 3 bits.
-    product_weight : process (all)
-        variable aligned : signed(ACC_W - 1 downto 0);
-        variable weighted : signed(ACC_W - 1 downto 0);
-    begin
-        case to_integer(align_field) is
-            when 1 => aligned := shift_left(resize(pp_reg, ACC_W), PLL_KI_ALIGN);
-            when 2 => aligned := shift_left(resize(pp_reg, ACC_W), PLL_KP_ALIGN);
-            when 3 => aligned := shift_left(resize(pp_reg, ACC_W), AGC_KI_ALIGN);
-            when 4 => aligned := shift_left(resize(pp_reg, ACC_W), AGC_KP_ALIGN);
-            when others => aligned := resize(pp_reg, ACC_W);
-        end case;
-        weighted := aligned;
-        for k in 1 to A_LIMBS - 1 loop
-            if product_limb_field = to_unsigned(k mod 8, 3) then
-                weighted := shift_left(aligned, 15 * k);
-            end if;
-        end loop;
-        pp_weighted <= weighted;
-    end process;
-
     -- y, and whether it enters negated (x + not y + 1).
     y_operand : process (all)
     begin
         y_negate <= '0';
         case to_integer(y_field) is
-            when 1 => y_value <= pp_weighted;
+            when 1 => y_value <= pp_reg;
             when 2 =>
                 y_value <= resize(rd, ACC_W);
                 y_negate <= '1';
             when 3 => y_value <= shift_left(resize(p_reg, ACC_W), DEMOD_ALIGN);
             when 4 =>
-                y_value <= resize(demod_output, ACC_W);
+                y_value <= resize(output_reg, ACC_W);
                 y_negate <= '1';
-            when 5 => y_value <= resize(demod_output, ACC_W);
+            when 5 => y_value <= resize(output_reg, ACC_W);
             when 6 => y_value <= resize(previous_rd_reg, ACC_W);
             when 7 =>
                 y_value <= shift_right(resize(rd, ACC_W), LOCK_SHIFT);
@@ -1058,7 +1090,7 @@ begin
             case to_integer(point) is
                 when 1 => p_reg <= p_next;
                 when 2 => y_reg <= y_next;
-                when 3 => drive_q_reg <= demod_output;
+                when 3 => drive_q_reg <= output_reg;
                 when 4 => amplitude_error_reg <= error_next;
                 when 5 => v_reg <= resize(pll_v_next, V_W);
                 when 6 => freq_reg <= unsigned(pll_out(NCO_PHASE_W - 1 downto 0));

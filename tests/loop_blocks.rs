@@ -668,7 +668,7 @@ fn the_folded_loops_rtl_defaults_are_the_parallel_loops_and_the_default_schedule
 
 /// Each `<field>_field` the folded loop's RTL (both languages) slices out of the control word is
 /// the field of the model's layout (`folded::FIELDS`: name, width, offset from bit 0), and every
-/// field the layout has is sliced (but the spare bit, always 0), so a moved or resized field
+/// field the layout has is sliced (but the spare bits, always 0), so a moved or resized field
 /// fails here.
 #[test]
 fn the_folded_loops_rtl_slices_the_models_control_word_fields() {

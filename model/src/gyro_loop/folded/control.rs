@@ -15,17 +15,19 @@
 //! | 15–18 | `tap` | compensator tap index, for `b` = tap |
 //! | 19–22 | `x` | [`AccX`]: the accumulator's base |
 //! | 23–26 | `y` | [`AccY`]: the accumulator's addend |
-//! | 27–29 | `product_limb` | the limb of the product arriving now, for `y` = product |
-//! | 30–32 | `align` | [`Align`]: the product's extra left shift |
-//! | 33 | `read` | a RAM read this clock |
-//! | 34–40 | `read_address` | its word |
-//! | 41–43 | `gate` | [`ReadGate`]: when it reads as 0 (or the PLL preset) |
-//! | 44–47 | `seen` | for the `seen` gate: 0 until this many decimations since reset |
-//! | 48 | `write` | a RAM write this clock |
-//! | 49–55 | `write_address` | its word |
-//! | 56–58 | `data` | [`WriteData`]: what is written |
-//! | 59–62 | `quantize` | [`Quantize`]: the quantization point that fires |
-//! | 63 | `spare` | 0 |
+//! | 27 | `read` | a RAM read this clock |
+//! | 28–34 | `read_address` | its word |
+//! | 35–37 | `gate` | [`ReadGate`]: when it reads as 0 (or the PLL preset) |
+//! | 38–41 | `seen` | for the `seen` gate: 0 until this many decimations since reset |
+//! | 42 | `write` | a RAM write this clock |
+//! | 43–49 | `write_address` | its word |
+//! | 50–52 | `data` | [`WriteData`]: what is written |
+//! | 53–56 | `quantize` | [`Quantize`]: the quantization point that fires |
+//! | 57–63 | `spare` | 0 |
+//!
+//! A product's weight (its limb's `2^(15·limb)` and a PI's alignment, which follows from
+//! its `b`, [`BSource::alignment`]) travels with it down the multiplier's pipeline, so the
+//! accumulator's `y` = product needs no field of its own.
 
 /// Width of a limb of the multiplier's operands, bits: the serial chain's, for the same reason
 /// (15 unsigned bits fit a signed 16×16 multiplier, one SB_MAC16 or DSP48 slice, with a zero
@@ -155,7 +157,7 @@ field_enum!(
         /// Zero.
         #[default]
         Zero = 0,
-        /// The product of the limb issued two clocks ago, `<< 15·product_limb + align`.
+        /// The product of the limb issued [`PRODUCT_LATENCY`] clocks ago, at its weight.
         Product = 1,
         /// Minus the RAM read register.
         NegRead = 2,
@@ -173,24 +175,6 @@ field_enum!(
         DriveQ = 8,
         /// The AGC's error.
         AmplitudeError = 9,
-    }
-);
-
-field_enum!(
-    /// An extra left shift of the product, when a PI's product has fewer fraction bits than
-    /// the sum it enters.
-    Align {
-        /// None.
-        #[default]
-        None = 0,
-        /// `ki·e` into the PLL's update.
-        PllKi = 1,
-        /// `kp·e` into the PLL's output sum.
-        PllKp = 2,
-        /// `ki·e` into the AGC's update.
-        AgcKi = 3,
-        /// `kp·e` into the AGC's output sum.
-        AgcKp = 4,
     }
 );
 
@@ -292,6 +276,12 @@ pub struct Write {
     pub data: WriteData,
 }
 
+/// Clocks from a product's issue to the clock whose accumulation adds it: the operand
+/// registers, the multiplier's output registers, then the weighted sum `pp` (each one
+/// register, so that no clock runs a multiplexer into a multiplier or a multiplier into the
+/// accumulator's adder).
+pub const PRODUCT_LATENCY: u32 = 3;
+
 /// A product issued to the multiplier: one limb of `a` times all of `b`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Issue {
@@ -307,6 +297,21 @@ pub struct Issue {
     pub tap: u8,
 }
 
+impl BSource {
+    /// The PI alignment a product with this `b` takes (the index of the folded loop's
+    /// alignment shifts: 0 none, 1 PLL `ki`, 2 PLL `kp`, 3 AGC `ki`, 4 AGC `kp`), when the
+    /// product has fewer fraction bits than the sum it enters.
+    pub const fn alignment(self) -> usize {
+        match self {
+            BSource::PllKi => 1,
+            BSource::PllKp => 2,
+            BSource::AgcKi => 3,
+            BSource::AgcKp => 4,
+            _ => 0,
+        }
+    }
+}
+
 /// An accumulator operation `acc <= x + y`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct Accumulate {
@@ -314,10 +319,6 @@ pub struct Accumulate {
     pub x: AccX,
     /// Addend.
     pub y: AccY,
-    /// For [`AccY::Product`]: the limb of the product arriving now.
-    pub product_limb: u8,
-    /// For [`AccY::Product`]: its extra shift.
-    pub align: Align,
 }
 
 /// One clock of the schedule. `None` fields leave their unit idle.
@@ -345,7 +346,7 @@ pub struct Busy(pub &'static str);
 
 /// The control word's fields, least significant first: name and width in bits (the
 /// [module doc](self)'s table; 64 bits in all).
-pub const FIELDS: [(&str, u32); 20] = [
+pub const FIELDS: [(&str, u32); 18] = [
     ("rom", 3),
     ("advance", 1),
     ("a", 4),
@@ -355,8 +356,6 @@ pub const FIELDS: [(&str, u32); 20] = [
     ("tap", 4),
     ("x", 4),
     ("y", 4),
-    ("product_limb", 3),
-    ("align", 3),
     ("read", 1),
     ("read_address", ADDRESS_BITS),
     ("gate", 3),
@@ -365,12 +364,12 @@ pub const FIELDS: [(&str, u32); 20] = [
     ("write_address", ADDRESS_BITS),
     ("data", 3),
     ("quantize", 4),
-    ("spare", 1),
+    ("spare", 7),
 ];
 
 impl Control {
     /// Each field's value, in [`FIELDS`] order.
-    pub fn fields(&self) -> [u64; 20] {
+    pub fn fields(&self) -> [u64; 18] {
         let issue = self.issue.unwrap_or(Issue {
             a: ASource::None,
             limb: 0,
@@ -395,8 +394,6 @@ impl Control {
             u64::from(issue.tap),
             acc.x.code(),
             acc.y.code(),
-            u64::from(acc.product_limb),
-            acc.align.code(),
             read.0,
             read.1,
             read.2,
@@ -474,12 +471,7 @@ impl std::fmt::Display for Control {
             parts.push(format!("{:?}[{}]×{:?}{tap}", i.a, i.limb, i.b));
         }
         if let Some(a) = self.accumulate {
-            let limb = if a.y == AccY::Product {
-                format!("{}", a.product_limb)
-            } else {
-                String::new()
-            };
-            parts.push(format!("acc {:?}+{:?}{limb}", a.x, a.y));
+            parts.push(format!("acc {:?}+{:?}", a.x, a.y));
         }
         if let Some(r) = self.read {
             parts.push(format!("read {} {:?}", r.address, r.gate));

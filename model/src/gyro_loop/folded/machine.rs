@@ -2,7 +2,7 @@
 //! runs it: the proof of a [`Schedule`] against the parallel model.
 
 use super::control::{
-    ASource, AccX, AccY, Align, BSource, Control, Quantize, ReadGate, RomRead, WriteData, LIMB_BITS,
+    ASource, AccX, AccY, BSource, Control, Issue, Quantize, ReadGate, RomRead, WriteData, LIMB_BITS,
 };
 use super::schedule::Schedule;
 use super::{sign_extend, Datapath};
@@ -63,7 +63,7 @@ struct Shifts {
     pll_v_to_sum: u32,
     agc_v_to_update: u32,
     agc_v_to_sum: u32,
-    /// [`Align`]'s shifts, by code.
+    /// The PI products' alignments, by [`BSource::alignment`].
     align: [u32; 5],
     lock: u32,
 }
@@ -114,11 +114,18 @@ pub struct FoldedGyroLoop {
     reference: i128,
     rd: i128,
     previous_rd: i128,
-    product: i128,
+    /// The multiplier's operand registers: the limb of `a`, `b`, and the product's weight
+    /// (a left shift).
+    operands: (i128, i128, u32),
+    /// The multiplier's output register and the weight that travels with it.
+    product: (i128, u32),
+    /// The weighted product the accumulator adds.
     pp: i128,
     acc: i128,
     p: i128,
     y: i128,
+    /// `Q_O(y)` of the clock before.
+    output: i128,
     drive_q: i128,
     amplitude_error: i128,
     v: i128,
@@ -253,11 +260,13 @@ impl FoldedGyroLoop {
             reference: 0,
             rd: 0,
             previous_rd: 0,
-            product: 0,
+            operands: (0, 0, 0),
+            product: (0, 0),
             pp: 0,
             acc: 0,
             p: 0,
             y: 0,
+            output: 0,
             drive_q: 0,
             amplitude_error: 0,
             v: 0,
@@ -352,20 +361,12 @@ impl FoldedGyroLoop {
             };
             self.nco_acc = self.nco_acc.wrapping_add(freq) & self.nco.mask;
         }
-        let product = control.issue.map_or(0, |issue| {
-            let a = self.a_operand(issue.a);
-            let limb = if issue.top {
-                a >> (LIMB_BITS * u32::from(issue.limb))
-            } else {
-                (a >> (LIMB_BITS * u32::from(issue.limb))) & ((1 << LIMB_BITS) - 1)
-            };
-            debug_assert!(
-                (-(1 << 15)..(1 << 15)).contains(&limb),
-                "limb {limb} of {a}"
-            );
-            limb * self.b_operand(issue.b, issue.tap, &m)
-        });
-        let pp = self.product;
+        let operands = control
+            .issue
+            .map_or((0, 0, 0), |issue| self.operands(&issue, &m));
+        let (a_limb, b, shift) = self.operands;
+        let product = (a_limb * b, shift);
+        let pp = self.product.0 << self.product.1;
         let acc_next = control.accumulate.map(|op| {
             let x = match op.x {
                 AccX::Keep => acc,
@@ -380,15 +381,11 @@ impl FoldedGyroLoop {
             };
             let y = match op.y {
                 AccY::Zero => 0,
-                AccY::Product => {
-                    self.pp
-                        << (LIMB_BITS * u32::from(op.product_limb)
-                            + self.shifts.align[op.align as usize])
-                }
+                AccY::Product => self.pp,
                 AccY::NegRead => -rd,
                 AccY::DemodProduct => self.p << self.shifts.product_to_state,
-                AccY::NegDemodOutput => -self.points.output.apply(y_register),
-                AccY::DemodOutput => self.points.output.apply(y_register),
+                AccY::NegDemodOutput => -self.output,
+                AccY::DemodOutput => self.output,
                 AccY::PreviousRead => previous_rd,
                 AccY::NegReadShifted => -(rd >> self.shifts.lock),
                 AccY::DriveQ => self.drive_q,
@@ -444,15 +441,17 @@ impl FoldedGyroLoop {
             };
             self.ram[usize::from(write.address)] = value;
         }
-        self.quantize(control.quantize, acc, y_register, &m);
+        self.quantize(control.quantize, acc, &m);
 
         // The loads.
         self.previous_rd = rd;
         if let Some(value) = read {
             self.rd = value;
         }
+        self.output = self.points.output.apply(y_register);
         self.pp = pp;
         self.product = product;
+        self.operands = operands;
         if let Some(value) = acc_next {
             self.acc = value;
         }
@@ -496,6 +495,24 @@ impl FoldedGyroLoop {
         })
     }
 
+    /// The operand registers' values for `issue`: the limb of `a`, `b`, and the product's
+    /// weight (the limb's and the PI's alignment).
+    fn operands(&self, issue: &Issue, m: &ModeConstants) -> (i128, i128, u32) {
+        let a = self.a_operand(issue.a);
+        let shift = LIMB_BITS * u32::from(issue.limb);
+        let limb = if issue.top {
+            a >> shift
+        } else {
+            (a >> shift) & ((1 << LIMB_BITS) - 1)
+        };
+        debug_assert!(
+            (-(1 << 15)..(1 << 15)).contains(&limb),
+            "limb {limb} of {a}"
+        );
+        let b = self.b_operand(issue.b, issue.tap, m);
+        (limb, b, shift + self.shifts.align[issue.b.alignment()])
+    }
+
     fn a_operand(&self, a: ASource) -> i128 {
         let [driven, sensed] = self.mode.axes();
         match a {
@@ -537,7 +554,7 @@ impl FoldedGyroLoop {
     }
 
     /// The quantization point of this clock, from the accumulator (or the state register).
-    fn quantize(&mut self, point: Quantize, acc: i128, y_register: i128, m: &ModeConstants) {
+    fn quantize(&mut self, point: Quantize, acc: i128, m: &ModeConstants) {
         let e = &self.exact;
         match point {
             Quantize::None => {}
@@ -545,7 +562,7 @@ impl FoldedGyroLoop {
                 self.p = self.points.product.apply(sign_extend(acc, e.product));
             }
             Quantize::DemodState => self.y = self.points.state.apply(sign_extend(acc, e.state)),
-            Quantize::DriveQ => self.drive_q = self.points.output.apply(y_register),
+            Quantize::DriveQ => self.drive_q = self.output,
             Quantize::AmplitudeError => {
                 self.amplitude_error = self.points.agc_error.apply(sign_extend(acc, e.agc_error));
             }
@@ -596,6 +613,3 @@ impl FoldedGyroLoop {
         }
     }
 }
-
-/// The `Align` codes index `Shifts::align`.
-const _: () = assert!(Align::AgcKp as usize == 4);

@@ -5,22 +5,26 @@
 //! # Datapath
 //!
 //! ```text
-//!  sine ROM ─► ref ─┐                       ┌─► pp ─┐
-//!  a operands ──────┴─► a limb × b (B limbs) ┘       ├─► acc ◄─ x (RAM word, setpoint, integrator…)
-//!                                                    │    │
-//!  RAM (states) ─► rd ─► prev_rd                     │    └─► quantization points ─► registers, RAM
+//!  sine ROM ─► ref ─┐                                      ┌─► pp ─┐
+//!  a operands ──────┴─► a limb, b ─► a limb × b (B limbs) ─┘       ├─► acc ◄─ x (RAM word, setpoint, integrator…)
+//!                                                                   │    │
+//!  RAM (states) ─► rd ─► prev_rd          y ─► Q_O(y) ───────────────┘    └─► quantization points ─► registers, RAM
 //! ```
 //!
 //! - **Multiplier.** Each clock it may take one 15-bit limb of an `a` operand (sign-extended;
 //!   the top limb signed, the others unsigned) and all of a `b` operand, split into
-//!   `B = ⌈(W_b − 1)/15⌉` limbs: `B` signed 16×16 products, one SB_MAC16 or DSP slice each,
-//!   registered, then summed (`pp`) on the next clock. A `W`-bit `a` takes `⌈(W − 1)/15⌉`
-//!   clocks; the accumulator adds each limb's product at its weight `2^(15·limb)`.
+//!   `B = ⌈(W_b − 1)/15⌉` limbs, into its operand registers; on the next clock `B` signed
+//!   16×16 products, one SB_MAC16 or DSP slice each, registered; on the next, their sum at
+//!   the limb's weight `2^(15·limb)` and the PI's alignment (`pp`), which the accumulator
+//!   adds [`PRODUCT_LATENCY`] clocks after the issue. A `W`-bit `a` takes `⌈(W − 1)/15⌉`
+//!   clocks.
 //! - **Accumulator.** `acc <= x + y` ([`AccX`], [`AccY`]), wide enough for every exact sum of
 //!   the loop ([`Datapath::accumulator_width`]); partial sums wrap, the exact results fit.
 //! - **Quantization points** read the accumulator's low bits as the exact value's format
 //!   and load their register ([`Quantize`]), rounding and saturating as the parallel loop's
-//!   points do, in the same order for each value.
+//!   points do, in the same order for each value. The demodulator's output point `Q_O`
+//!   reads the state register `y` every clock into its own register, so its readers see
+//!   the `y` of the clock before (no clock runs a quantizer into the accumulator's adder).
 //! - **RAM.** Every state: the four demodulator low-pass states, the two PI integrators, the
 //!   two lock filters, the CICs' integrators and combs, the compensators' delay lines. One
 //!   read and one write a clock; a read lands in `rd` on the next clock. Clears at a mode
@@ -40,8 +44,8 @@ mod schedule;
 mod tests;
 
 pub use control::{
-    ASource, AccX, AccY, Accumulate, Align, BSource, Busy, Control, Issue, Quantize, Read,
-    ReadGate, RomRead, Write, WriteData, ADDRESS_BITS, CONTROL_BITS, FIELDS, LIMB_BITS,
+    ASource, AccX, AccY, Accumulate, BSource, Busy, Control, Issue, Quantize, Read, ReadGate,
+    RomRead, Write, WriteData, ADDRESS_BITS, CONTROL_BITS, FIELDS, LIMB_BITS, PRODUCT_LATENCY,
 };
 pub use machine::FoldedGyroLoop;
 pub use schedule::{Schedule, ScheduleError, Words};

@@ -7,8 +7,8 @@ use std::collections::BTreeMap;
 use std::fmt;
 
 use super::control::{
-    ASource, AccX, AccY, Accumulate, Align, BSource, Control, Issue, Quantize, Read, ReadGate,
-    RomRead, Write, WriteData, ADDRESS_BITS,
+    ASource, AccX, AccY, Accumulate, BSource, Control, Issue, Quantize, Read, ReadGate, RomRead,
+    Write, WriteData, ADDRESS_BITS, PRODUCT_LATENCY,
 };
 use super::limbs;
 use crate::gyro_loop::cic::{MAX_STAGES, MAX_TAPS};
@@ -166,16 +166,7 @@ impl Template {
     }
 
     fn accumulate(&mut self, t: u32, x: AccX, y: AccY) {
-        self.accumulate_product(t, x, y, 0, Align::None);
-    }
-
-    fn accumulate_product(&mut self, t: u32, x: AccX, y: AccY, product_limb: u8, align: Align) {
-        let accumulate = Some(Accumulate {
-            x,
-            y,
-            product_limb,
-            align,
-        });
+        let accumulate = Some(Accumulate { x, y });
         self.at(
             t,
             Control {
@@ -221,9 +212,9 @@ impl Template {
         );
     }
 
-    /// `a · b` issued from `start`, one limb a clock, accumulated from `start + 2` onto `first`
-    /// (the first limb's base); returns the clock at which the accumulator holds the sum.
-    #[allow(clippy::too_many_arguments)]
+    /// `a · b` issued from `start`, one limb a clock, accumulated from
+    /// `start + PRODUCT_LATENCY` onto `first` (the first limb's base); returns the clock at
+    /// which the accumulator holds the sum.
     fn product(
         &mut self,
         start: u32,
@@ -232,7 +223,6 @@ impl Template {
         b: BSource,
         tap: u8,
         first: AccX,
-        align: Align,
     ) -> u32 {
         let l = limbs(a_width);
         for k in 0..l {
@@ -251,9 +241,9 @@ impl Template {
                 },
             );
             let x = if k == 0 { first } else { AccX::Keep };
-            self.accumulate_product(start + 2 + k, x, AccY::Product, k as u8, align);
+            self.accumulate(start + PRODUCT_LATENCY + k, x, AccY::Product);
         }
-        start + 2 + l
+        start + PRODUCT_LATENCY + l
     }
 
     /// The first clock of an op matching `predicate`.
@@ -339,7 +329,8 @@ fn used(c: &Control, t: u32) -> Vec<(Register, u32)> {
             AccY::NegRead | AccY::NegReadShifted => out.push((Register::ReadData, t)),
             AccY::PreviousRead => out.push((Register::ReadData, t - 1)),
             AccY::DemodProduct => out.push((Register::DemodProduct, t)),
-            AccY::NegDemodOutput | AccY::DemodOutput => out.push((Register::DemodState, t)),
+            // Q_O's register holds the state of the clock before.
+            AccY::NegDemodOutput | AccY::DemodOutput => out.push((Register::DemodState, t - 1)),
             _ => {}
         }
     }
@@ -352,7 +343,7 @@ fn used(c: &Control, t: u32) -> Vec<(Register, u32)> {
     }
     match c.quantize {
         Quantize::None => {}
-        Quantize::DriveQ => out.push((Register::DemodState, t)),
+        Quantize::DriveQ => out.push((Register::DemodState, t - 1)),
         _ => out.push((Register::Accumulator, t)),
     }
     out
@@ -443,32 +434,26 @@ fn demodulator(
 ) -> Template {
     let mut t = Template::new(name);
     t.rom(0, rom);
-    let done = t.product(
-        1,
-        a,
-        widths.adc,
-        BSource::Reference,
-        0,
-        AccX::Zero,
-        Align::None,
-    );
+    let done = t.product(1, a, widths.adc, BSource::Reference, 0, AccX::Zero);
     t.read(done - 1, word, ReadGate::Switch, 0);
     t.quantize(done, Quantize::DemodProduct);
     t.accumulate(done, AccX::ReadLowpass, AccY::NegRead);
     t.accumulate(done + 1, AccX::Keep, AccY::DemodProduct);
     t.quantize(done + 2, Quantize::DemodState);
     t.write(done + 2, word, WriteData::DemodState);
+    // The state register loads at done + 2; Q_O's register has its output from done + 4.
+    let output = done + 4;
     match consumer {
         Consumer::AmplitudeError => {
-            t.accumulate(done + 3, AccX::Setpoint, AccY::NegDemodOutput);
-            t.quantize(done + 4, Quantize::AmplitudeError);
+            t.accumulate(output, AccX::Setpoint, AccY::NegDemodOutput);
+            t.quantize(output + 1, Quantize::AmplitudeError);
         }
-        Consumer::DriveQ => t.quantize(done + 3, Quantize::DriveQ),
+        Consumer::DriveQ => t.quantize(output, Quantize::DriveQ),
         Consumer::Cic(channel) => {
             // v_1 += x, v_j += v_(j−1) (the old values): stage j's sum at o_j, its word read
             // the clock before and written the clock after.
             for (j, &v) in words.integrators[channel].iter().enumerate() {
-                let o = done + 3 + j as u32;
+                let o = output + j as u32;
                 t.read(o - 1, v, ReadGate::First, 0);
                 let y = if j == 0 {
                     AccY::DemodOutput
@@ -492,25 +477,25 @@ struct Pi {
     word: u8,
     gate: ReadGate,
     x: [AccX; 2],
-    align: [Align; 2],
     points: [Quantize; 2],
     data: WriteData,
 }
 
 fn pi(p: &Pi) -> Template {
     let mut t = Template::new(p.name);
-    t.read(1, p.word, p.gate, 0);
-    let update = t.product(0, p.error, p.error_width, p.gains[0], 0, p.x[0], p.align[0]);
+    // The integrator's word is in the read register when the first limb's product arrives.
+    t.read(PRODUCT_LATENCY - 1, p.word, p.gate, 0);
+    let update = t.product(0, p.error, p.error_width, p.gains[0], 0, p.x[0]);
     t.quantize(update, p.points[0]);
     t.write(update, p.word, p.data);
+    // kp·e's first product arrives the clock after the integrator register loads.
     let sum = t.product(
-        update - 1,
+        update + 1 - PRODUCT_LATENCY,
         p.error,
         p.error_width,
         p.gains[1],
         0,
         p.x[1],
-        p.align[1],
     );
     t.quantize(sum, p.points[1]);
     t
@@ -526,7 +511,6 @@ fn dac(widths: &Widths) -> Template {
         BSource::Reference,
         0,
         AccX::Zero,
-        Align::None,
     );
     t.quantize(done, Quantize::Dac);
     t
@@ -577,7 +561,9 @@ fn cic(channel: usize, widths: &Widths, words: &Words, taps: usize) -> Template 
     // word moves one place on after it is read), then tap 0 on this decimation's c.
     let l = limbs(widths.cic);
     let line = &words.line[channel];
-    let mut issue = (read_clock + 1).max(cic_ready.saturating_sub(2));
+    // The first tap's product may arrive at the clock that quantizes c (which reads the
+    // accumulator before it loads).
+    let mut issue = (read_clock + 1).max(cic_ready.saturating_sub(PRODUCT_LATENCY));
     let mut first = AccX::Zero;
     for g in (1..taps).rev() {
         t.read(issue - 1, line[g - 1], ReadGate::Seen, g as u8);
@@ -591,7 +577,6 @@ fn cic(channel: usize, widths: &Widths, words: &Words, taps: usize) -> Template 
             BSource::Tap,
             g as u8,
             first,
-            Align::None,
         );
         first = AccX::Keep;
         issue += l;
@@ -600,15 +585,7 @@ fn cic(channel: usize, widths: &Widths, words: &Words, taps: usize) -> Template 
     if taps > 1 {
         t.write(issue, line[0], WriteData::Cic);
     }
-    let fir = t.product(
-        issue,
-        ASource::Cic,
-        widths.cic,
-        BSource::Tap,
-        0,
-        first,
-        Align::None,
-    );
+    let fir = t.product(issue, ASource::Cic, widths.cic, BSource::Tap, 0, first);
     t.quantize(fir, Quantize::CicOutput);
     let (coefficient, point) = if channel == 0 {
         (BSource::RateCoefficient, Quantize::Rate)
@@ -622,7 +599,6 @@ fn cic(channel: usize, widths: &Widths, words: &Words, taps: usize) -> Template 
         coefficient,
         0,
         AccX::Zero,
-        Align::None,
     );
     t.quantize(out, point);
     t
@@ -695,7 +671,6 @@ impl Schedule {
             word: words.agc,
             gate: ReadGate::Switch,
             x: [AccX::AgcIntegrator, AccX::AgcSum],
-            align: [Align::AgcKi, Align::AgcKp],
             points: [Quantize::AgcIntegrator, Quantize::AgcOutput],
             data: WriteData::AgcIntegrator,
         });
@@ -748,7 +723,6 @@ impl Schedule {
             word: words.pll,
             gate: ReadGate::Preset,
             x: [AccX::PllIntegrator, AccX::PllSum],
-            align: [Align::PllKi, Align::PllKp],
             points: [Quantize::PllIntegrator, Quantize::PllOutput],
             data: WriteData::PllIntegrator,
         });

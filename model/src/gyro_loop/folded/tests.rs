@@ -202,5 +202,5 @@ fn a_control_word_packs_its_fields_at_their_offsets() {
         quantize: Quantize::LockA,
         ..Control::default()
     };
-    assert_eq!(control.encode(), 1 << 48 | 5 << 49 | 6 << 56 | 15 << 59);
+    assert_eq!(control.encode(), 1 << 42 | 5 << 43 | 6 << 50 | 15 << 53);
 }
