@@ -29,6 +29,7 @@ pub mod gyro_loop;
 pub mod kf;
 pub mod mean_filter;
 pub mod plant;
+pub mod population;
 pub mod range;
 pub mod resonator;
 pub mod sequencer;
