@@ -31,6 +31,7 @@ pub mod hash;
 pub mod input;
 pub mod job;
 pub mod pipeline;
+pub mod population;
 pub mod recording;
 pub mod residual_budget;
 pub mod system;

@@ -21,6 +21,7 @@ mod estimator;
 mod gyro;
 mod kf;
 mod mean_filter;
+mod population;
 mod resonator;
 mod sequencer;
 mod stimulus;
@@ -29,6 +30,7 @@ pub use estimator::EstimatorConfig;
 pub use gyro::PlantConfig;
 pub use kf::{KfConfig, KfSettings};
 pub use mean_filter::MeanFilterConfig;
+pub use population::{PopulationConfig, SpreadConfig};
 pub use resonator::GyroLoop;
 pub use sequencer::SequencerConfig;
 pub use stimulus::{Source, StimulusConfig};
@@ -84,6 +86,10 @@ pub struct Config {
     /// config's).
     #[serde(rename = "loop")]
     pub gyro_loop: toml::Table,
+    /// How the resonators and front ends spread over a population (`gyrofx population`);
+    /// optional, left out of the resolved config when empty.
+    #[serde(default, skip_serializing_if = "PopulationConfig::is_empty")]
+    pub population: PopulationConfig,
 }
 
 /// Everything the config says, validated and typed.
@@ -150,6 +156,10 @@ const OPTIONAL_KEYS: [&str; 5] = [
     "loop.scale_coefficient_format",
 ];
 
+/// Optional sections the default leaves out, whose keys their own types check
+/// (`deny_unknown_fields`).
+const OPTIONAL_SECTIONS: [&str; 1] = ["population"];
+
 /// Refuses a key of `user` that neither the default nor [`OPTIONAL_KEYS`] has, naming it and
 /// the line it stands on.
 fn check_known_keys(
@@ -167,6 +177,7 @@ fn check_known_keys(
             }
             (Some(_), _) => {}
             (None, _) if OPTIONAL_KEYS.contains(&path.as_str()) => {}
+            (None, _) if OPTIONAL_SECTIONS.contains(&path.as_str()) => {}
             (None, _) => {
                 let line = text
                     .lines()
@@ -454,6 +465,7 @@ impl Config {
             .estimator
             .validate(schedule, kf.input, rounding, overflow)?;
         let mean_filter = self.mean_filter.validate(kf.input, rounding, overflow)?;
+        self.population.spreads()?;
         if let Some(loops) = &resonator {
             resonator::check_chain(loops, fs_hz, kf.input, &estimator.schedule)?;
         }
