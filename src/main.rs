@@ -9,7 +9,7 @@ use clap::{Parser, Subcommand};
 
 use commands::{
     allan, ar, davar, denoise, design, explore, filter, formats, generate, gyro_loop, init,
-    reproduce, synth, verify,
+    population, reproduce, synth, verify,
 };
 
 #[derive(Parser)]
@@ -40,6 +40,7 @@ enum Command {
     Generate(generate::Args),
     Synth(synth::Args),
     Loop(gyro_loop::Args),
+    Population(population::Args),
     Verify(verify::Args),
     Filter(filter::Args),
     Reproduce(reproduce::Args),
@@ -68,6 +69,7 @@ fn main() -> ExitCode {
         Command::Generate(args) => generate::run(args),
         Command::Synth(args) => synth::run(args),
         Command::Loop(args) => gyro_loop::run(args),
+        Command::Population(args) => population::run(args),
         Command::Verify(args) => verify::run(args),
         Command::Filter(args) => filter::run(args),
         Command::Reproduce(args) => reproduce::run(args),

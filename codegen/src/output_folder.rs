@@ -46,6 +46,8 @@ pub enum Kind {
     Filter,
     /// `gyrofx explore`: the candidates' CSV, the Pareto plots and the chosen config.
     Explore,
+    /// `gyrofx population`: the members' CSV, the summary and its plots.
+    Population,
 }
 
 impl Kind {
@@ -57,6 +59,7 @@ impl Kind {
             Kind::Reproduce => "reproduce",
             Kind::Filter => "filter",
             Kind::Explore => "explore",
+            Kind::Population => "population",
         }
     }
 
@@ -67,6 +70,7 @@ impl Kind {
             Kind::Reproduce,
             Kind::Filter,
             Kind::Explore,
+            Kind::Population,
         ]
         .into_iter()
         .find(|k| k.name() == name)

@@ -23,6 +23,7 @@ pub mod junit;
 pub mod place_route;
 pub mod plot;
 pub mod pool;
+pub mod population;
 pub mod processes;
 pub mod reproduce;
 pub mod simulate;

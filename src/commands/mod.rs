@@ -12,6 +12,7 @@ pub mod generate;
 pub mod gyro_loop;
 pub mod init;
 mod options;
+pub mod population;
 mod progress;
 pub mod reproduce;
 pub mod synth;
