@@ -20,6 +20,7 @@ mod layers;
 mod loop_blocks;
 mod memory;
 mod output_folder;
+mod population;
 mod random_configs;
 mod recording;
 mod roms;
