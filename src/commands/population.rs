@@ -14,7 +14,7 @@ use gyrofx_lab::population::{self, Request};
 use super::options::{ConfigSource, OutputFolder};
 use super::usage;
 
-/// Study a population of gyro pairs spread as [population] says: lock, settling, bias, yield.
+/// Spread the gyros over many pairs: lock, settling, bias, residual, yield.
 ///
 /// Draws --gyros members (gyro pairs) from the config's [population] spreads of the resonators'
 /// and the front end's parameters (normal, uniform or a list of values; absolute or relative to
