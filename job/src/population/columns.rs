@@ -162,8 +162,9 @@ pub fn row(result: &MemberResult) -> Vec<String> {
             }
             cells.extend(PAIR_COLUMNS.iter().map(|(_, read)| cell(read(f))));
         }
-        Err(_) => cells.extend(
-            std::iter::repeat(String::new()).take(2 * GYRO_COLUMNS.len() + PAIR_COLUMNS.len()),
+        Err(_) => cells.resize(
+            cells.len() + 2 * GYRO_COLUMNS.len() + PAIR_COLUMNS.len(),
+            String::new(),
         ),
     }
     cells

@@ -128,7 +128,7 @@ impl Parameter {
             .collect()
     }
 
-    fn slot<'a>(self, gyro: &'a mut GyroPhysics) -> &'a mut f64 {
+    fn slot(self, gyro: &mut GyroPhysics) -> &mut f64 {
         let (r, f) = (&mut gyro.params, &mut gyro.front_end);
         match self {
             Parameter::MassKg => &mut r.mass_kg,

@@ -272,9 +272,9 @@ fn chain_run(study: &Study, gyros: &[GyroPhysics; 2]) -> Result<ChainRun, String
         }
         let step = system.step(adc, enable, study.bw_sel);
         if !enable {
-            for g in 0..2 {
-                if !step.locked[g] {
-                    lock_sample[g] = k + 1;
+            for (sample, locked) in lock_sample.iter_mut().zip(step.locked) {
+                if !locked {
+                    *sample = k + 1;
                 }
             }
             if k + 1 == startup {
