@@ -33,6 +33,15 @@
 //! `(g B(φ_r) − g′ B′(φ_r′))/2`.
 //! The loop's latency and the DAC offset act only through `f_L` (below 5e-5°).
 //!
+//! **A resonator the plan was not made for** (a population's member under the nominal FPGA,
+//! `gyrofx population`): the offset word was designed from the nominal sense axis's phase
+//! `ψ_d(f_nom)`, so the member's reference also lags by its own axis's difference there,
+//! `−[ψ(f_nom) − ψ_d(f_nom)]` ([`RealizedPhase::design_deg`]); the sense gain is
+//! `|Z_d(f_nom)| / |Z(f_L)|`, and the loop's `1/SF` is the design's, `2 m_d w_d cos φ_d`. Both
+//! terms vanish for the plan's own resonator. The design's drive amplitude is assumed (the
+//! AGC holds the pick-off reading, so a member whose pick-off gain or ADC full scale differs
+//! drives another amplitude, which scales its bias by the same ratio).
+//!
 //! With `[loop] phase_trim = true` the plan advances `δ_S` by the first two terms
 //! ([`super::gyro::trimmed_sense_offset`]), so that the loop realizes the configured phase up to
 //! the offset word's rounding; [`RealizedPhase::trim_deg`] is that advance. Only the per-mode
@@ -51,7 +60,7 @@ use std::f64::consts::PI;
 use serde::Serialize;
 
 use super::gyro::{phase_shifts, PhaseInputs, Plan};
-use crate::resonator::{Mode, ModeFigures, ResonatorParams};
+use crate::resonator::{sense_impedance, Mode, ModeFigures, ResonatorParams};
 
 /// One mode's realized reference phase, derived from the plan, with its parts. Phases in
 /// degrees, positive when the reference lags the Coriolis component more (as `φ`).
@@ -70,9 +79,15 @@ pub struct RealizedPhase {
     pub offset_word_deg: f64,
     /// `−360°·trim`: what `[loop] phase_trim` took off (0 without it), deg.
     pub trim_deg: f64,
+    /// `−[ψ(f_nom) − ψ_d(f_nom)]`: the resonator's sense axis against the one the plan was
+    /// designed for, at the design's frequency (0 for the plan's own resonator), deg.
+    pub design_deg: f64,
     /// The sense gain against the design's: `|Z_ss(f_nom)|/|Z_ss(f_L)|` times the modulation's
     /// gain (1 − 5e-5 at the defaults).
     pub gain: f64,
+    /// The loop's `1/SF` without `q0/|Z|`: `2 m w cos φ` of the design, N·s/m.
+    #[serde(skip)]
+    pub design_scale: f64,
 }
 
 impl RealizedPhase {
@@ -83,6 +98,7 @@ impl RealizedPhase {
             + self.pll_modulation_deg
             + self.offset_word_deg
             + self.trim_deg
+            + self.design_deg
     }
 
     /// The bias the loop outputs in this mode, °/s (`B`'s sign, not the chain's), for
@@ -92,18 +108,12 @@ impl RealizedPhase {
     /// `g [k_xy sin φ_r + w_L d_xy cos φ_r] / (2 m w cos φ)`: `g B(φ_r)` but for the ratios
     /// `w_L / w` and `cos φ_r / cos φ`, which matter where the bias is large (2e-5 of a 505 °/s
     /// bias is 10 mdps).
-    pub fn bias_dps(&self, params: &ResonatorParams, mode: Mode) -> f64 {
+    pub fn bias_dps(&self, params: &ResonatorParams, _mode: Mode) -> f64 {
         let mats = params.matrices();
-        let design = ModeFigures::new(params, mode);
         let w_locked = 2.0 * PI * self.locked_frequency_hz;
         let phase = self.derived_deg().to_radians();
         let coupling = mats.k[0][1] * libm::sin(phase) + w_locked * mats.d[0][1] * libm::cos(phase);
-        let rate = coupling
-            / (2.0
-                * params.mass_kg
-                * design.drive_angular_frequency
-                * libm::cos(design.phase_error));
-        self.gain * rate.to_degrees()
+        self.gain * (coupling / self.design_scale).to_degrees()
     }
 
     /// [`RealizedPhase::bias_dps`] in the chain's sign convention (`+B` normal, `−B′`
@@ -122,20 +132,29 @@ pub fn residual_dps(params: &ResonatorParams, realized: &[RealizedPhase; 2]) -> 
 }
 
 /// The realized reference phase of `mode` in the loop `plan` closes around `params`, derived
-/// (see the [module doc](self)). `plan` must be the plan made for `params`.
+/// (see the [module doc](self)): the plan made for `params`, or another (a population's
+/// nominal plan around a member).
 pub fn derive(plan: &Plan, params: &ResonatorParams, mode: Mode) -> RealizedPhase {
     let m = plan.mode(mode);
     let shifts = phase_shifts(params, mode, &phase_inputs(plan, mode));
     let word = m.sense_offset_word as f64 * crate::fx::pow2(-(plan.nco.phase.width as i32));
     let exact = m.sense_offset - libm::floor(m.sense_offset);
+    let design = &m.figures;
+    // The same computation as the design's figures, so exactly the design's for its resonator.
+    let (z_own, psi_own) = sense_impedance(params, mode, design.drive_angular_frequency);
     RealizedPhase {
-        configured_deg: m.figures.phase_error.to_degrees(),
+        configured_deg: ModeFigures::new(params, mode).phase_error.to_degrees(),
         locked_frequency_hz: shifts.locked_frequency_hz,
         locked_frequency_deg: shifts.locked_frequency_deg,
         pll_modulation_deg: shifts.pll_modulation_deg,
         offset_word_deg: -360.0 * (word - exact),
         trim_deg: -360.0 * m.sense_offset_trim,
-        gain: shifts.gain,
+        design_deg: -(psi_own - design.sense_phase).to_degrees(),
+        gain: shifts.gain * (design.sense_impedance / z_own),
+        design_scale: 2.0
+            * design.mass_kg()
+            * design.drive_angular_frequency
+            * libm::cos(design.phase_error),
     }
 }
 

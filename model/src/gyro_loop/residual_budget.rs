@@ -278,7 +278,9 @@ fn derived_parts(
         pll_modulation_deg: 0.0,
         offset_word_deg: 0.0,
         trim_deg: 0.0,
+        design_deg: 0.0,
         gain: 1.0,
+        design_scale: 2.0 * f.mass_kg() * f.drive_angular_frequency * libm::cos(f.phase_error),
     });
     let steps: [Step; 4] = [
         ("locked frequency", "structure", |to, from| {

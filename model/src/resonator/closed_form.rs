@@ -63,6 +63,11 @@ pub struct ModeFigures {
 }
 
 impl ModeFigures {
+    /// The resonator's mass, kg.
+    pub fn mass_kg(&self) -> f64 {
+        self.mass
+    }
+
     /// The figures of `mode` for `params` (assumed valid, see [`ResonatorParams::validate`]).
     pub fn new(params: &ResonatorParams, mode: Mode) -> Self {
         let m = params.mass_kg;
