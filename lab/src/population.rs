@@ -1,7 +1,8 @@
 //! `gyrofx population`'s work: every member drawn and studied on `jobs` threads
 //! ([`crate::pool::ordered`]), each row streamed into `population.csv` in member order as it
-//! is done, the summary built from the rows' figures alone, then `summary.json`, the plots and
-//! the manifest: the whole folder written all or nothing, as every package
+//! is done (each line [`columns::csv_line`], as the Python package writes it), the summary
+//! built from the rows' figures alone, then `summary.json`, the plots and the manifest: the
+//! whole folder written all or nothing, as every package
 //! ([`gyrofx_codegen::package::Staging`]). Memory is bounded whatever the members and seconds:
 //! the rows wait for at most `2·jobs` members, the summary keeps a few numbers per member and
 //! each member's study streams its run.
@@ -12,7 +13,7 @@ use std::path::Path;
 use gyrofx_codegen::output_folder::{Kind, Replace, MANIFEST};
 use gyrofx_codegen::package::{FileEntry, Package, Staging};
 use gyrofx_job::error::{Error, Result};
-use gyrofx_job::population::summary::{Report, Summary};
+use gyrofx_job::population::summary::{self, Report, Summary};
 use gyrofx_job::population::targets::Target;
 use gyrofx_job::population::{columns, Population, RunSettings};
 
@@ -61,9 +62,10 @@ pub fn run(
     let staging = Staging::create(request.out, Kind::Population, request.replace)?;
     let csv_path = staging.path().join("population.csv");
     let file = std::fs::File::create(&csv_path).map_err(|e| Error::io(&csv_path, e))?;
-    let mut csv = csv::Writer::from_writer(std::io::BufWriter::new(file));
-    let io = |e: csv::Error| Error::io(&csv_path, std::io::Error::other(e.to_string()));
-    csv.write_record(columns::header(population)).map_err(io)?;
+    let mut csv = std::io::BufWriter::new(file);
+    let io = |e: std::io::Error| Error::io(&csv_path, e);
+    csv.write_all(columns::csv_line(&columns::header(population)).as_bytes())
+        .map_err(io)?;
     let mut summary = Summary::new(&request.targets);
     let mut gyro_samples = 0u64;
     crate::pool::ordered(
@@ -77,18 +79,16 @@ pub fn run(
                     std::io::Error::from(std::io::ErrorKind::Interrupted),
                 ));
             }
-            csv.write_record(columns::row(&result)).map_err(io)?;
+            csv.write_all(columns::csv_line(&columns::row(&result)).as_bytes())
+                .map_err(io)?;
             summary.add(&result);
             gyro_samples += result.figures.as_ref().map_or(0, |f| f.gyro_samples);
             progress(1);
             Ok(())
         },
     )?;
-    let mut writer = csv
-        .into_inner()
-        .map_err(|e| Error::io(&csv_path, std::io::Error::other(e.to_string())))?;
-    writer.flush().map_err(|e| Error::io(&csv_path, e))?;
-    drop(writer);
+    csv.flush().map_err(|e| Error::io(&csv_path, e))?;
+    drop(csv);
     let report = summary.report(
         population.chain.estimator.schedule.interval_length,
         population.chain_rate_hz(),
@@ -101,9 +101,10 @@ pub fn run(
             .map_err(|e| Error::io(&csv_path, e))?
             .len() as usize,
     });
-    let text = serde_json::to_string_pretty(&summary_json(population, request, &report))
-        .expect("the summary serializes");
-    package.add("summary.json", text + "\n");
+    package.add(
+        "summary.json",
+        summary::json_text(population, request.members, &request.settings, &report),
+    );
     for (name, svg) in plots::render(&summary, &report)? {
         package.add(name, svg);
     }
@@ -127,23 +128,30 @@ pub fn run(
     })
 }
 
-/// `summary.json`: the run's settings and the [`Report`]. Nothing in it depends on the threads
-/// or the clock.
-fn summary_json(population: &Population, request: &Request, report: &Report) -> serde_json::Value {
-    let spreads: Vec<String> = population
-        .spreads
-        .iter()
-        .map(|(parameter, spread)| format!("{}: {spread:?}", parameter.name()))
-        .collect();
-    serde_json::json!({
-        "tool": "gyrofx",
-        "seed": population.seed,
-        "members": request.members,
-        "seconds": request.settings.seconds,
-        "noise": request.settings.noise,
-        "startup_s": gyrofx_job::population::STARTUP_S,
-        "chain_rate_hz": population.chain_rate_hz(),
-        "spreads": spreads,
-        "report": report,
-    })
+#[cfg(test)]
+mod tests {
+    use gyrofx_job::population::columns::csv_line;
+
+    /// The job's lines are the `csv` crate's (what `population.csv` was written with before the
+    /// Python package needed the same bytes): quotes only where a cell needs them.
+    #[test]
+    fn csv_lines_are_the_csv_crates() {
+        let records: [&[&str]; 5] = [
+            &["0", "ok", "", "1.5", "-2e-7"],
+            &[
+                "3",
+                "unlocked",
+                "gyro a: beyond the PLL's pull range; gyro b: x, y",
+            ],
+            &["quote \"q\"", "line\nbreak", "cr\r", ""],
+            &[""],
+            &["a", ""],
+        ];
+        for record in records {
+            let mut writer = csv::Writer::from_writer(Vec::new());
+            writer.write_record(record).unwrap();
+            let expected = String::from_utf8(writer.into_inner().unwrap()).unwrap();
+            assert_eq!(csv_line(record), expected, "{record:?}");
+        }
+    }
 }

@@ -147,6 +147,29 @@ fn message(result: &MemberResult) -> String {
     }
 }
 
+/// A record as one line of `population.csv`, `\n` ended: a cell holding `,`, `"`, `\r` or
+/// `\n` in double quotes with its quotes doubled, every other cell as it is (what the `csv`
+/// crate's default writer writes, so that the CLI and the Python package, which both write
+/// through this, give the same bytes).
+pub fn csv_line<S: AsRef<str>>(cells: &[S]) -> String {
+    let mut line = String::new();
+    for (k, cell) in cells.iter().enumerate() {
+        let cell = cell.as_ref();
+        if k > 0 {
+            line.push(',');
+        }
+        if cell.contains([',', '"', '\r', '\n']) || (cells.len() == 1 && cell.is_empty()) {
+            line.push('"');
+            line.push_str(&cell.replace('"', "\"\""));
+            line.push('"');
+        } else {
+            line.push_str(cell);
+        }
+    }
+    line.push('\n');
+    line
+}
+
 /// A member's row, in the order of [`header`].
 pub fn row(result: &MemberResult) -> Vec<String> {
     let mut cells = vec![

@@ -5,9 +5,8 @@
 
 use serde::Serialize;
 
-use super::columns::status;
-use super::targets::{Figure, Target};
-use super::MemberResult;
+use super::targets::{Figure, Record, Target};
+use super::{MemberResult, Population, RunSettings, STARTUP_S};
 
 /// The quantiles reported, as fractions.
 pub const QUANTILES: [f64; 7] = [0.0, 0.05, 0.25, 0.5, 0.75, 0.95, 1.0];
@@ -109,27 +108,32 @@ impl Summary {
 
     /// Adds a member.
     pub fn add(&mut self, result: &MemberResult) {
+        self.add_record(&Record::of(result));
+    }
+
+    /// Adds a member from its [`Record`]: the same as [`Summary::add`] with its result.
+    pub fn add_record(&mut self, record: &Record) {
         self.counts.members += 1;
-        match status(result) {
+        match record.status {
             "ok" => self.counts.ok += 1,
             "unlocked" => self.counts.unlocked += 1,
             _ => self.counts.invalid += 1,
         }
-        for (figure, values) in Figure::ALL.iter().zip(&mut self.values) {
-            if let Some(v) = figure.of_member(result).filter(|v| v.is_finite()) {
+        for (value, values) in record.figures.iter().zip(&mut self.values) {
+            if let Some(v) = value.filter(|v| v.is_finite()) {
                 values.push(v);
             }
         }
-        let mut all = status(result) == "ok";
+        let mut all = record.status == "ok";
         for (target, met) in self.targets.iter().zip(&mut self.met) {
-            if target.met_by_member(result) {
+            if target.met_by_record(record) {
                 *met += 1;
             } else {
                 all = false;
             }
         }
         if all {
-            if let Some(settling) = Figure::SettlingMs.of_member(result) {
+            if let Some(settling) = record.figure(Figure::SettlingMs) {
                 self.settling_of_good.push(settling);
             }
         }
@@ -202,6 +206,38 @@ impl Summary {
             .expect("a figure");
         &self.values[index]
     }
+}
+
+/// The spreads as `summary.json` lists them, one line each (`q_drive: Normal { .. }`).
+pub fn spreads(population: &Population) -> Vec<String> {
+    population
+        .spreads
+        .iter()
+        .map(|(parameter, spread)| format!("{}: {spread:?}", parameter.name()))
+        .collect()
+}
+
+/// `summary.json`'s text: the run's settings (the seed, the members, `settings`, the start-up,
+/// the chain rate in Hz and the spreads) and `report`, pretty-printed and `\n` ended. Nothing in
+/// it depends on the threads, the machines or the clock.
+pub fn json_text(
+    population: &Population,
+    members: u64,
+    settings: &RunSettings,
+    report: &Report,
+) -> String {
+    let json = serde_json::json!({
+        "tool": "gyrofx",
+        "seed": population.seed,
+        "members": members,
+        "seconds": settings.seconds,
+        "noise": settings.noise,
+        "startup_s": STARTUP_S,
+        "chain_rate_hz": population.chain_rate_hz(),
+        "spreads": spreads(population),
+        "report": report,
+    });
+    serde_json::to_string_pretty(&json).expect("the summary serializes") + "\n"
 }
 
 #[cfg(test)]

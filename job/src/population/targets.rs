@@ -5,6 +5,7 @@
 use std::fmt;
 use std::str::FromStr;
 
+use super::columns::status;
 use super::MemberResult;
 use gyrofx_model::population::study::MemberFigures;
 
@@ -143,6 +144,55 @@ impl FromStr for Figure {
     }
 }
 
+/// What the targets and the summary take of a member: its status and its [`Figure`]s. Plain
+/// data (a word and ten numbers), so that a member studied elsewhere (a Python worker on a
+/// cluster) is judged and summed as one studied here.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Record {
+    /// [`status`]: `ok`, `unlocked` or `invalid`.
+    pub status: &'static str,
+    /// Each of [`Figure::ALL`], in that order (`None`: the member has none).
+    pub figures: [Option<f64>; Figure::ALL.len()],
+}
+
+impl Record {
+    /// The record of `result`.
+    pub fn of(result: &MemberResult) -> Record {
+        Record {
+            status: status(result),
+            figures: Figure::ALL.map(|figure| figure.of_member(result)),
+        }
+    }
+
+    /// A record from its parts, as [`Record::of`] gave them.
+    ///
+    /// # Errors
+    /// A status other than the three, or not one figure per [`Figure::ALL`].
+    pub fn new(status: &str, figures: &[Option<f64>]) -> Result<Record, String> {
+        let status = ["ok", "unlocked", "invalid"]
+            .into_iter()
+            .find(|s| *s == status)
+            .ok_or_else(|| format!("status {status:?} is not one of ok, unlocked, invalid"))?;
+        let figures = figures.try_into().map_err(|_| {
+            format!(
+                "{} figures given: one per figure, {}",
+                figures.len(),
+                Figure::ALL.len()
+            )
+        })?;
+        Ok(Record { status, figures })
+    }
+
+    /// Its value of `figure`.
+    pub fn figure(&self, figure: Figure) -> Option<f64> {
+        let index = Figure::ALL
+            .iter()
+            .position(|f| *f == figure)
+            .expect("a figure");
+        self.figures[index]
+    }
+}
+
 /// A comparison.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Comparison {
@@ -192,11 +242,12 @@ impl Target {
 
     /// Whether a member meets it: it ran, both gyros locked and its figure meets it.
     pub fn met_by_member(&self, result: &MemberResult) -> bool {
-        super::columns::status(result) == "ok"
-            && self
-                .figure
-                .of_member(result)
-                .is_some_and(|v| self.met_by(v))
+        self.met_by_record(&Record::of(result))
+    }
+
+    /// [`Target::met_by_member`] from the member's [`Record`].
+    pub fn met_by_record(&self, record: &Record) -> bool {
+        record.status == "ok" && record.figure(self.figure).is_some_and(|v| self.met_by(v))
     }
 }
 
