@@ -166,13 +166,18 @@ cargo test --workspace --doc
 
 # The Python package (python/): pyo3 + numpy, built by maturin as an abi3 wheel into a
 # virtualenv from PyPI (reused across runs), then its pytest suite: the model against the CLI's
-# vectors, and the package's cocotb tests in Icarus (python/tests/test_cocotb.py).
+# vectors, the package's cocotb tests in Icarus (python/tests/test_cocotb.py), and the
+# population study here and on dask clusters against the CLI's files
+# (python/tests/test_population.py).
 echo "== python: cargo fmt, maturin wheel (linted by clippy), pytest"
 python_venv="${XDG_CACHE_HOME:-$HOME/.cache}/gyrofx/python-venv"
-if [ ! -x "$python_venv/bin/maturin" ] || ! "$python_venv/bin/python" -c "import numpy, pytest, xdist, cocotb, mypy" >/dev/null 2>&1; then
-    echo "== installing maturin, numpy, pytest, pytest-xdist, cocotb, mypy into $python_venv"
+# dask.distributed: gyrofx.population's cluster runs (python/tests/test_population.py starts a
+# LocalCluster and a scheduler and workers with its `dask` command); calendar versions, so the
+# year is the major.
+if [ ! -x "$python_venv/bin/maturin" ] || ! "$python_venv/bin/python" -c "import numpy, pytest, xdist, cocotb, mypy, dask, distributed" >/dev/null 2>&1; then
+    echo "== installing maturin, numpy, pytest, pytest-xdist, cocotb, mypy, dask[distributed] into $python_venv"
     python3 -m venv "$python_venv"
-    "$python_venv/bin/pip" install -q "maturin>=1.5,<2" numpy pytest pytest-xdist "cocotb>=2.0,<3" mypy
+    "$python_venv/bin/pip" install -q "maturin>=1.5,<2" numpy pytest pytest-xdist "cocotb>=2.0,<3" mypy "dask[distributed]>=2026.1,<2027"
 fi
 cargo fmt --manifest-path python/Cargo.toml -- --check
 # In the workspace's target folder and its dev profile (the model fully optimised): a crate

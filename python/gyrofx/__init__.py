@@ -45,6 +45,7 @@ from ._gyrofx import (
     quantize,
     to_real,
 )
+from ._population import PopulationResult, population
 
 __all__ = [
     "Chain",
@@ -61,12 +62,14 @@ __all__ = [
     "MeanFilterFloat",
     "Overflow",
     "Plan",
+    "PopulationResult",
     "Resonator",
     "Rounding",
     "Sequencer",
     "System",
     "SystemFloat",
     "__version__",
+    "population",
     "quantize",
     "to_real",
 ]

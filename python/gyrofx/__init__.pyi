@@ -6,7 +6,8 @@ reverse. Real values are °/s. Every refused input raises ``GyrofxError``.
 """
 
 from os import PathLike
-from typing import ClassVar, Dict, List, Literal, Optional, Tuple, TypedDict, Union, final, overload
+from pathlib import Path
+from typing import Any, ClassVar, Dict, List, Literal, Optional, Sequence, Tuple, TypedDict, Union, final, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -26,12 +27,14 @@ __all__ = [
     "MeanFilterFloat",
     "Overflow",
     "Plan",
+    "PopulationResult",
     "Resonator",
     "Rounding",
     "Sequencer",
     "System",
     "SystemFloat",
     "__version__",
+    "population",
     "quantize",
     "to_real",
 ]
@@ -463,3 +466,54 @@ class Resonator:
         """The pick-offs follow the loop's mode (1 normal, 0 reverse) from this sample on."""
     def step(self, dac_x: int, dac_y: int) -> _ResonatorStep:
         """The ADC codes adc_x, adc_y the loop reads next."""
+
+class PopulationResult:
+    """A population study's outcome: ``population.csv`` and ``summary.json`` as ``gyrofx
+    population`` writes them, byte for byte. ``header`` and ``lines`` are the CSV's lines
+    (``\\n`` ended; ``lines[i]`` is member ``i``), ``columns`` the header's names,
+    ``summary`` the parsed ``summary.json`` and ``summary_json`` its exact text."""
+
+    columns: List[str]
+    header: str
+    lines: List[str]
+    summary: Dict[str, Any]
+    summary_json: str
+    def __init__(
+        self,
+        columns: List[str],
+        header: str,
+        lines: List[str],
+        summary: Dict[str, Any],
+        summary_json: str,
+    ) -> None: ...
+    @property
+    def csv(self) -> str:
+        """``population.csv``'s text."""
+    def rows(self) -> List[Dict[str, str]]:
+        """Each member's row as a dict of cells by column (empty: the figure does not exist)."""
+    def write(self, folder: Union[str, PathLike[str]]) -> List[Path]:
+        """Writes ``population.csv`` and ``summary.json`` (the CLI's bytes; not its plots or
+        manifest) into ``folder``, created if missing; returns their paths."""
+
+def population(
+    config: Union[str, PathLike[str], None] = None,
+    *,
+    toml: Optional[str] = None,
+    preset: Optional[str] = None,
+    gyros: int,
+    seconds: float = 10.0,
+    noise: bool = False,
+    seed: Optional[int] = None,
+    targets: Sequence[str] = (),
+    client: Any = None,
+    batch: Optional[int] = None,
+    jobs: Optional[int] = None,
+    in_flight: Optional[int] = None,
+) -> PopulationResult:
+    """``gyrofx population``'s study (docs/guide how-to/population.md): the default config
+    overlaid by ``preset``, then the file ``config`` or the TOML text ``toml``; ``gyros``
+    members, ``seconds`` of chain run each, ``noise``, ``seed`` and ``targets`` as the CLI's
+    flags. Without ``client``, on ``jobs`` threads here (default: every core); with a
+    ``dask.distributed.Client``, on its cluster in batches of ``batch`` members, at most
+    ``in_flight`` batches out (default: twice its threads), only strings and numbers shipped.
+    Equal to the CLI's files byte for byte either way."""

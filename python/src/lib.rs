@@ -15,6 +15,7 @@ mod codes;
 mod format;
 mod loops;
 mod plan;
+mod population;
 
 create_exception!(
     gyrofx,
@@ -53,5 +54,8 @@ fn _gyrofx(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<format::Overflow>()?;
     module.add_function(wrap_pyfunction!(format::quantize, module)?)?;
     module.add_function(wrap_pyfunction!(format::to_real, module)?)?;
+    module.add_function(wrap_pyfunction!(population::_population_describe, module)?)?;
+    module.add_function(wrap_pyfunction!(population::_population_members, module)?)?;
+    module.add_function(wrap_pyfunction!(population::_population_summary, module)?)?;
     Ok(())
 }
