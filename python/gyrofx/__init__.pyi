@@ -470,7 +470,7 @@ class Resonator:
 class PopulationResult:
     """A population study's outcome: ``population.csv`` and ``summary.json`` as ``gyrofx
     population`` writes them, byte for byte. ``header`` and ``lines`` are the CSV's lines
-    (``\\n`` ended; ``lines[i]`` is member ``i``), ``columns`` the header's names,
+    (each ends in a newline; ``lines[i]`` is member ``i``), ``columns`` the header's names,
     ``summary`` the parsed ``summary.json`` and ``summary_json`` its exact text."""
 
     columns: List[str]

@@ -49,8 +49,8 @@ def _study_batch(definition: _Definition, first: int, count: int) -> List[_Membe
 class PopulationResult:
     """A population study's outcome: ``population.csv`` and ``summary.json`` as the CLI writes them.
 
-    ``header`` and ``lines`` are the CSV's lines (``\\n`` ended; ``lines[i]`` is member ``i``),
-    ``columns`` the header's names, ``summary`` the parsed ``summary.json`` and
+    ``header`` and ``lines`` are the CSV's lines (each ends in a newline; ``lines[i]`` is
+    member ``i``), ``columns`` the header's names, ``summary`` the parsed ``summary.json`` and
     ``summary_json`` its exact text.
     """
 
@@ -225,8 +225,8 @@ def population(
     installed (the same version). Either way the result equals the CLI's ``population.csv``
     and ``summary.json`` byte for byte.
 
-    Raises ``GyrofxError`` with the CLI's message for a refused config, preset, seconds,
-    target or member count; ``OSError`` when the ``config`` file cannot be read.
+    Raises ``GyrofxError`` for a refused config (the CLI's message), preset, seconds, target
+    or member count; ``OSError`` when the ``config`` file cannot be read.
     """
     if config is not None and toml is not None:
         raise GyrofxError("give config (a file) or toml (a text), not both")

@@ -64,7 +64,7 @@ fn targets(texts: &[String]) -> PyResult<Vec<Target>> {
 
 /// The run checked and described: `seed` (resolved), `columns` and `header` (the CSV's first
 /// line), `chain_rate_hz`, `startup_s` and `spreads` (one line each). Raises `GyrofxError`
-/// with the CLI's message for a bad config, preset, seconds or target.
+/// for a bad config (the CLI's message), preset, seconds or target.
 #[pyfunction]
 #[pyo3(signature = (config, origin, preset, seed, seconds, noise, targets))]
 #[allow(clippy::too_many_arguments)]
