@@ -8,6 +8,8 @@
 //! the preset, the seed, the seconds and the noise) instead of an object: a member is a pure
 //! function of it and its index ([`Population::study`]).
 
+use std::sync::{Arc, Mutex};
+
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -18,6 +20,18 @@ use gyrofx_job::population::{columns, Population, RunSettings, MAX_SECONDS, STAR
 
 use crate::refused;
 
+/// What a population is resolved from: the config's text, its origin, the preset, the seed.
+type Definition = (Option<String>, String, Option<String>, Option<u64>);
+
+/// The populations resolved last in this process, newest last: resolving one (the job's plans,
+/// its proven formats) takes about as long as studying a member, and a worker is given the same
+/// definition with every batch. A cache, not a state: a population is a function of its
+/// definition.
+static RESOLVED: Mutex<Vec<(Definition, Arc<Population>)>> = Mutex::new(Vec::new());
+
+/// Populations [`RESOLVED`] keeps.
+const RESOLVED_KEPT: usize = 4;
+
 /// The population of the embedded default overlaid by `preset` and then by the TOML text
 /// `config` (`origin` names it in errors, as the CLI names a `--config` file by its path), its
 /// seed replaced by `seed`.
@@ -26,13 +40,25 @@ fn resolve(
     origin: &str,
     preset: Option<&str>,
     seed: Option<u64>,
-) -> PyResult<Population> {
+) -> Result<Arc<Population>, gyrofx_job::error::Error> {
+    let key: Definition = (
+        config.map(str::to_string),
+        origin.to_string(),
+        preset.map(str::to_string),
+        seed,
+    );
+    let cached = |cache: &Vec<(Definition, Arc<Population>)>| {
+        cache
+            .iter()
+            .find(|(k, _)| *k == key)
+            .map(|(_, p)| Arc::clone(p))
+    };
+    if let Some(population) = cached(&RESOLVED.lock().unwrap_or_else(|e| e.into_inner())) {
+        return Ok(population);
+    }
     let mut overlays: Vec<(String, String)> = Vec::new();
     if let Some(name) = preset {
-        overlays.push((
-            config::preset(name).map_err(refused)?.to_string(),
-            format!("preset {name}"),
-        ));
+        overlays.push((config::preset(name)?.to_string(), format!("preset {name}")));
     }
     if let Some(text) = config {
         overlays.push((text.to_string(), origin.to_string()));
@@ -41,11 +67,19 @@ fn resolve(
         .iter()
         .map(|(t, o)| (t.as_str(), o.as_str()))
         .collect();
-    let mut config = Config::from_overlays(&refs).map_err(refused)?;
+    let mut config = Config::from_overlays(&refs)?;
     if let Some(seed) = seed {
         config.seed = seed;
     }
-    Population::new(&config).map_err(refused)
+    let population = Arc::new(Population::new(&config)?);
+    let mut cache = RESOLVED.lock().unwrap_or_else(|e| e.into_inner());
+    if cached(&cache).is_none() {
+        if cache.len() == RESOLVED_KEPT {
+            cache.remove(0);
+        }
+        cache.push((key, Arc::clone(&population)));
+    }
+    Ok(population)
 }
 
 /// `seconds` and `noise` checked as `--seconds` is.
@@ -80,7 +114,9 @@ pub(crate) fn _population_describe<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     settings(seconds, noise)?;
     self::targets(&targets)?;
-    let population = resolve(config, origin, preset, seed)?;
+    let population = py
+        .detach(|| resolve(config, origin, preset, seed))
+        .map_err(refused)?;
     let header = columns::header(&population);
     let dict = PyDict::new(py);
     dict.set_item("seed", population.seed)?;
@@ -113,12 +149,12 @@ pub(crate) fn _population_members(
     noise: bool,
 ) -> PyResult<Vec<MemberRow>> {
     let settings = settings(seconds, noise)?;
-    let population = resolve(config, origin, preset, seed)?;
     let last = first
         .checked_add(count)
         .ok_or_else(|| refused(format!("members {first} + {count} overflow")))?;
-    Ok(py.detach(|| {
-        (first..last)
+    py.detach(|| -> Result<Vec<MemberRow>, gyrofx_job::error::Error> {
+        let population = resolve(config, origin, preset, seed)?;
+        Ok((first..last)
             .map(|index| {
                 let result = population.study(index, &settings);
                 let record = Record::of(&result);
@@ -129,8 +165,9 @@ pub(crate) fn _population_members(
                     record.figures.to_vec(),
                 )
             })
-            .collect()
-    }))
+            .collect())
+    })
+    .map_err(refused)
 }
 
 /// `summary.json`'s text from every member's `(status, figures)` in member order, as the CLI
@@ -139,6 +176,7 @@ pub(crate) fn _population_members(
 #[pyo3(signature = (config, origin, preset, seed, seconds, noise, targets, records))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn _population_summary(
+    py: Python<'_>,
     config: Option<&str>,
     origin: &str,
     preset: Option<&str>,
@@ -150,7 +188,9 @@ pub(crate) fn _population_summary(
 ) -> PyResult<String> {
     let settings = settings(seconds, noise)?;
     let targets = self::targets(&targets)?;
-    let population = resolve(config, origin, preset, seed)?;
+    let population = py
+        .detach(|| resolve(config, origin, preset, seed))
+        .map_err(refused)?;
     let mut sum = Summary::new(&targets);
     for (status, figures) in &records {
         sum.add_record(&Record::new(status, figures).map_err(refused)?);
