@@ -91,7 +91,7 @@ def test_a_local_cluster_gives_the_clis_files(config_file, cli_files, tmp_path):
         processes=True,
         threads_per_worker=1,
         host="127.0.0.1",
-        dashboard_address=None,
+        dashboard_address="127.0.0.1:0",
         local_directory=str(tmp_path / "dask"),
     ) as cluster, Client(cluster) as client:
         result = study(config_file, client=client, batch=1, in_flight=3)
