@@ -37,10 +37,10 @@
  *   CIC_DECIMATION-th) all SCHEDULE_LEN.
  *
  * Pipeline: ce takes the sample (inputs, mode, switch clears); the schedule's word t acts
- *   t + 1 clocks after ce. dac_x, dac_y and locked load at the schedule's DAC and lock
- *   words; rate, quadrature and out_valid (one clock) at its end. The next ce may come
- *   SCHEDULE_LEN + 1 clocks after ce (gyrofx_job::pipeline). A clock with rst high stops
- *   the schedule and clears every register a sample reads before it loads it (the pipeline's
+ *   t + 2 clocks after ce (fetched, then its accumulator operands decoded). dac_x, dac_y
+ *   and locked load at the schedule's DAC and lock words; rate, quadrature and out_valid
+ *   (one clock) at its end. The next ce may come SCHEDULE_LEN + 2 clocks after ce
+ *   (gyrofx_job::pipeline). A clock with rst high stops the schedule and clears every register a sample reads before it loads it (the pipeline's
  *   operand, product and read registers load again before they are read); the RAM keeps its
  *   words, which the next samples' read gates ignore until they are written again.
  *
@@ -324,7 +324,12 @@ end
 
 reg busy_reg = 1'b0;
 reg [PC_W-1:0] pc_reg = {PC_W{1'b0}};
+// The word fetched (the schedule ROM's output register), then the word executing a clock
+// later: the clock between decodes the accumulator's operands from the fetched word.
+reg [63:0] fetched_reg = 64'd0;
 reg [63:0] control_reg = 64'd0;
+reg executing_reg = 1'b0;
+reg executing_last_reg = 1'b0;
 reg mode_reg = 1'b1;
 reg start_reg = 1'b1;
 reg switching_reg = 1'b0;
@@ -347,8 +352,34 @@ wire [PC_W-1:0] fetch_address = ce ? {PC_W{1'b0}} : pc_reg + 1'b1;
 
 always @(posedge clk) begin
     if (fetch) begin
-        control_reg <= schedule[fetch_address];
+        fetched_reg <= schedule[fetch_address];
     end
+    control_reg <= fetched_reg;
+    executing_reg <= busy_reg && !rst;
+    executing_last_reg <= last_word && !rst;
+end
+
+// The accumulator's x and y decoded from the fetched word into one-hot selects, a clock
+// before the word executes: a clock runs an AND-OR of registered selects into the adder, not
+// the ROM's output through a decoder (gyrofx_model::gyro_loop::folded::AccX, AccY codes).
+wire [3:0] next_x_field = fetched_reg[22:19];
+wire [3:0] next_y_field = fetched_reg[26:23];
+// (x code 1 and y code 0 select nothing, 0: their bits stay 0.)
+/* verilator lint_off UNUSEDSIGNAL */
+reg [8:0] x_select_reg = 9'd0;
+reg [9:0] y_select_reg = 10'd0;
+/* verilator lint_on UNUSEDSIGNAL */
+reg y_negate_reg = 1'b0;
+reg accumulate_reg = 1'b0;
+always @(posedge clk) begin
+    x_select_reg <= {next_x_field == 4'd8, next_x_field == 4'd7, next_x_field == 4'd6,
+        next_x_field == 4'd5, next_x_field == 4'd4, next_x_field == 4'd3, next_x_field == 4'd2,
+        1'b0, next_x_field == 4'd0};
+    y_select_reg <= {next_y_field == 4'd9, next_y_field == 4'd8, next_y_field == 4'd7,
+        next_y_field == 4'd6, next_y_field == 4'd5, next_y_field == 4'd4, next_y_field == 4'd3,
+        next_y_field == 4'd2, next_y_field == 4'd1, 1'b0};
+    y_negate_reg <= next_y_field == 4'd2 || next_y_field == 4'd4 || next_y_field == 4'd7;
+    accumulate_reg <= next_x_field != 4'd0 || next_y_field != 4'd0;
 end
 
 // The control word's fields (gyrofx_model::gyro_loop::folded::Control): a fixed layout, whose
@@ -374,11 +405,11 @@ wire [3:0] quantize_field = control_reg[56:53];
 wire [6:0] spare_field = control_reg[63:57];
 /* verilator lint_on UNUSEDSIGNAL */
 
-wire rom_en = busy_reg && rom_field != 3'd0;
-wire accumulate_en = busy_reg && (x_field != 4'd0 || y_field != 4'd0);
-wire read_en = busy_reg && read_field;
-wire write_en = busy_reg && write_field;
-wire [3:0] point = busy_reg ? quantize_field : 4'd0;
+wire rom_en = executing_reg && rom_field != 3'd0;
+wire accumulate_en = executing_reg && accumulate_reg;
+wire read_en = executing_reg && read_field;
+wire write_en = executing_reg && write_field;
+wire [3:0] point = executing_reg ? quantize_field : 4'd0;
 
 // ---- NCO: one accumulator, three references' truncation errors, the sine ROM -------------
 reg [NCO_PHASE_W-1:0] nco_acc_reg = {NCO_PHASE_W{1'b0}};
@@ -613,31 +644,30 @@ wire signed [ACC_W-1:0] drive_q_acc = {{(ACC_W-DEMOD_OUT_W){drive_q_reg[DEMOD_OU
 wire signed [ACC_W-1:0] error_acc =
     {{(ACC_W-AGC_ERR_W){amplitude_error_reg[AGC_ERR_W-1]}}, amplitude_error_reg};
 
+// x and y as AND-ORs of the selects decoded a clock early (at most one select is high; none:
+// x = 0, y = 0).
 wire signed [ACC_W-1:0] x_value =
-    x_field == 4'd1 ? {ACC_W{1'b0}}
-    : x_field == 4'd2 ? rd_acc
-    : x_field == 4'd3 ? rd_acc <<< DEMOD_SHIFT
-    : x_field == 4'd4 ? setpoint_acc
-    : x_field == 4'd5 ? rd_acc <<< (PLL_UPD_F - PLL_INT_F)
-    : x_field == 4'd6 ? v_acc <<< (PLL_SUM_F - PLL_INT_F)
-    : x_field == 4'd7 ? rd_acc <<< (AGC_UPD_F - AGC_INT_F)
-    : x_field == 4'd8 ? v_acc <<< (AGC_SUM_F - AGC_INT_F)
-    : acc_reg;
+      ({ACC_W{x_select_reg[0]}} & acc_reg)
+    | ({ACC_W{x_select_reg[2]}} & rd_acc)
+    | ({ACC_W{x_select_reg[3]}} & (rd_acc <<< DEMOD_SHIFT))
+    | ({ACC_W{x_select_reg[4]}} & setpoint_acc)
+    | ({ACC_W{x_select_reg[5]}} & (rd_acc <<< (PLL_UPD_F - PLL_INT_F)))
+    | ({ACC_W{x_select_reg[6]}} & (v_acc <<< (PLL_SUM_F - PLL_INT_F)))
+    | ({ACC_W{x_select_reg[7]}} & (rd_acc <<< (AGC_UPD_F - AGC_INT_F)))
+    | ({ACC_W{x_select_reg[8]}} & (v_acc <<< (AGC_SUM_F - AGC_INT_F)));
 
 // y, and whether it enters negated (x + ~y + 1).
 wire signed [ACC_W-1:0] y_value =
-    y_field == 4'd1 ? pp_reg
-    : y_field == 4'd2 ? rd_acc
-    : y_field == 4'd3 ? p_acc <<< DEMOD_ALIGN
-    : (y_field == 4'd4 || y_field == 4'd5) ? output_acc
-    : y_field == 4'd6 ? previous_rd_acc
-    : y_field == 4'd7 ? rd_acc >>> LOCK_SHIFT
-    : y_field == 4'd8 ? drive_q_acc
-    : y_field == 4'd9 ? error_acc
-    : {ACC_W{1'b0}};
-wire y_negate = y_field == 4'd2 || y_field == 4'd4 || y_field == 4'd7;
+      ({ACC_W{y_select_reg[1]}} & pp_reg)
+    | ({ACC_W{y_select_reg[2]}} & rd_acc)
+    | ({ACC_W{y_select_reg[3]}} & (p_acc <<< DEMOD_ALIGN))
+    | ({ACC_W{y_select_reg[4] | y_select_reg[5]}} & output_acc)
+    | ({ACC_W{y_select_reg[6]}} & previous_rd_acc)
+    | ({ACC_W{y_select_reg[7]}} & (rd_acc >>> LOCK_SHIFT))
+    | ({ACC_W{y_select_reg[8]}} & drive_q_acc)
+    | ({ACC_W{y_select_reg[9]}} & error_acc);
 wire signed [ACC_W-1:0] acc_next =
-    x_value + (y_negate ? ~y_value : y_value) + {{(ACC_W-1){1'b0}}, y_negate};
+    x_value + (y_negate_reg ? ~y_value : y_value) + {{(ACC_W-1){1'b0}}, y_negate_reg};
 
 // ---- quantization points, at the parallel loop's formats -----------------------------------
 wire signed [DEMOD_PROD_W-1:0] p_next;
@@ -773,11 +803,10 @@ wire within_limit = z_cmp < lock_limit && z_cmp > lock_floor;
 // ---- RAM writes ---------------------------------------------------------------------------
 wire signed [RAM_W-1:0] write_data =
     data_field == 3'd1 ? {{(RAM_W-Z_W){z[Z_W-1]}}, z}
-    : data_field == 3'd2 ? {{(RAM_W-DEMOD_STATE_W){y_next[DEMOD_STATE_W-1]}}, y_next}
-    : data_field == 3'd3 ? {{(RAM_W-PLL_INT_W){pll_v_next[PLL_INT_W-1]}}, pll_v_next}
-    : data_field == 3'd4 ? {{(RAM_W-AGC_INT_W){agc_v_next[AGC_INT_W-1]}}, agc_v_next}
-    : data_field == 3'd5 ? rd
-    : data_field == 3'd6 ? {{(RAM_W-CIC_MID_W){c_reg[CIC_MID_W-1]}}, c_reg}
+    : data_field == 3'd2 ? {{(RAM_W-DEMOD_STATE_W){y_reg[DEMOD_STATE_W-1]}}, y_reg}
+    : data_field == 3'd3 ? {{(RAM_W-V_W){v_reg[V_W-1]}}, v_reg}
+    : data_field == 3'd4 ? rd
+    : data_field == 3'd5 ? {{(RAM_W-CIC_MID_W){c_reg[CIC_MID_W-1]}}, c_reg}
     : {{(RAM_W-REG_W){acc_reg[REG_W-1]}}, acc_reg[REG_W-1:0]};
 
 always @(posedge clk) begin
@@ -842,12 +871,12 @@ always @(posedge clk) begin
     end else if (busy_reg) begin
         if (last_word) begin
             busy_reg <= 1'b0;
-            if (decimate_reg && seen_reg < MOST_SEEN[3:0]) begin
-                seen_reg <= seen_reg + 4'd1;
-            end
         end else begin
             pc_reg <= pc_reg + 1'b1;
         end
+    end
+    if (executing_reg && executing_last_reg && decimate_reg && seen_reg < MOST_SEEN[3:0]) begin
+        seen_reg <= seen_reg + 4'd1;
     end
 
     if (rom_en) begin
@@ -856,7 +885,7 @@ always @(posedge clk) begin
             residue_reg[nco_index] <= phase[R_W-1:0] ^ HALF_BIN;
         end
     end
-    if (busy_reg && advance_field) begin
+    if (executing_reg && advance_field) begin
         nco_acc_reg <= nco_acc_reg + freq_sample;
     end
     if (read_en) begin
@@ -957,7 +986,7 @@ assign locked = locked_reg;
 // Simulation only (yosys defines SYNTHESIS): a sample takes the schedule's clocks
 // (gyrofx_job::pipeline); a sooner ce stops the simulation, naming this instance.
 gyrofx_spacing_check #(
-    .MIN_CLOCKS_PER_SAMPLE(SCHEDULE_LEN + 1),
+    .MIN_CLOCKS_PER_SAMPLE(SCHEDULE_LEN + 2),
     .BLOCK_NAME("gyrofx_gyro_loop_serial")
 ) spacing_check (
     .clk(clk),

@@ -34,10 +34,11 @@
 --   CIC_DECIMATION-th) all SCHEDULE_LEN.
 --
 -- Pipeline: ce takes the sample (inputs, mode, switch clears); the schedule's word t acts
---   t + 1 clocks after ce. dac_x, dac_y and locked load at the schedule's DAC and lock
---   words; rate, quadrature and out_valid (one clock) at its end. The next ce may come
---   SCHEDULE_LEN + 1 clocks after ce (gyrofx_job::pipeline). A clock with rst high clears
---   every register of the loop's state and stops the schedule; the RAM keeps its words,
+--   t + 2 clocks after ce (fetched, then its accumulator operands decoded). dac_x, dac_y
+--   and locked load at the schedule's DAC and lock words; rate, quadrature and out_valid
+--   (one clock) at its end. The next ce may come SCHEDULE_LEN + 2 clocks after ce
+--   (gyrofx_job::pipeline). A clock with rst high clears every register of the loop's state
+--   and stops the schedule; the RAM keeps its words,
 --   which the next samples' read gates ignore until they are written again (as in the
 --   Verilog, the control word, the sine ROM's, the multiplier's and the RAM's read registers
 --   are not cleared: nothing reads them before the next sample's schedule loads them).
@@ -429,7 +430,17 @@ architecture rtl of gyrofx_gyro_loop_serial is
     -- ---- control: the schedule ROM, the sample's flags ----
     signal busy_reg : std_logic := '0';
     signal pc_reg : unsigned(PC_W - 1 downto 0) := (others => '0');
+    -- The word fetched (the schedule ROM's output register), then the word executing a clock
+    -- later: the clock between decodes the accumulator's operands from the fetched word.
+    signal fetched_reg : std_logic_vector(63 downto 0) := (others => '0');
     signal control_reg : std_logic_vector(63 downto 0) := (others => '0');
+    signal executing_reg : std_logic := '0';
+    signal executing_last_reg : std_logic := '0';
+    -- The fetched word's x and y codes, registered (the Verilog's one-hot selects), and
+    -- whether it accumulates and negates y.
+    signal x_code_reg : unsigned(3 downto 0) := (others => '0');
+    signal y_code_reg : unsigned(3 downto 0) := (others => '0');
+    signal accumulate_reg : std_logic := '0';
     signal mode_reg : std_logic := '1';
     signal start_reg : std_logic := '1';
     signal switching_reg : std_logic := '0';
@@ -613,7 +624,8 @@ begin
     switching <= '1' when mode /= mode_reg or start_reg = '1' else '0';
     schedule_end <= DECIMATING_END when decimate_reg = '1' else REGULAR_END;
     last_word <= '1' when busy_reg = '1' and pc_reg = schedule_end else '0';
-    -- A word is fetched the clock before it acts: word 0 at ce, word t + 1 while t acts.
+    -- A word is fetched two clocks before it acts (word 0 at ce), its x and y decoded the
+    -- clock between.
     fetch <= (ce and not rst) or (busy_reg and not last_word);
     fetch_address <= (others => '0') when ce = '1' else pc_reg + 1;
 
@@ -622,10 +634,20 @@ begin
         if rising_edge(clk) then
             if fetch = '1' then
                 if to_integer(fetch_address) < SCHEDULE_LEN then
-                    control_reg <= SCHEDULE(to_integer(fetch_address));
+                    fetched_reg <= SCHEDULE(to_integer(fetch_address));
                 else
-                    control_reg <= (others => '0');
+                    fetched_reg <= (others => '0');
                 end if;
+            end if;
+            control_reg <= fetched_reg;
+            executing_reg <= busy_reg and not rst;
+            executing_last_reg <= last_word and not rst;
+            x_code_reg <= unsigned(fetched_reg(22 downto 19));
+            y_code_reg <= unsigned(fetched_reg(26 downto 23));
+            if unsigned(fetched_reg(26 downto 19)) /= 0 then
+                accumulate_reg <= '1';
+            else
+                accumulate_reg <= '0';
             end if;
         end if;
     end process;
@@ -649,11 +671,11 @@ begin
     quantize_field <= unsigned(control_reg(56 downto 53));
 
     -- The word acts only while the schedule runs: the last one stays in control_reg after it.
-    rom_en <= '1' when busy_reg = '1' and rom_field /= 0 else '0';
-    accumulate_en <= '1' when busy_reg = '1' and (x_field /= 0 or y_field /= 0) else '0';
-    read_en <= busy_reg and read_field;
-    write_en <= busy_reg and write_field;
-    point <= quantize_field when busy_reg = '1' else (others => '0');
+    rom_en <= '1' when executing_reg = '1' and rom_field /= 0 else '0';
+    accumulate_en <= executing_reg and accumulate_reg;
+    read_en <= executing_reg and read_field;
+    write_en <= executing_reg and write_field;
+    point <= quantize_field when executing_reg = '1' else (others => '0');
 
     -- ---- NCO: one accumulator, three references' truncation errors, the sine ROM ----
     -- rom_field: 1 drive sin, 2 drive cos, 3 transmit cos, 4 sense sin, 5 sense cos.
@@ -824,7 +846,7 @@ begin
 
     x_operand : process (all)
     begin
-        case to_integer(x_field) is
+        case to_integer(x_code_reg) is
             when 1 => x_value <= (others => '0');
             when 2 => x_value <= resize(rd, ACC_W);
             when 3 => x_value <= shift_left(resize(rd, ACC_W), DEMOD_SHIFT);
@@ -841,7 +863,7 @@ begin
     y_operand : process (all)
     begin
         y_negate <= '0';
-        case to_integer(y_field) is
+        case to_integer(y_code_reg) is
             when 1 => y_value <= pp_reg;
             when 2 =>
                 y_value <= resize(rd, ACC_W);
@@ -995,11 +1017,10 @@ begin
     begin
         case to_integer(data_field) is
             when 1 => write_data <= resize(z, RAM_W);
-            when 2 => write_data <= resize(y_next, RAM_W);
-            when 3 => write_data <= resize(pll_v_next, RAM_W);
-            when 4 => write_data <= resize(agc_v_next, RAM_W);
-            when 5 => write_data <= rd;
-            when 6 => write_data <= resize(c_reg, RAM_W);
+            when 2 => write_data <= resize(y_reg, RAM_W);
+            when 3 => write_data <= resize(v_reg, RAM_W);
+            when 4 => write_data <= rd;
+            when 5 => write_data <= resize(c_reg, RAM_W);
             -- The accumulator wrapped to the CIC registers' width.
             when others => write_data <= resize(acc_reg(REG_W - 1 downto 0), RAM_W);
         end case;
@@ -1060,12 +1081,13 @@ begin
             elsif busy_reg = '1' then
                 if last_word = '1' then
                     busy_reg <= '0';
-                    if decimate_reg = '1' and seen_reg < SEEN_LIMIT then
-                        seen_reg <= seen_reg + 1;
-                    end if;
                 else
                     pc_reg <= pc_reg + 1;
                 end if;
+            end if;
+            if executing_reg = '1' and executing_last_reg = '1' and decimate_reg = '1'
+                and seen_reg < SEEN_LIMIT then
+                seen_reg <= seen_reg + 1;
             end if;
 
             if rom_en = '1' then
@@ -1076,7 +1098,7 @@ begin
                     residue_reg(nco_index) <= signed(phase(R_W - 1 downto 0)) xor HALF_BIN;
                 end if;
             end if;
-            if busy_reg = '1' and advance_field = '1' then
+            if executing_reg = '1' and advance_field = '1' then
                 nco_acc_reg <= nco_acc_reg + freq_sample;
             end if;
             if read_en = '1' then
@@ -1186,7 +1208,7 @@ begin
     -- ce stops the simulation, naming this instance.
     spacing_check : entity work.gyrofx_spacing_check
         generic map (
-            MIN_CLOCKS_PER_SAMPLE => SCHEDULE_LEN + 1, BLOCK_NAME => "gyrofx_gyro_loop_serial"
+            MIN_CLOCKS_PER_SAMPLE => SCHEDULE_LEN + 2, BLOCK_NAME => "gyrofx_gyro_loop_serial"
         )
         port map (clk => clk, rst => rst, ce => ce);
     -- pragma translate_on

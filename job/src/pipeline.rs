@@ -57,11 +57,13 @@ pub const TOP: Pipeline = ESTIMATOR;
 pub const GYRO_LOOP: Pipeline = Pipeline::new(4, 4);
 
 /// The gyro loop as `job` builds it: [`GYRO_LOOP`], or `gyrofx_gyro_loop_serial`, whose
-/// schedule's last word loads the outputs the clock after it acts (the next `ce` no sooner).
+/// schedule's word `t` acts `t + 2` clocks after `ce` (a clock fetches it, a clock decodes its
+/// accumulator operands) and its last word loads the outputs the clock after (the next `ce` no
+/// sooner).
 pub fn gyro_loop(job: &Job) -> Pipeline {
     match &job.loop_schedule {
         Some(schedule) => {
-            let latency = schedule.len() as u32 + 1;
+            let latency = schedule.len() as u32 + 2;
             Pipeline::new(latency, latency)
         }
         None => GYRO_LOOP,

@@ -197,23 +197,23 @@ field_enum!(
 );
 
 field_enum!(
-    /// What a RAM write stores (sign-extended to the RAM's width).
+    /// What a RAM write stores (sign-extended to the RAM's width). A quantized state is
+    /// written from the register its point loaded, the clock after, so that no clock runs a
+    /// quantizer into the RAM's write multiplexer.
     WriteData {
         /// The accumulator, wrapped to the CIC register width.
         #[default]
         AccCic = 0,
         /// The accumulator, a lock filter's `z`.
         AccLock = 1,
-        /// The accumulator through the demodulator state's point.
+        /// The demodulator state register `y`.
         DemodState = 2,
-        /// The accumulator through the PLL's integrator point and clamp.
-        PllIntegrator = 3,
-        /// The same for the AGC.
-        AgcIntegrator = 4,
+        /// The PI integrator register `v` (the PLL's or the AGC's).
+        Integrator = 3,
         /// The RAM read register (the delay lines' shift).
-        Read = 5,
+        Read = 4,
         /// The CIC output register `c`.
-        Cic = 6,
+        Cic = 5,
     }
 );
 

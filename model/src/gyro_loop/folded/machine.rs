@@ -431,11 +431,8 @@ impl FoldedGyroLoop {
             let value = match write.data {
                 WriteData::AccCic => sign_extend(acc, self.exact.register),
                 WriteData::AccLock => sign_extend(acc, self.datapath.lock_width),
-                WriteData::DemodState => {
-                    self.points.state.apply(sign_extend(acc, self.exact.state))
-                }
-                WriteData::PllIntegrator => self.pll_integrator(acc),
-                WriteData::AgcIntegrator => self.agc_integrator(acc),
+                WriteData::DemodState => y_register,
+                WriteData::Integrator => self.v,
                 WriteData::Read => rd,
                 WriteData::Cic => self.c,
             };

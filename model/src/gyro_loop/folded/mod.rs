@@ -27,10 +27,15 @@
 //!   the `y` of the clock before (no clock runs a quantizer into the accumulator's adder).
 //! - **RAM.** Every state: the four demodulator low-pass states, the two PI integrators, the
 //!   two lock filters, the CICs' integrators and combs, the compensators' delay lines. One
-//!   read and one write a clock; a read lands in `rd` on the next clock. Clears at a mode
-//!   switch and at reset are read gates ([`ReadGate`]), not clocks spent writing zeros.
+//!   read and one write a clock; a read lands in `rd` on the next clock; a quantized state
+//!   is written from the register its point loaded, the clock after ([`WriteData`]). Clears
+//!   at a mode switch and at reset are read gates ([`ReadGate`]), not clocks spent writing
+//!   zeros.
 //! - **NCO.** One accumulator and the three references' truncation errors; a ROM read
 //!   computes the reference's phase and address.
+//!
+//! The RTL fetches each control word two clocks before it acts and decodes the accumulator's
+//! operand selects from it in the clock between; the model's clocks are the words' own.
 //!
 //! The schedule ([`Schedule`]) is derived from the loop's plan: which unit does what in each
 //! clock of a sample, the regular part every sample and the decimation part (combs,

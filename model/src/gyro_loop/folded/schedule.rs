@@ -338,6 +338,8 @@ fn used(c: &Control, t: u32) -> Vec<(Register, u32)> {
         match write.data {
             WriteData::Read => out.push((Register::ReadData, t)),
             WriteData::Cic => out.push((Register::Cic, t)),
+            WriteData::DemodState => out.push((Register::DemodState, t)),
+            WriteData::Integrator => out.push((Register::Integrator, t)),
             _ => out.push((Register::Accumulator, t)),
         }
     }
@@ -440,7 +442,8 @@ fn demodulator(
     t.accumulate(done, AccX::ReadLowpass, AccY::NegRead);
     t.accumulate(done + 1, AccX::Keep, AccY::DemodProduct);
     t.quantize(done + 2, Quantize::DemodState);
-    t.write(done + 2, word, WriteData::DemodState);
+    // The state register loads at done + 2 and is written back from it.
+    t.write(done + 3, word, WriteData::DemodState);
     // The state register loads at done + 2; Q_O's register has its output from done + 4.
     let output = done + 4;
     match consumer {
@@ -478,7 +481,6 @@ struct Pi {
     gate: ReadGate,
     x: [AccX; 2],
     points: [Quantize; 2],
-    data: WriteData,
 }
 
 fn pi(p: &Pi) -> Template {
@@ -487,7 +489,7 @@ fn pi(p: &Pi) -> Template {
     t.read(PRODUCT_LATENCY - 1, p.word, p.gate, 0);
     let update = t.product(0, p.error, p.error_width, p.gains[0], 0, p.x[0]);
     t.quantize(update, p.points[0]);
-    t.write(update, p.word, p.data);
+    t.write(update + 1, p.word, WriteData::Integrator);
     // kp·e's first product arrives the clock after the integrator register loads.
     let sum = t.product(
         update + 1 - PRODUCT_LATENCY,
@@ -672,7 +674,6 @@ impl Schedule {
             gate: ReadGate::Switch,
             x: [AccX::AgcIntegrator, AccX::AgcSum],
             points: [Quantize::AgcIntegrator, Quantize::AgcOutput],
-            data: WriteData::AgcIntegrator,
         });
         let s = line.place(&agc, error_ready)?;
         let amplitude_ready = at(&agc, s, &is(Quantize::AgcOutput)) + 1;
@@ -724,7 +725,6 @@ impl Schedule {
             gate: ReadGate::Preset,
             x: [AccX::PllIntegrator, AccX::PllSum],
             points: [Quantize::PllIntegrator, Quantize::PllOutput],
-            data: WriteData::PllIntegrator,
         });
         let output_at = pll
             .first(|c| c.quantize == Quantize::PllOutput)

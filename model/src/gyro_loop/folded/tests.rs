@@ -62,10 +62,11 @@ fn a_schedule_missing_one_write_is_caught() {
     let schedule = Schedule::new(&plan).unwrap();
     // Drop the PLL integrator's write-back: the loop then never integrates its phase error.
     let mut broken = schedule.clone();
+    let pll_word = schedule.words.pll;
     let clock = broken
         .controls
         .iter()
-        .position(|c| c.quantize == Quantize::PllIntegrator)
+        .position(|c| c.write.is_some_and(|w| w.address == pll_word))
         .unwrap();
     broken.controls[clock].write = None;
     let mut parallel = FixedGyroLoop::new(&plan);
@@ -202,5 +203,5 @@ fn a_control_word_packs_its_fields_at_their_offsets() {
         quantize: Quantize::LockA,
         ..Control::default()
     };
-    assert_eq!(control.encode(), 1 << 42 | 5 << 43 | 6 << 50 | 15 << 53);
+    assert_eq!(control.encode(), 1 << 42 | 5 << 43 | 5 << 50 | 15 << 53);
 }
