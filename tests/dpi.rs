@@ -85,7 +85,10 @@ fn a_c_program_gets_the_models_results_and_its_errors() {
     for (line, p) in [
         ("kf", pipeline::KF),
         ("gyro_loop", pipeline::GYRO_LOOP),
-        ("system", pipeline::SYSTEM),
+        (
+            "system",
+            pipeline::system(&Job::new(Config::embedded()).unwrap()),
+        ),
         ("serial chain", pipeline::top(&serial)),
         ("serial mean_filter", pipeline::mean_filter(&serial)),
         ("estimator", pipeline::ESTIMATOR),

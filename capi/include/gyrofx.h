@@ -29,7 +29,9 @@ typedef struct GyrofxPlan GyrofxPlan;
 // The mode-reversal sequencer (`gyrofx_sequencer`).
 typedef struct GyrofxSequencer GyrofxSequencer;
 
-// The whole gyro (`gyrofx_system`): both loops and the chain.
+// The whole gyro (`gyrofx_system`, or `gyrofx_system_serial` with `architecture = "serial"`:
+// the chain's outputs `gyrofx_job::pipeline::system_chain_delay` samples later): both loops and
+// the chain.
 typedef struct GyrofxSystem GyrofxSystem;
 
 #ifdef __cplusplus

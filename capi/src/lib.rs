@@ -1193,7 +1193,9 @@ pub unsafe extern "C" fn gyrofx_gyro_loop_step(
     }
 }
 
-/// The whole gyro (`gyrofx_system`): both loops and the chain.
+/// The whole gyro (`gyrofx_system`, or `gyrofx_system_serial` with `architecture = "serial"`:
+/// the chain's outputs `gyrofx_job::pipeline::system_chain_delay` samples later): both loops and
+/// the chain.
 pub struct GyrofxSystem(golden::System, Pipeline);
 
 /// The system from reset; NULL when `plan` is NULL or its plant has no system (the rate
@@ -1213,11 +1215,9 @@ pub unsafe extern "C" fn gyrofx_system_new(plan: *const GyrofxPlan) -> *mut Gyro
     // SAFETY: forwarded contract.
     unsafe {
         new(plan, |job| {
-            let [a, b] = &job.gyro_loops;
-            let chain = job.system_chain.as_ref().expect("checked above");
             GyrofxSystem(
-                golden::System::new([&a.plan, &b.plan], chain),
-                pipeline::SYSTEM,
+                golden::System::of(job).expect("checked above"),
+                pipeline::system(job),
             )
         })
     }

@@ -40,6 +40,9 @@ pub struct Job {
     pub serial: Option<gyrofx_model::serial::Program>,
     /// The gyro loop's schedule for `gyrofx_gyro_loop_serial`, with `architecture = "serial"`.
     pub loop_schedule: Option<gyrofx_model::gyro_loop::folded::Schedule>,
+    /// The system's chain ([`Job::system_chain`]) compiled for the `gyrofx_top_serial` inside
+    /// `gyrofx_system_serial`, with `architecture = "serial"` on a resonator plant.
+    pub system_serial: Option<gyrofx_model::serial::Program>,
 }
 
 /// Designs one filter per bandwidth of `settings` at `fs_hz` for the noise model (°/√h, °/h/√h).
@@ -100,8 +103,13 @@ impl Job {
         if job.serial.is_none() {
             job.serial = Some(compile_serial(&job.chain)?);
             job.loop_schedule = Some(schedule_loop(&job.gyro_loops)?);
+            job.system_serial = match &job.system_chain {
+                Some(chain) => Some(compile_serial(chain)?),
+                None => None,
+            };
             job.config.architecture = "serial".into();
             job.settings.architecture = crate::config::Architecture::Serial;
+            crate::pipeline::check_system(&job)?;
         }
         Ok(job)
     }
@@ -135,14 +143,18 @@ impl Job {
             Some(_) => Some(crate::system::chain_plan(&settings.estimator, &chain.kf)?),
             None => None,
         };
-        let (serial, loop_schedule) = match settings.architecture {
-            crate::config::Architecture::Parallel => (None, None),
+        let (serial, loop_schedule, system_serial) = match settings.architecture {
+            crate::config::Architecture::Parallel => (None, None, None),
             crate::config::Architecture::Serial => (
                 Some(compile_serial(&chain)?),
                 Some(schedule_loop(&gyro_loops)?),
+                match &system_chain {
+                    Some(chain) => Some(compile_serial(chain)?),
+                    None => None,
+                },
             ),
         };
-        Ok(Job {
+        let job = Job {
             config,
             settings,
             designs,
@@ -153,7 +165,10 @@ impl Job {
             recording: None,
             serial,
             loop_schedule,
-        })
+            system_serial,
+        };
+        crate::pipeline::check_system(&job)?;
+        Ok(job)
     }
 
     /// The job with `recording` driving the chain: its rate must be the config's and its

@@ -9,6 +9,7 @@
 //! 1 stops a simulation that feeds it faster (a check synthesis ignores).
 
 use crate::config::Architecture;
+use crate::error::{Error, Result};
 use crate::job::Job;
 
 /// A block's pipeline as its RTL has it, in clocks.
@@ -71,10 +72,76 @@ pub fn gyro_loop(job: &Job) -> Pipeline {
 }
 
 /// `gyrofx_system`: the loop's four stages, then the chain's (`gyrofx_top`).
-pub const SYSTEM: Pipeline = Pipeline::new(
+const PARALLEL_SYSTEM: Pipeline = Pipeline::new(
     GYRO_LOOP.latency_clocks + TOP.latency_clocks,
     GYRO_LOOP.latency_clocks + TOP.latency_clocks,
 );
+
+/// The system as `job` builds it: `gyrofx_system` (the loop's four stages, then the chain's),
+/// or `gyrofx_system_serial`, whose outputs all show the clock after the folded loops' (the
+/// chain takes their rates then and its sequencer's modes change), every ADC sample; the
+/// chain's results come [`system_chain_delay`] samples later, at that same clock.
+pub fn system(job: &Job) -> Pipeline {
+    match &job.loop_schedule {
+        Some(_) => {
+            let latency = gyro_loop(job).latency_clocks + 1;
+            Pipeline::new(latency, latency)
+        }
+        None => PARALLEL_SYSTEM,
+    }
+}
+
+/// Clocks `gyrofx_system_serial` leaves between the serial chain's results and their
+/// publication, beyond the chain's latency: the engine's outputs have held for a clock.
+pub const CHAIN_MARGIN_CLOCKS: u32 = 1;
+
+/// ADC samples by which `gyrofx_system_serial` publishes the chain's outputs (`rate_out`,
+/// `out_valid`, `bias_a`, `bias_b`, `estimated`) after the sample whose loop outputs the chain
+/// took (its `CHAIN_DELAY_SAMPLES`); 0 for `gyrofx_system`, which shows them in that sample.
+///
+/// The serial chain needs `gyrofx_top_serial`'s latency S (clocks) for a sample, while a new ADC
+/// sample may come every `system(job).min_clocks_per_sample` = m clocks: publishing at the
+/// K-th sample after, K = ⌈(S + [`CHAIN_MARGIN_CLOCKS`]) / m⌉, reads finished results whatever
+/// the `ce` cadence (the samples are at least m clocks apart).
+pub fn system_chain_delay(job: &Job) -> u32 {
+    match &job.system_serial {
+        Some(program) => {
+            let chain = program.settle_clocks() + 1;
+            (chain + CHAIN_MARGIN_CLOCKS).div_ceil(system(job).min_clocks_per_sample)
+        }
+        None => 0,
+    }
+}
+
+/// Refuses a serial system whose chain cannot finish a sample before the next chain sample:
+/// [`system_chain_delay`] must not exceed the loops' decimation (chain samples are that many
+/// ADC samples apart), so that the engine is free for the next one and its results are
+/// published before they change.
+///
+/// # Errors
+/// [`Error::Config`] naming `loop.decimation` and `architecture`.
+pub fn check_system(job: &Job) -> Result<()> {
+    let Some(program) = &job.system_serial else {
+        return Ok(());
+    };
+    let delay = system_chain_delay(job);
+    let decimation = job.gyro_loops[0].plan.cic.decimation;
+    if u64::from(delay) <= u64::from(decimation) {
+        return Ok(());
+    }
+    let clocks = system(job).min_clocks_per_sample;
+    let chain = program.settle_clocks() + 1;
+    Err(Error::Config {
+        field: "loop.decimation (with architecture = \"serial\")".into(),
+        value: format!(
+            "{decimation}: a chain sample every {decimation} ADC samples of at least {clocks} clocks ({} clocks)",
+            u64::from(decimation) * u64::from(clocks)
+        ),
+        allowed: format!(
+            "at least {delay}: gyrofx_system_serial's chain (gyrofx_top_serial, {chain} clocks a sample, + {CHAIN_MARGIN_CLOCKS}) must finish between chain samples; raise loop.decimation or set architecture = \"parallel\""
+        ),
+    })
+}
 
 /// The chain as `job` builds it: [`TOP`], or `gyrofx_top_serial`, whose sample program takes
 /// its instructions' clocks and frees the engine just after.
@@ -97,6 +164,53 @@ pub fn mean_filter(job: &Job) -> Pipeline {
         Architecture::Serial => {
             let latency = gyrofx_model::mean_filter::serial::latency_clocks(&job.mean_filter);
             Pipeline::new(latency, latency)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::Config;
+
+    fn serial() -> Job {
+        Job::new(Config::from_toml("architecture = \"serial\"\n", "t").unwrap()).unwrap()
+    }
+
+    /// The serial system shows every output the clock after the folded loops' and publishes the
+    /// chain's the fewest samples after that cover the serial chain's clocks and the margin.
+    #[test]
+    fn the_serial_systems_delay_covers_its_chain_in_the_fewest_samples() {
+        let parallel = Job::new(Config::embedded()).unwrap();
+        assert_eq!(system(&parallel), PARALLEL_SYSTEM);
+        assert_eq!(system_chain_delay(&parallel), 0);
+        let job = serial();
+        let timing = system(&job);
+        assert_eq!(
+            timing.latency_clocks,
+            gyro_loop(&job).latency_clocks + 1,
+            "the modes change the clock after the loops' outputs"
+        );
+        assert_eq!(timing.min_clocks_per_sample, timing.latency_clocks);
+        let chain = job.system_serial.as_ref().unwrap().settle_clocks() + 1;
+        let k = system_chain_delay(&job);
+        assert!(k * timing.min_clocks_per_sample >= chain + CHAIN_MARGIN_CLOCKS);
+        assert!((k - 1) * timing.min_clocks_per_sample < chain + CHAIN_MARGIN_CLOCKS);
+        assert!(check_system(&job).is_ok());
+    }
+
+    /// A chain that cannot finish between chain samples is refused, naming the fields and the
+    /// decimation it needs.
+    #[test]
+    fn a_chain_slower_than_the_chain_samples_is_refused_naming_the_fields() {
+        let mut job = serial();
+        let k = system_chain_delay(&job);
+        job.gyro_loops[0].plan.cic.decimation = k;
+        assert!(check_system(&job).is_ok());
+        job.gyro_loops[0].plan.cic.decimation = k - 1;
+        let error = check_system(&job).unwrap_err().to_string();
+        for word in ["loop.decimation", "architecture", &format!("at least {k}")] {
+            assert!(error.contains(word), "{word}: {error}");
         }
     }
 }

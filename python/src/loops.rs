@@ -215,11 +215,9 @@ pub(crate) struct System {
 }
 
 impl System {
-    pub(crate) fn new(loops: [&LoopPlan; 2], chain: &chain::Plan, pipeline: Pipeline) -> System {
-        System {
-            ports: golden::System::new(loops, chain),
-            pipeline,
-        }
+    /// `ports`: the job's system ([`golden::System::of`]), `pipeline` its RTL's.
+    pub(crate) fn new(ports: golden::System, pipeline: Pipeline) -> System {
+        System { ports, pipeline }
     }
 }
 

@@ -8,6 +8,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use gyrofx_job::config::Config;
+use gyrofx_job::golden;
 use gyrofx_job::job::Job;
 use gyrofx_job::pipeline;
 
@@ -162,8 +163,8 @@ impl Plan {
     /// The whole gyro at the ADC rate (`gyrofx_system`): both loops and the chain on the
     /// system's short schedule. Only resonator plants have it.
     fn system(&self) -> PyResult<System> {
-        let (loops, chain) = self.system_plans()?;
-        Ok(System::new(loops, chain, pipeline::SYSTEM))
+        let ports = golden::System::of(&self.job).ok_or_else(|| refused(golden::NO_SYSTEM))?;
+        Ok(System::new(ports, pipeline::system(&self.job)))
     }
 
     /// The system's float twin (quantized coefficients).

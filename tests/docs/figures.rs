@@ -174,7 +174,7 @@ fn the_pipeline_clocks_the_guide_quotes_are_the_codes() {
         pipeline::KF,
         pipeline::ESTIMATOR,
         pipeline::GYRO_LOOP,
-        pipeline::SYSTEM,
+        pipeline::system(&job),
     );
     let top = pipeline::top(&job);
     let top_serial = pipeline::top(&serial);

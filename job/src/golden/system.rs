@@ -1,10 +1,16 @@
-//! The port-level golden model of the whole gyro (`gyrofx_system`).
+//! The port-level golden model of the whole gyro (`gyrofx_system`, and
+//! `gyrofx_system_serial`: the same with the chain's outputs [`crate::pipeline::system_chain_delay`]
+//! ADC samples later).
+
+use std::collections::VecDeque;
 
 use super::{check_bw_sel, check_code, check_flag, PortResult};
 use gyrofx_model::chain;
 use gyrofx_model::gyro_loop::gyro as gyro_loop;
 use gyrofx_model::resonator::Mode;
 use gyrofx_model::system::FixedSystem;
+
+use crate::job::Job;
 
 /// The system's output ports (`gyrofx_system`), in the RTL's order.
 pub const SYSTEM_OUTPUTS: [&str; 13] = [
@@ -38,6 +44,10 @@ pub struct System {
     model: FixedSystem,
     /// `rate_out` of the chain's last output: the RTL holds it between pulses.
     held: i64,
+    /// The chain's outputs (`out_valid`, `rate_out`, `bias_a`, `bias_b`, `estimated`) of the
+    /// last `chain_delay` samples, oldest first: what the serial system publishes ([`System::of`]).
+    delayed: VecDeque<[i64; 5]>,
+    chain_delay: usize,
 }
 
 impl System {
@@ -59,14 +69,37 @@ impl System {
         super::ports::system(&self.loops[0], &self.chain)
     }
 
-    /// From reset: gyro A's and B's loop plans and the system's chain plan.
+    /// From reset: gyro A's and B's loop plans and the system's chain plan (`gyrofx_system`:
+    /// the chain's outputs in the sample that produced them).
     pub fn new(loops: [&gyro_loop::Plan; 2], chain: &chain::Plan) -> System {
         System {
             loops: loops.map(Clone::clone),
             chain: chain.clone(),
             model: FixedSystem::new(loops, chain),
             held: 0,
+            delayed: VecDeque::new(),
+            chain_delay: 0,
         }
+    }
+
+    /// The system `job` builds, from reset: `gyrofx_system`, or with `architecture = "serial"`
+    /// `gyrofx_system_serial`, whose chain outputs (`out_valid`, `rate_out`, `bias_a`, `bias_b`,
+    /// `estimated`) are those of [`System::new`]
+    /// [`crate::pipeline::system_chain_delay`] samples earlier (their reset values before).
+    /// `None` on the rate plant ([`NO_SYSTEM`]).
+    pub fn of(job: &Job) -> Option<System> {
+        let chain = job.system_chain.as_ref()?;
+        let [a, b] = &job.gyro_loops;
+        let mut system = System::new([&a.plan, &b.plan], chain);
+        system.chain_delay = crate::pipeline::system_chain_delay(job) as usize;
+        system.reset();
+        Some(system)
+    }
+
+    /// ADC samples by which the chain's outputs come after the sample that produced them
+    /// (0: `gyrofx_system`).
+    pub fn chain_delay(&self) -> usize {
+        self.chain_delay
     }
 
     /// Gyro A's and B's loop plans.
@@ -83,6 +116,7 @@ impl System {
     pub fn reset(&mut self) {
         self.model = FixedSystem::new([&self.loops[0], &self.loops[1]], &self.chain);
         self.held = 0;
+        self.delayed = std::iter::repeat_n([0; 5], self.chain_delay).collect();
     }
 
     /// The modes `[mode_a, mode_b]` (1 normal, 0 reverse) the loops take at the next sample if
@@ -114,7 +148,8 @@ impl System {
 
     /// One ADC sample: the output ports ([`SYSTEM_OUTPUTS`] order) after it, `mode_a`/`mode_b`
     /// the modes of the next sample when `enable` is high; `rate_out` holds its last value
-    /// where `out_valid` is 0, as the RTL's does.
+    /// where `out_valid` is 0, as the RTL's does. The chain's outputs are those of
+    /// [`System::chain_delay`] samples before (0 after a reset until then).
     ///
     /// # Errors
     /// As [`System::check`].
@@ -135,6 +170,18 @@ impl System {
         let upcoming = self.model.upcoming_modes();
         let estimator = self.model.chain().estimator();
         let [bias_a, bias_b] = estimator.bias();
+        let mut chain = [
+            i64::from(rate.is_some()),
+            self.held,
+            bias_a as i64,
+            bias_b as i64,
+            i64::from(estimator.estimated()),
+        ];
+        if self.chain_delay > 0 {
+            self.delayed.push_back(chain);
+            chain = self.delayed.pop_front().expect("chain_delay entries");
+        }
+        let [out_valid, rate_out, bias_a, bias_b, estimated] = chain;
         [
             step.dac[0][0],
             step.dac[0][1],
@@ -144,11 +191,52 @@ impl System {
             i64::from(step.locked[1]),
             i64::from(upcoming[0] == Mode::Normal),
             i64::from(upcoming[1] == Mode::Normal),
-            i64::from(rate.is_some()),
-            self.held,
-            bias_a as i64,
-            bias_b as i64,
-            i64::from(estimator.estimated()),
+            out_valid,
+            rate_out,
+            bias_a,
+            bias_b,
+            estimated,
         ]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::Config;
+
+    /// The serial system is the parallel one with the chain's five outputs
+    /// `system_chain_delay` samples later (reset values before), the loops' and the modes as
+    /// they are; a reset clears the delay.
+    #[test]
+    fn the_serial_system_is_the_parallel_one_with_the_chains_outputs_delayed() {
+        let config = Config::from_toml("architecture = \"serial\"\n", "t").unwrap();
+        let job = Job::new(config).unwrap();
+        let mut serial = System::of(&job).unwrap();
+        let k = serial.chain_delay();
+        assert_eq!(k, crate::pipeline::system_chain_delay(&job) as usize);
+        assert!(k > 1);
+        let [a, b] = &job.gyro_loops;
+        let mut parallel = System::new([&a.plan, &b.plan], job.system_chain.as_ref().unwrap());
+        let decimation = a.plan.cic.decimation as usize;
+        let mut rows = Vec::new();
+        let mut valid = 0;
+        for round in 0..2 {
+            for n in 0..2 * decimation + k + 3 {
+                let code = |i: usize| ((n * 7919 + i * 104_729) % 2001) as i64 - 1000;
+                let adc = [code(0), code(1), code(2), code(3)];
+                let p = parallel.step(1, 0, adc).unwrap();
+                let s = serial.step(1, 0, adc).unwrap();
+                assert_eq!(s[..8], p[..8], "round {round} sample {n}: loops and modes");
+                rows.push(p);
+                let want = if n >= k { rows[rows.len() - 1 - k] } else { [0; 13] };
+                assert_eq!(s[8..], want[8..], "round {round} sample {n}: chain outputs");
+                valid += s[8];
+            }
+            parallel.reset();
+            serial.reset();
+            rows.clear();
+        }
+        assert!(valid > 0, "the run covers published chain outputs");
     }
 }

@@ -211,7 +211,7 @@ impl RtlBlock for System {
         );
         block.dpi = Some(DPI);
         block.cocotb_test = Some(include_str!("cocotb_test.py"));
-        block.pipeline = pipeline::SYSTEM;
+        block.pipeline = pipeline::system(job);
         let gains = roms.entry(GAINS_ROM);
         let coefficients = roms.entry(kf::ROM);
         block.params = top::chain_params(plan, &gains.0, &coefficients.0);
@@ -255,8 +255,8 @@ impl RtlBlock for System {
             json!({
                 "adc_rate_hz": lp.adc_rate_hz,
                 "decimation": lp.cic.decimation,
-                "latency_clocks": pipeline::SYSTEM.latency_clocks,
-                "min_clocks_per_sample": pipeline::SYSTEM.min_clocks_per_sample,
+                "latency_clocks": pipeline::system(job).latency_clocks,
+                "min_clocks_per_sample": pipeline::system(job).min_clocks_per_sample,
                 "schedule": {
                     "interval_length": schedule.interval_length,
                     "intervals": schedule.intervals,
