@@ -80,6 +80,22 @@ pub fn design_files(block: &Block) -> Vec<(String, String)> {
         files.push(("nco_sine.mem".into(), image("gyro_loop_nco_sine")));
         files.push(("cic_taps.mem".into(), image("gyro_loop_cic_taps")));
     }
+    // Likewise the serial engine inside the folded system: its defaults name the serial
+    // chain's images, the system carries its own chain's.
+    if block.module == "gyrofx_system_serial" {
+        for (default, rom) in [
+            ("serial_program.mem", "system_serial_program"),
+            ("serial_coefficients.mem", "system_serial_coefficients"),
+        ] {
+            let image = block
+                .roms
+                .iter()
+                .find(|(name, _)| name.starts_with(rom))
+                .map(|(_, text)| text.clone())
+                .expect("the folded system carries its chain's ROMs");
+            files.push((default.into(), image));
+        }
+    }
     files.push((CONFIGURED_FILE.into(), configured_module(block)));
     files
 }

@@ -2,7 +2,7 @@
 //! in compile order (a unit before its users), and the sources one module needs.
 
 /// The reference RTL, embedded so that every package is self-contained.
-pub const RTL_SOURCES: [(&str, &str); 18] = [
+pub const RTL_SOURCES: [(&str, &str); 19] = [
     (
         "gyrofx_quantize.v",
         include_str!("../../hdl/gyrofx_quantize.v"),
@@ -57,6 +57,10 @@ pub const RTL_SOURCES: [(&str, &str); 18] = [
         include_str!("../../hdl/gyrofx_gyro_loop_serial.v"),
     ),
     ("gyrofx_system.v", include_str!("../../hdl/gyrofx_system.v")),
+    (
+        "gyrofx_system_serial.v",
+        include_str!("../../hdl/gyrofx_system_serial.v"),
+    ),
 ];
 
 /// The sources of `sources` (file name, text) that `roots` need: their files, and those of
@@ -128,7 +132,7 @@ pub fn vhdl_sources_of(module: &str) -> Vec<&'static (&'static str, &'static str
 
 /// The reference RTL in VHDL-2008, in compile order (packages first), and the package the VHDL
 /// testbenches share (last: simulation only).
-pub const VHDL_SOURCES: [(&str, &str); 20] = [
+pub const VHDL_SOURCES: [(&str, &str); 21] = [
     (
         "gyrofx_mem_pkg.vhd",
         include_str!("../../hdl/gyrofx_mem_pkg.vhd"),
@@ -189,6 +193,10 @@ pub const VHDL_SOURCES: [(&str, &str); 20] = [
     (
         "gyrofx_top_serial.vhd",
         include_str!("../../hdl/gyrofx_top_serial.vhd"),
+    ),
+    (
+        "gyrofx_system_serial.vhd",
+        include_str!("../../hdl/gyrofx_system_serial.vhd"),
     ),
     (
         "gyrofx_testbench_pkg.vhd",
@@ -277,6 +285,7 @@ mod tests {
             "gyrofx_mean_filter_serial.vhd",
             "gyrofx_serial_engine.vhd",
             "gyrofx_top_serial.vhd",
+            "gyrofx_system_serial.vhd",
         ];
         let expected: Vec<&str> = super::VHDL_SOURCES
             .iter()
@@ -284,5 +293,24 @@ mod tests {
             .filter(|n| !left_out.contains(n))
             .collect();
         assert_eq!(system, expected);
+        // The folded system: both folded loops and the serial chain, not the parallel ones.
+        let folded = names("gyrofx_system_serial");
+        for file in [
+            "gyrofx_gyro_loop_serial.vhd",
+            "gyrofx_top_serial.vhd",
+            "gyrofx_serial_engine.vhd",
+            "gyrofx_sequencer.vhd",
+            "gyrofx_spacing_check.vhd",
+        ] {
+            assert!(folded.contains(&file), "{file}: {folded:?}");
+        }
+        for file in [
+            "gyrofx_gyro_loop.vhd",
+            "gyrofx_top.vhd",
+            "gyrofx_system.vhd",
+        ] {
+            assert!(!folded.contains(&file), "{file}: {folded:?}");
+        }
+        assert_eq!(folded.last(), Some(&"gyrofx_testbench_pkg.vhd"));
     }
 }

@@ -40,8 +40,9 @@ pub struct PlaceRequest {
 }
 
 /// The names of the blocks placed, in the package's order: each block that places itself
-/// ([`gyrofx_codegen::blocks::RtlBlock::placement`]; the system does not), its serial variant
-/// beside it (`top_serial`, `mean_filter_serial`).
+/// ([`gyrofx_codegen::blocks::RtlBlock::placement`]), its serial variant beside it
+/// (`top_serial`, `mean_filter_serial`, `gyro_loop_serial`); of the system only its serial
+/// variant (`system_serial`).
 pub fn placed_blocks() -> Vec<&'static str> {
     blocks::placed_names()
 }

@@ -112,6 +112,9 @@ pub enum Placement {
     /// Placed as the job builds it, and beside it, under this name, as the job's serial
     /// variant builds it (whatever the job's architecture, so that one run measures both).
     WithSerial(&'static str),
+    /// Only its serial variant is placed, under this name, as the job's serial variant builds
+    /// it (the system: the parallel one fits no target).
+    SerialOnly(&'static str),
 }
 
 /// The names `synth` places and routes under, in registry order: each placed block, its
@@ -123,6 +126,7 @@ pub fn placed_names() -> Vec<&'static str> {
             Placement::No => vec![],
             Placement::Alone => vec![b.name()],
             Placement::WithSerial(serial) => vec![b.name(), serial],
+            Placement::SerialOnly(serial) => vec![serial],
         })
         .collect()
 }
@@ -135,6 +139,7 @@ pub fn placed(name: &str) -> Option<(&'static dyn RtlBlock, bool)> {
         Placement::WithSerial(serial) if b.name() == name || serial == name => {
             Some((*b, serial == name))
         }
+        Placement::SerialOnly(serial) if serial == name => Some((*b, true)),
         _ => None,
     })
 }

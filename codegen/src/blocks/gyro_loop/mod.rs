@@ -240,6 +240,36 @@ pub fn parameters(plan: &Plan, sine_file: &str, taps_file: &str) -> Vec<Param> {
     p
 }
 
+/// `gyrofx_gyro_loop_serial`'s parameters beyond `gyrofx_gyro_loop`'s: the schedule read from
+/// `schedule_file`, its lengths and the RAM's words (`gyrofx_system_serial` takes them too).
+pub fn schedule_params(
+    schedule: &gyrofx_model::gyro_loop::folded::Schedule,
+    schedule_file: &str,
+) -> [Param; 4] {
+    [
+        Param::string(
+            "SCHEDULE_FILE",
+            schedule_file,
+            "the schedule ROM image (control words)",
+        ),
+        Param::integer(
+            "SCHEDULE_LEN",
+            schedule.len() as i64,
+            "control words: clocks of a decimating sample",
+        ),
+        Param::integer(
+            "SCHEDULE_REGULAR",
+            schedule.regular as i64,
+            "clocks of every sample",
+        ),
+        Param::integer(
+            "RAM_WORDS",
+            schedule.words.count() as i64,
+            "RAM words: the loop's states",
+        ),
+    ]
+}
+
 impl RtlBlock for GyroLoop {
     fn name(&self) -> &'static str {
         "gyro_loop"
@@ -300,28 +330,7 @@ impl RtlBlock for GyroLoop {
             block.module = SERIAL_MODULE;
             block.title = "one gyro's drive/sense loop, folded onto one multiplier, one accumulator and one RAM";
             let rom = roms.entry(SCHEDULE_ROM);
-            block.params.extend([
-                Param::string(
-                    "SCHEDULE_FILE",
-                    &rom.0,
-                    "the schedule ROM image (control words)",
-                ),
-                Param::integer(
-                    "SCHEDULE_LEN",
-                    schedule.len() as i64,
-                    "control words: clocks of a decimating sample",
-                ),
-                Param::integer(
-                    "SCHEDULE_REGULAR",
-                    schedule.regular as i64,
-                    "clocks of every sample",
-                ),
-                Param::integer(
-                    "RAM_WORDS",
-                    schedule.words.count() as i64,
-                    "RAM words: the loop's states",
-                ),
-            ]);
+            block.params.extend(schedule_params(schedule, &rom.0));
             block.roms.push(rom);
         }
         block

@@ -14,6 +14,13 @@
 //! estimator, the KF on their calibrated combination — not the estimates' accuracy, which
 //! the blanking of so short an interval cannot give (the `top` and `gyro_loop` vectors and
 //! the report cover that).
+//!
+//! With `architecture = "serial"` the block is `gyrofx_system_serial`: both loops folded
+//! (`gyrofx_gyro_loop_serial`, one schedule ROM), the chain time-multiplexed
+//! (`gyrofx_top_serial`, the system chain's program and coefficient ROMs). Its vectors are the
+//! same run with the chain's outputs (`out_valid`, `rate_out`, `bias_a`, `bias_b`, `estimated`)
+//! [`gyrofx_job::pipeline::system_chain_delay`] lines later, as its port-level model
+//! ([`gyrofx_job::golden::System::of`]) has them.
 
 use gyrofx_model::chain;
 use gyrofx_model::gyro_loop::gyro::Plan as LoopPlan;
@@ -39,6 +46,13 @@ pub struct System;
 
 /// Name of the system chain's estimator gain ROM (its schedule's, not the configured one's).
 pub const GAINS_ROM: &str = "system_estimator_gains";
+/// Name of the system chain's program ROM for `gyrofx_system_serial`.
+pub const SERIAL_PROGRAM_ROM: &str = "system_serial_program";
+/// Name of the system chain's coefficient ROM for `gyrofx_system_serial`.
+pub const SERIAL_COEFFICIENT_ROM: &str = "system_serial_coefficients";
+
+/// The module with `architecture = "serial"`.
+pub const SERIAL_MODULE: &str = "gyrofx_system_serial";
 
 /// Estimator windows after the start-up.
 pub const WINDOWS: usize = 2;
@@ -129,11 +143,38 @@ pub fn loop_params(loops: [&LoopPlan; 2], sine_file: &str, taps_file: &str) -> R
     Ok(shared)
 }
 
+/// Refuses loops whose folded schedules differ: `gyrofx_system_serial` gives both one
+/// schedule ROM (`SCHEDULE_FILE`), gyro A's.
+///
+/// # Errors
+/// [`Error::Config`] on `resonator_b` naming `SCHEDULE_FILE`.
+pub fn check_schedules(loops: [&LoopPlan; 2]) -> Result<()> {
+    let [a, b] = loops.map(|plan| {
+        gyrofx_model::gyro_loop::folded::Schedule::new(plan)
+            .map(|s| Rom::gyro_loop_schedule(&s).codes)
+            .map_err(|e| e.to_string())
+    });
+    if a == b {
+        return Ok(());
+    }
+    Err(Error::Config {
+        field: "resonator_b (system block, architecture = \"serial\")".into(),
+        value: "the folded loop's schedule (SCHEDULE_FILE) of gyro B differs from gyro A's".into(),
+        allowed: "gyrofx_system_serial gives both folded loops one schedule ROM: resonators whose loop designs share their formats (the [loop] section sets them for both)".into(),
+    })
+}
+
 impl RtlBlock for System {
     fn check(&self, job: &Job) -> Result<()> {
         // gyrofx_system gives both loops one value of every shared parameter: refuse
         // resonators whose loop designs differ in one (ROM file names do not matter).
-        loop_params([&job.gyro_loops[0].plan, &job.gyro_loops[1].plan], "", "").map(|_| ())
+        let loops = [&job.gyro_loops[0].plan, &job.gyro_loops[1].plan];
+        loop_params(loops, "", "")?;
+        // gyrofx_system_serial gives them one schedule too.
+        if job.loop_schedule.is_some() {
+            check_schedules(loops)?;
+        }
+        Ok(())
     }
 
     fn name(&self) -> &'static str {
@@ -152,12 +193,29 @@ impl RtlBlock for System {
         job.system_chain.is_some()
     }
 
-    /// Two loops and the chain: larger than the one loop, which already does not fit.
+    /// Two loops and the chain: the parallel system is larger than the one parallel loop,
+    /// which already fits no target, so only `gyrofx_system_serial` is placed, as
+    /// `system_serial`.
     fn placement(&self) -> Placement {
-        Placement::No
+        Placement::SerialOnly("system_serial")
     }
 
     fn roms(&self, job: &Job) -> Vec<Rom> {
+        if let Some(program) = &job.system_serial {
+            let mut code = Rom::serial_program(program);
+            let mut limbs = Rom::serial_coefficients(program);
+            for (rom, name) in [
+                (&mut code, SERIAL_PROGRAM_ROM),
+                (&mut limbs, SERIAL_COEFFICIENT_ROM),
+            ] {
+                rom.name = name.into();
+                rom.description = format!(
+                    "{} (the system vectors' chain, L = {INTERVAL_LENGTH}, M = {BLANK})",
+                    rom.description
+                );
+            }
+            return vec![code, limbs];
+        }
         match &job.system_chain {
             Some(plan) => {
                 let mut rom = Rom::estimator(&plan.estimator);
@@ -212,10 +270,53 @@ impl RtlBlock for System {
         block.dpi = Some(DPI);
         block.cocotb_test = Some(include_str!("cocotb_test.py"));
         block.pipeline = pipeline::system(job);
+        block.extra = vec!["loop_rate_a_dps", "loop_rate_b_dps"];
+        if let (Some(program), Some(schedule)) = (&job.system_serial, &job.loop_schedule) {
+            let code = roms.entry(SERIAL_PROGRAM_ROM);
+            let limbs = roms.entry(SERIAL_COEFFICIENT_ROM);
+            block.module = SERIAL_MODULE;
+            block.title = "the whole gyro, folded: both folded loops feeding the serial chain, which commands their modes";
+            block.params = top::serial_params(plan, program, &code.0, &limbs.0);
+            // The loops' output fraction bits beside the chain's input width.
+            let at = block
+                .params
+                .iter()
+                .position(|p| p.name == "IN_W")
+                .expect("the serial chain has IN_W")
+                + 1;
+            block.params.insert(
+                at,
+                Param::integer(
+                    "IN_F",
+                    plan.estimator.input.frac.into(),
+                    "the loops' rate output: fraction bits",
+                ),
+            );
+            let sine = roms.entry(gyro_loop::SINE_ROM);
+            let taps = roms.entry(gyro_loop::TAPS_ROM);
+            let rom = roms.entry(gyro_loop::SCHEDULE_ROM);
+            block.params.extend(
+                loop_params(
+                    [&job.gyro_loops[0].plan, &job.gyro_loops[1].plan],
+                    &sine.0,
+                    &taps.0,
+                )
+                .expect("checked_job checked that the loops share what the RTL shares"),
+            );
+            block
+                .params
+                .extend(gyro_loop::schedule_params(schedule, &rom.0));
+            block.params.push(Param::integer(
+                "CHAIN_DELAY_SAMPLES",
+                pipeline::system_chain_delay(job).into(),
+                "ADC samples from the chain's take to its outputs",
+            ));
+            block.roms.extend([code, limbs, sine, taps, rom]);
+            return block;
+        }
         let gains = roms.entry(GAINS_ROM);
         let coefficients = roms.entry(kf::ROM);
         block.params = top::chain_params(plan, &gains.0, &coefficients.0);
-        block.extra = vec!["loop_rate_a_dps", "loop_rate_b_dps"];
         let sine = roms.entry(gyro_loop::SINE_ROM);
         let taps = roms.entry(gyro_loop::TAPS_ROM);
         block.params.extend(
@@ -250,13 +351,23 @@ impl RtlBlock for System {
         let plan = job.system_chain.as_ref()?;
         let schedule = &plan.estimator.schedule;
         let lp = &job.gyro_loops[0].plan;
+        let timing = pipeline::system(job);
         Some((
             "system",
             json!({
                 "adc_rate_hz": lp.adc_rate_hz,
                 "decimation": lp.cic.decimation,
-                "latency_clocks": pipeline::system(job).latency_clocks,
-                "min_clocks_per_sample": pipeline::system(job).min_clocks_per_sample,
+                "architecture": if job.system_serial.is_some() { "serial" } else { "parallel" },
+                "module": if job.system_serial.is_some() { SERIAL_MODULE } else { self.module() },
+                "latency_clocks": timing.latency_clocks,
+                "min_clocks_per_sample": timing.min_clocks_per_sample,
+                "chain_delay_samples": pipeline::system_chain_delay(job),
+                "serial_chain": job.system_serial.as_ref().map(|program| json!({
+                    "instructions": program.sample.len(),
+                    "latency_clocks": program.settle_clocks() + 1,
+                    "ram_words": program.ram_words,
+                    "coefficient_words": program.coefficients.len(),
+                })),
                 "schedule": {
                     "interval_length": schedule.interval_length,
                     "intervals": schedule.intervals,
@@ -341,6 +452,10 @@ impl VectorBuilder for Vectors<'_> {
         let mut previous_modes = [Mode::Normal; 2];
         let mut last_rate = 0i128;
         let mut k = 0usize;
+        // gyrofx_system_serial's chain outputs come this many lines later (reset values first).
+        let delay = pipeline::system_chain_delay(self.job) as usize;
+        let mut delayed: std::collections::VecDeque<[i128; 5]> =
+            std::iter::repeat_n([0; 5], delay).collect();
         let block = &mut self.block;
         // bw_sel: 0 in the first window, the next entry after it (the chain's ROM switch).
         let bw_sel_of = |k: usize| usize::from(k >= startup + window).min(entries - 1);
@@ -376,6 +491,15 @@ impl VectorBuilder for Vectors<'_> {
                 if s.estimated && summary.first_estimate_sample.is_none() {
                     summary.first_estimate_sample = Some(k);
                 }
+                delayed.push_back([
+                    flag(chain.is_some_and(|c| c.rate.is_some())),
+                    last_rate,
+                    s.bias[0],
+                    s.bias[1],
+                    flag(s.estimated),
+                ]);
+                let [out_valid, rate_out, bias_a, bias_b, estimated] =
+                    delayed.pop_front().expect("one in, one out");
                 block.push_with_extra(
                     false,
                     &[
@@ -395,11 +519,11 @@ impl VectorBuilder for Vectors<'_> {
                         flag(step.locked[1]),
                         mode_flag(s.upcoming[0]),
                         mode_flag(s.upcoming[1]),
-                        flag(chain.is_some_and(|c| c.rate.is_some())),
-                        last_rate,
-                        s.bias[0],
-                        s.bias[1],
-                        flag(s.estimated),
+                        out_valid,
+                        rate_out,
+                        bias_a,
+                        bias_b,
+                        estimated,
                     ],
                     &loop_rates,
                 );
@@ -501,5 +625,21 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(error.contains("CIC_ROM_FILE"), "{error}");
+    }
+
+    /// `gyrofx_system_serial` gives both folded loops gyro A's schedule: loops whose schedules
+    /// differ are refused, naming the parameter.
+    #[test]
+    fn loops_whose_folded_schedules_differ_are_refused_naming_the_rom() {
+        let job = Job::new(Config::embedded()).unwrap();
+        let a = job.gyro_loops[0].plan.clone();
+        assert!(check_schedules([&a, &job.gyro_loops[1].plan]).is_ok());
+        let mut b = a.clone();
+        b.cic.taps.pop();
+        let error = check_schedules([&a, &b]).unwrap_err().to_string();
+        assert!(
+            error.contains("SCHEDULE_FILE") && error.contains("resonator_b"),
+            "{error}"
+        );
     }
 }
