@@ -128,8 +128,8 @@ module gyrofx_system_serial #(
     parameter integer LOCK_HOLD = 2000,
     parameter integer LOOP_ROUNDING = 3,
     parameter integer LOOP_SATURATE = 1,
-    parameter NCO_ROM_FILE = "nco_sine.mem",
-    parameter CIC_ROM_FILE = "cic_taps.mem",
+    parameter NCO_ROM_FILE = "gyro_loop_nco_sine.mem",
+    parameter CIC_ROM_FILE = "gyro_loop_cic_taps.mem",
     // gyro A's loop: PI gains and limits, 1/SF format, per-mode values (_N normal, _R reverse)
     parameter integer A_PLL_KP_W = 18,
     parameter integer A_PLL_KP_F = 27,

@@ -120,8 +120,8 @@ entity gyrofx_system_serial is
         LOCK_HOLD : natural := 2000;
         LOOP_ROUNDING : natural := 3;
         LOOP_SATURATE : natural := 1;
-        NCO_ROM_FILE : string := "nco_sine.mem";
-        CIC_ROM_FILE : string := "cic_taps.mem";
+        NCO_ROM_FILE : string := "gyro_loop_nco_sine.mem";
+        CIC_ROM_FILE : string := "gyro_loop_cic_taps.mem";
         -- gyro A's loop: PI gains and limits, 1/SF format, per-mode values (_N normal, _R reverse)
         A_PLL_KP_W : positive := 18;
         A_PLL_KP_F : integer := 27;

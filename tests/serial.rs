@@ -1,7 +1,8 @@
 //! `architecture = "serial"`: the time-multiplexed chain (`gyrofx_top_serial`) passes the same
 //! top vectors bit-exact in Icarus, Verilator and GHDL and against the C model through DPI-C, a
-//! flipped bit fails every testbench, and bad values are refused. (Its cocotb test:
-//! `python/tests/test_cocotb.py`.)
+//! flipped bit fails every testbench, and bad values are refused; so do the sequential mean
+//! filter, the folded gyro loop and the folded system (`gyrofx_system_serial`) with their own
+//! vectors. (Their cocotb tests: `python/tests/test_cocotb.py`.)
 
 use crate::common::*;
 
@@ -348,4 +349,105 @@ fn the_serial_variants_fed_one_clock_too_soon_stop_the_simulation() {
             );
         }
     }
+}
+
+/// `architecture = "serial"` makes the system `gyrofx_system_serial`: both folded loops feeding
+/// the serial chain. Its vectors (the parallel system's closed run, the chain's outputs
+/// `chain_delay_samples` lines later) pass bit-exact in Verilator and against the C model
+/// through DPI-C; GHDL runs the VHDL twin over every sample, the last one's `estimated` flipped,
+/// and fails at that sample only; Icarus and Verilator fail at a flipped bit early on.
+#[test]
+fn the_folded_system_passes_the_system_vectors_and_a_flipped_bit_fails() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = generate(dir.path(), SERIAL);
+    let m = manifest(&out);
+    let system = &m["system"];
+    assert_eq!(system["architecture"], "serial");
+    assert_eq!(system["module"], "gyrofx_system_serial");
+    // Every output the clock after the folded loops' (the chain's modes change then), every
+    // ADC sample; the chain's results the fewest samples later that cover its program.
+    let loop_clocks = m["gyro_loop"]["latency_clocks"].as_u64().unwrap();
+    assert_eq!(system["latency_clocks"].as_u64().unwrap(), loop_clocks + 1);
+    assert_eq!(
+        system["min_clocks_per_sample"].as_u64().unwrap(),
+        loop_clocks + 1
+    );
+    let chain = system["serial_chain"]["latency_clocks"].as_u64().unwrap();
+    let delay = system["chain_delay_samples"].as_u64().unwrap();
+    assert_eq!(delay, (chain + 1).div_ceil(loop_clocks + 1));
+    let folder = std::path::Path::new(&out).join("system");
+    for file in [
+        "tb_gyrofx_system_serial.v",
+        "tb_gyrofx_system_serial.vhd",
+        "system_serial_program.mem",
+        "gyro_loop_schedule.mem",
+    ] {
+        assert!(folder.join(file).exists(), "{file}");
+    }
+    assert!(!folder.join("tb_gyrofx_system.v").exists());
+    let params = std::fs::read_to_string(folder.join("system_params.vh")).unwrap();
+    assert!(
+        params.contains(&format!("P_CHAIN_DELAY_SAMPLES = {delay};")),
+        "{params}"
+    );
+    let lines = m["blocks"]["system"]["vectors"].as_u64().unwrap();
+    let log = ok(&[
+        "verify",
+        "--out",
+        &out,
+        "--sim",
+        "verilator",
+        "--blocks",
+        "system",
+    ]);
+    assert!(log.contains(&format!("PASS n={lines}")), "{log}");
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_gyrofx"))
+        .args([
+            "verify", "--out", &out, "--sim", "dpi", "--blocks", "system",
+        ])
+        .env("GYROFX_CAPI_LIB", capi_library())
+        .output()
+        .unwrap();
+    let log = String::from_utf8_lossy(&output.stdout).into_owned()
+        + &String::from_utf8_lossy(&output.stderr);
+    assert!(
+        output.status.success() && log.contains("dpi: passed"),
+        "{log}"
+    );
+
+    let fail_at = |sims: &[&str], sample: usize| {
+        for sim in sims {
+            let log = fails(&[
+                "verify",
+                "--out",
+                &out,
+                "--sim",
+                sim,
+                "--blocks",
+                "system",
+                "--max-mismatches",
+                "1",
+            ]);
+            // Every sample before it passed.
+            assert!(
+                log.contains(&format!("MISMATCH sample {sample} signal estimated"))
+                    && log.contains(&format!(" first={sample} ")),
+                "{sim}: {log}"
+            );
+        }
+    };
+    // Early: `estimated` is still its reset value there, through the delay.
+    let package = std::path::Path::new(&out);
+    assert_eq!(flip_expected_bit(package, "system", 700), "estimated");
+    fail_at(&["iverilog", "verilator"], 700);
+    flip_expected_bit(package, "system", 700);
+    // Last: the published estimate; GHDL passes every sample before it.
+    let last = lines as usize - 1;
+    let expected = std::fs::read_to_string(folder.join("system_expected.hex")).unwrap();
+    assert!(
+        expected.lines().nth(2 + last).unwrap().ends_with(" 1"),
+        "the run ends estimated"
+    );
+    flip_expected_bit(package, "system", last);
+    fail_at(&["verilator", "ghdl"], last);
 }

@@ -3,9 +3,11 @@
 DAC codes drive them, their ADC codes come back; each resonator's pick-offs follow the mode its
 loop takes). Start-up with `enable` low, then mode reversal under the chain's sequencer through
 an estimator window and a bandwidth change. The DAC codes, lock flags, the chain's modes, bias
-ports and `estimated` are checked 9 clocks after the edge that takes the sample (the loop's show
-after 3 and hold; the chain's after the loop's 4 stages and its own pipeline); `rate_out` as a stream
-wherever `out_valid` is 1 (any latency)."""
+ports and `estimated` are checked at the DUT's timing (`TIMING`: gyrofx_system's 9 clocks after
+the edge that takes the sample, the loop's show after 3 and hold, the chain's after the loop's 4
+stages and its own pipeline; gyrofx_system_serial's after the folded loops' schedule and a clock,
+its chain's outputs `CHAIN_DELAY_SAMPLES` samples later, as `plan.system()` has them); `rate_out`
+as a stream wherever `out_valid` is 1 (any latency)."""
 
 import cocotb
 

@@ -229,7 +229,11 @@ mod tests {
                 let s = serial.step(1, 0, adc).unwrap();
                 assert_eq!(s[..8], p[..8], "round {round} sample {n}: loops and modes");
                 rows.push(p);
-                let want = if n >= k { rows[rows.len() - 1 - k] } else { [0; 13] };
+                let want = if n >= k {
+                    rows[rows.len() - 1 - k]
+                } else {
+                    [0; 13]
+                };
                 assert_eq!(s[8..], want[8..], "round {round} sample {n}: chain outputs");
                 valid += s[8];
             }
