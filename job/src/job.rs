@@ -109,7 +109,6 @@ impl Job {
             };
             job.config.architecture = "serial".into();
             job.settings.architecture = crate::config::Architecture::Serial;
-            crate::pipeline::check_system(&job)?;
         }
         Ok(job)
     }
@@ -154,7 +153,7 @@ impl Job {
                 },
             ),
         };
-        let job = Job {
+        Ok(Job {
             config,
             settings,
             designs,
@@ -166,9 +165,7 @@ impl Job {
             serial,
             loop_schedule,
             system_serial,
-        };
-        crate::pipeline::check_system(&job)?;
-        Ok(job)
+        })
     }
 
     /// The job with `recording` driving the chain: its rate must be the config's and its

@@ -113,7 +113,8 @@ pub fn system_chain_delay(job: &Job) -> u32 {
     }
 }
 
-/// Refuses a serial system whose chain cannot finish a sample before the next chain sample:
+/// Refuses a serial system whose chain cannot finish a sample before the next chain sample
+/// (the system block's check: only `gyrofx_system_serial` needs it):
 /// [`system_chain_delay`] must not exceed the loops' decimation (chain samples are that many
 /// ADC samples apart), so that the engine is free for the next one and its results are
 /// published before they change.

@@ -170,11 +170,12 @@ impl RtlBlock for System {
         // resonators whose loop designs differ in one (ROM file names do not matter).
         let loops = [&job.gyro_loops[0].plan, &job.gyro_loops[1].plan];
         loop_params(loops, "", "")?;
-        // gyrofx_system_serial gives them one schedule too.
+        // gyrofx_system_serial gives them one schedule too, and its chain must finish a
+        // sample before the next.
         if job.loop_schedule.is_some() {
             check_schedules(loops)?;
         }
-        Ok(())
+        pipeline::check_system(job)
     }
 
     fn name(&self) -> &'static str {
@@ -625,6 +626,26 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(error.contains("CIC_ROM_FILE"), "{error}");
+    }
+
+    /// The serial system's check refuses a chain that cannot finish between chain samples,
+    /// naming the fields; the parallel system has no such bound.
+    #[test]
+    fn a_serial_chain_slower_than_the_chain_samples_is_refused_by_the_blocks_check() {
+        let config = Config::from_toml("architecture = \"serial\"\n", "t").unwrap();
+        let mut job = Job::new(config).unwrap();
+        assert!(System.check(&job).is_ok());
+        let fewer = pipeline::system_chain_delay(&job) - 1;
+        for gyro in &mut job.gyro_loops {
+            gyro.plan.cic.decimation = fewer;
+        }
+        let error = System.check(&job).unwrap_err().to_string();
+        assert!(error.contains("loop.decimation"), "{error}");
+        let mut parallel = Job::new(Config::embedded()).unwrap();
+        for gyro in &mut parallel.gyro_loops {
+            gyro.plan.cic.decimation = 1;
+        }
+        assert!(System.check(&parallel).is_ok());
     }
 
     /// `gyrofx_system_serial` gives both folded loops gyro A's schedule: loops whose schedules
