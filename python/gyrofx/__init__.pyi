@@ -217,7 +217,8 @@ class Plan:
         ``min_clocks_per_sample`` are the folded loop's with ``architecture = "serial"``."""
     def gyro_loop_float(self, gyro: str = "a") -> GyroLoopFloat: ...
     def system(self) -> System:
-        """Both loops and the chain (resonator plants only)."""
+        """Both loops and the chain (resonator plants only); with ``architecture = "serial"``
+        gyrofx_system_serial's timing, its chain outputs ``chain_delay_samples`` later."""
     def system_float(self) -> SystemFloat: ...
     def resonator(self, gyro: str = "a", seed: Optional[int] = None, noise: bool = True) -> Resonator:
         """The simulated resonator; seed defaults to generate's (2·seed, 2·seed + 1)."""
@@ -425,6 +426,9 @@ class System:
         """Saturations and wraps per quantization point since it was made (a reset keeps them)."""
     decimation: int
     window: int
+    chain_delay_samples: int
+    """ADC samples by which out_valid, rate_out, bias_a, bias_b and estimated come after the
+    sample that produced them: 0, or gyrofx_system_serial's CHAIN_DELAY_SAMPLES."""
     def reset(self) -> None: ...
     def next_modes(self) -> Tuple[int, int]:
         """The modes the loops take at the next step if enable is 1."""

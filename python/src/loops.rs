@@ -258,6 +258,14 @@ impl System {
         self.pipeline.min_clocks_per_sample
     }
 
+    /// ADC samples by which the chain's outputs (`out_valid`, `rate_out`, `bias_a`, `bias_b`,
+    /// `estimated`) come after the sample that produced them: 0 for `gyrofx_system`,
+    /// `gyrofx_system_serial`'s `CHAIN_DELAY_SAMPLES` with `architecture = "serial"`.
+    #[getter]
+    fn chain_delay_samples(&self) -> usize {
+        self.ports.chain_delay()
+    }
+
     /// Clears every register.
     fn reset(&mut self) {
         self.ports.reset();

@@ -161,7 +161,8 @@ impl Plan {
     }
 
     /// The whole gyro at the ADC rate (`gyrofx_system`): both loops and the chain on the
-    /// system's short schedule. Only resonator plants have it.
+    /// system's short schedule; with `architecture = "serial"` `gyrofx_system_serial`'s timing
+    /// and its chain outputs `chain_delay_samples` samples later. Only resonator plants have it.
     fn system(&self) -> PyResult<System> {
         let ports = golden::System::of(&self.job).ok_or_else(|| refused(golden::NO_SYSTEM))?;
         Ok(System::new(ports, pipeline::system(&self.job)))

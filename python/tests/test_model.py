@@ -298,6 +298,9 @@ def test_every_block_class_has_the_manifests_latency_and_spacing(tmp_path, archi
     assert (plan.chain().latency_clocks > 1000) == serial
     assert (plan.mean_filter().latency_clocks > 1) == serial
     assert (plan.sequencer().latency_clocks, plan.sequencer().min_clocks_per_sample) == (1, 1)
+    # The folded system's chain outputs come the manifest's chain_delay_samples later.
+    assert plan.system().chain_delay_samples == manifest["system"]["chain_delay_samples"]
+    assert (plan.system().chain_delay_samples > 1) == serial
 
 
 def test_every_block_class_lists_the_manifests_ports(package):
