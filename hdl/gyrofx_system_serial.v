@@ -23,22 +23,22 @@
  *   outputs rate_out, out_valid (a one-clock pulse), bias_a, bias_b, estimated load what the
  *   chain made of them.
  *
- * Why the delay: a folded loop takes SCHEDULE_LEN + 1 clocks an ADC sample; the serial chain
+ * Why the delay: a folded loop takes SCHEDULE_LEN + 2 clocks an ADC sample; the serial chain
  *   takes its program's clocks (gyrofx_top_serial's SETTLE + 1, over a thousand) a chain
  *   sample and runs beside the loops over many ADC samples. Its sequencer's modes change the
  *   clock after it takes a sample, in time for the next ADC sample, as in gyrofx_system; its
  *   results come later, within some later ADC sample that depends on the ce cadence. The
  *   system publishes them a fixed number of ADC samples later instead,
- *   CHAIN_DELAY_SAMPLES = ceil((chain clocks + margin) / (SCHEDULE_LEN + 2))
+ *   CHAIN_DELAY_SAMPLES = ceil((chain clocks + margin) / (SCHEDULE_LEN + 3))
  *   (gyrofx_job::pipeline::system_chain_delay), so that every output is a function of the
  *   samples whatever the cadence: the engine holds its results until then. The chain must
  *   finish between chain samples: CHAIN_DELAY_SAMPLES <= CIC_DECIMATION (gyrofx refuses a
  *   config where it cannot).
  *
- * Timing: ce at most every SCHEDULE_LEN + 2 clocks. Every output shows SCHEDULE_LEN + 2
- *   clocks after ce: dac_*, locked_* load with the loops' (by SCHEDULE_LEN + 1 clocks) and
+ * Timing: ce at most every SCHEDULE_LEN + 3 clocks. Every output shows SCHEDULE_LEN + 3
+ *   clocks after ce: dac_*, locked_* load with the loops' (by SCHEDULE_LEN + 2 clocks) and
  *   hold until the next sample's; mode_a, mode_b (the modes of the next sample) and the
- *   published chain outputs load at the loops' output clock, SCHEDULE_LEN + 1 clocks after
+ *   published chain outputs load at the loops' output clock, SCHEDULE_LEN + 2 clocks after
  *   ce, and hold otherwise (out_valid for one clock). A clock with rst high clears every
  *   register and the pending publication.
  *
@@ -207,8 +207,8 @@ module gyrofx_system_serial #(
     // loops: the folded schedule (one for both gyros): image, words, words of a sample that
     // does not decimate, RAM words
     parameter SCHEDULE_FILE = "gyro_loop_schedule.mem",
-    parameter integer SCHEDULE_LEN = 109,
-    parameter integer SCHEDULE_REGULAR = 53,
+    parameter integer SCHEDULE_LEN = 114,
+    parameter integer SCHEDULE_REGULAR = 54,
     parameter integer RAM_WORDS = 28,
     // ADC samples from the one whose rates the chain takes to the one that publishes its
     // outputs (1..CIC_DECIMATION; gyrofx_job::pipeline::system_chain_delay)
@@ -249,7 +249,7 @@ function integer ceil_log2;
 endfunction
 
 // Clocks from ce to the loops' outputs (gyrofx_job::pipeline::gyro_loop): the output clock.
-localparam integer LOOP_CLOCKS = SCHEDULE_LEN + 1;
+localparam integer LOOP_CLOCKS = SCHEDULE_LEN + 2;
 localparam integer COUNT_W = ceil_log2(LOOP_CLOCKS + 1);
 localparam integer DELAY_W = ceil_log2(CHAIN_DELAY_SAMPLES + 1);
 localparam [COUNT_W-1:0] OUTPUT_COUNT = LOOP_CLOCKS[COUNT_W-1:0];
@@ -265,7 +265,7 @@ initial begin
 end
 
 // enable and bw_sel as of the ADC sample in flight: the loops' decimated output comes
-// SCHEDULE_LEN + 1 clocks after its ce, while the inputs may already describe the next.
+// SCHEDULE_LEN + 2 clocks after its ce, while the inputs may already describe the next.
 reg enable_reg = 1'b0;
 reg [SEL_W-1:0] bw_sel_reg = {SEL_W{1'b0}};
 
@@ -453,10 +453,10 @@ assign estimated = estimated_reg;
 
 `ifndef SYNTHESIS
 // Simulation only (yosys defines SYNTHESIS): the system takes a sample at most every
-// SCHEDULE_LEN + 2 clocks (gyrofx_job::pipeline::system), so that the chain's modes describe
+// SCHEDULE_LEN + 3 clocks (gyrofx_job::pipeline::system), so that the chain's modes describe
 // the next sample; a sooner ce stops the simulation, naming this instance.
 gyrofx_spacing_check #(
-    .MIN_CLOCKS_PER_SAMPLE(SCHEDULE_LEN + 2),
+    .MIN_CLOCKS_PER_SAMPLE(SCHEDULE_LEN + 3),
     .BLOCK_NAME("gyrofx_system_serial")
 ) spacing_check (
     .clk(clk),

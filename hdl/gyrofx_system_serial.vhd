@@ -19,20 +19,20 @@
 --   outputs rate_out, out_valid (a one-clock pulse), bias_a, bias_b, estimated load what the
 --   chain made of them.
 --
--- Why the delay: a folded loop takes SCHEDULE_LEN + 1 clocks an ADC sample; the serial chain
+-- Why the delay: a folded loop takes SCHEDULE_LEN + 2 clocks an ADC sample; the serial chain
 --   takes its program's clocks (over a thousand) a chain sample and runs beside the loops
 --   over many ADC samples. Its sequencer's modes change the clock after it takes a sample, in
 --   time for the next ADC sample; its results come within some later ADC sample that depends
 --   on the ce cadence. The system publishes them a fixed number of ADC samples later instead,
---   CHAIN_DELAY_SAMPLES = ceil((chain clocks + margin) / (SCHEDULE_LEN + 2))
+--   CHAIN_DELAY_SAMPLES = ceil((chain clocks + margin) / (SCHEDULE_LEN + 3))
 --   (gyrofx_job::pipeline::system_chain_delay), whatever the cadence; the engine holds its
 --   results until then. CHAIN_DELAY_SAMPLES <= CIC_DECIMATION: the chain finishes between
 --   chain samples.
 --
--- Timing: ce at most every SCHEDULE_LEN + 2 clocks. Every output shows SCHEDULE_LEN + 2
+-- Timing: ce at most every SCHEDULE_LEN + 3 clocks. Every output shows SCHEDULE_LEN + 3
 --   clocks after ce: dac_*, locked_* load with the loops' and hold until the next sample's;
 --   mode_a, mode_b and the published chain outputs load at the loops' output clock,
---   SCHEDULE_LEN + 1 clocks after ce, and hold otherwise (out_valid for one clock). A clock
+--   SCHEDULE_LEN + 2 clocks after ce, and hold otherwise (out_valid for one clock). A clock
 --   with rst high clears every register and the pending publication.
 
 library ieee;
@@ -199,8 +199,8 @@ entity gyrofx_system_serial is
         -- loops: the folded schedule (one for both gyros): image, words, words of a sample
         -- that does not decimate, RAM words
         SCHEDULE_FILE : string := "gyro_loop_schedule.mem";
-        SCHEDULE_LEN : positive := 109;
-        SCHEDULE_REGULAR : positive := 53;
+        SCHEDULE_LEN : positive := 114;
+        SCHEDULE_REGULAR : positive := 54;
         RAM_WORDS : positive := 28;
         -- ADC samples from the one whose rates the chain takes to the one that publishes its
         -- outputs (1..CIC_DECIMATION; gyrofx_job::pipeline::system_chain_delay)
@@ -235,10 +235,10 @@ end entity;
 architecture rtl of gyrofx_system_serial is
 
     -- Clocks from ce to the loops' outputs (gyrofx_job::pipeline::gyro_loop): the output clock.
-    constant LOOP_CLOCKS : positive := SCHEDULE_LEN + 1;
+    constant LOOP_CLOCKS : positive := SCHEDULE_LEN + 2;
 
     -- enable and bw_sel as of the ADC sample in flight: the loops' decimated output comes
-    -- SCHEDULE_LEN + 1 clocks after its ce, while the inputs may already describe the next.
+    -- SCHEDULE_LEN + 2 clocks after its ce, while the inputs may already describe the next.
     signal enable_reg : std_logic := '0';
     signal bw_sel_reg : unsigned(SEL_W - 1 downto 0) := (others => '0');
     signal chain_mode_a : std_logic;
@@ -463,11 +463,11 @@ begin
     estimated <= estimated_reg;
 
     -- pragma translate_off
-    -- Simulation only: the system takes a sample at most every SCHEDULE_LEN + 2 clocks
+    -- Simulation only: the system takes a sample at most every SCHEDULE_LEN + 3 clocks
     -- (gyrofx_job::pipeline::system), so that the chain's modes describe the next sample; a
     -- sooner ce stops the simulation, naming this instance.
     spacing_check : entity work.gyrofx_spacing_check
-        generic map (MIN_CLOCKS_PER_SAMPLE => SCHEDULE_LEN + 2, BLOCK_NAME => "gyrofx_system_serial")
+        generic map (MIN_CLOCKS_PER_SAMPLE => SCHEDULE_LEN + 3, BLOCK_NAME => "gyrofx_system_serial")
         port map (clk => clk, rst => rst, ce => ce);
     -- pragma translate_on
 end architecture;

@@ -88,7 +88,7 @@ def test_the_serial_blocks_pass_it_and_a_flipped_bit_fails_it(tmp_path):
     assert_fails(make(folder, "cocotb-gyro_loop", GYROFX_COCOTB_SAMPLES="300", GYROFX_COCOTB_FLIP_EXPECTED="40"), 1)
     # The folded system: every output after the loops' schedule and a clock, the chain's
     # chain_delay_samples later, as the Python System (the test's model) has them. Its run is
-    # an estimator window whatever GYROFX_COCOTB_SAMPLES (14 300 samples of 111 clocks, about
+    # an estimator window whatever GYROFX_COCOTB_SAMPLES (14 300 samples of 117 clocks, about
     # 100 s): no flipped-bit run, the scoreboards are those test_one_flipped_expected_bit_fails_it
     # proves on the parallel system.
     system = manifest["system"]
