@@ -327,7 +327,10 @@ reg [PC_W-1:0] pc_reg = {PC_W{1'b0}};
 // The word fetched (the schedule ROM's output register), then the word executing a clock
 // later: the clock between decodes the accumulator's operands from the fetched word.
 reg [63:0] fetched_reg = 64'd0;
+// (Its x and y bits are decoded from fetched_reg a clock earlier, not read here.)
+/* verilator lint_off UNUSEDSIGNAL */
 reg [63:0] control_reg = 64'd0;
+/* verilator lint_on UNUSEDSIGNAL */
 reg executing_reg = 1'b0;
 reg executing_last_reg = 1'b0;
 reg mode_reg = 1'b1;
@@ -362,8 +365,9 @@ end
 // The accumulator's x and y decoded from the fetched word into one-hot selects, a clock
 // before the word executes: a clock runs an AND-OR of registered selects into the adder, not
 // the ROM's output through a decoder (gyrofx_model::gyro_loop::folded::AccX, AccY codes).
-wire [3:0] next_x_field = fetched_reg[22:19];
-wire [3:0] next_y_field = fetched_reg[26:23];
+// (The control word's x and y fields, read from the fetched word: only the decode reads them.)
+wire [3:0] x_field = fetched_reg[22:19];
+wire [3:0] y_field = fetched_reg[26:23];
 // (x code 1 and y code 0 select nothing, 0: their bits stay 0.)
 /* verilator lint_off UNUSEDSIGNAL */
 reg [8:0] x_select_reg = 9'd0;
@@ -372,14 +376,14 @@ reg [9:0] y_select_reg = 10'd0;
 reg y_negate_reg = 1'b0;
 reg accumulate_reg = 1'b0;
 always @(posedge clk) begin
-    x_select_reg <= {next_x_field == 4'd8, next_x_field == 4'd7, next_x_field == 4'd6,
-        next_x_field == 4'd5, next_x_field == 4'd4, next_x_field == 4'd3, next_x_field == 4'd2,
-        1'b0, next_x_field == 4'd0};
-    y_select_reg <= {next_y_field == 4'd9, next_y_field == 4'd8, next_y_field == 4'd7,
-        next_y_field == 4'd6, next_y_field == 4'd5, next_y_field == 4'd4, next_y_field == 4'd3,
-        next_y_field == 4'd2, next_y_field == 4'd1, 1'b0};
-    y_negate_reg <= next_y_field == 4'd2 || next_y_field == 4'd4 || next_y_field == 4'd7;
-    accumulate_reg <= next_x_field != 4'd0 || next_y_field != 4'd0;
+    x_select_reg <= {x_field == 4'd8, x_field == 4'd7, x_field == 4'd6,
+        x_field == 4'd5, x_field == 4'd4, x_field == 4'd3, x_field == 4'd2,
+        1'b0, x_field == 4'd0};
+    y_select_reg <= {y_field == 4'd9, y_field == 4'd8, y_field == 4'd7,
+        y_field == 4'd6, y_field == 4'd5, y_field == 4'd4, y_field == 4'd3,
+        y_field == 4'd2, y_field == 4'd1, 1'b0};
+    y_negate_reg <= y_field == 4'd2 || y_field == 4'd4 || y_field == 4'd7;
+    accumulate_reg <= x_field != 4'd0 || y_field != 4'd0;
 end
 
 // The control word's fields (gyrofx_model::gyro_loop::folded::Control): a fixed layout, whose
@@ -392,8 +396,6 @@ wire [2:0] limb_field = control_reg[10:8];
 wire top_field = control_reg[11];
 wire [2:0] b_field = control_reg[14:12];
 wire [3:0] tap_field = control_reg[18:15];
-wire [3:0] x_field = control_reg[22:19];
-wire [3:0] y_field = control_reg[26:23];
 wire read_field = control_reg[27];
 wire [6:0] read_address_field = control_reg[34:28];
 wire [2:0] gate_field = control_reg[37:35];

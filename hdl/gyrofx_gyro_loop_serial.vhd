@@ -642,9 +642,9 @@ begin
             control_reg <= fetched_reg;
             executing_reg <= busy_reg and not rst;
             executing_last_reg <= last_word and not rst;
-            x_code_reg <= unsigned(fetched_reg(22 downto 19));
-            y_code_reg <= unsigned(fetched_reg(26 downto 23));
-            if unsigned(fetched_reg(26 downto 19)) /= 0 then
+            x_code_reg <= x_field;
+            y_code_reg <= y_field;
+            if x_field /= 0 or y_field /= 0 then
                 accumulate_reg <= '1';
             else
                 accumulate_reg <= '0';
@@ -659,8 +659,9 @@ begin
     top_field <= control_reg(11);
     b_field <= unsigned(control_reg(14 downto 12));
     tap_field <= unsigned(control_reg(18 downto 15));
-    x_field <= unsigned(control_reg(22 downto 19));
-    y_field <= unsigned(control_reg(26 downto 23));
+    -- (The x and y fields are read from the fetched word: only the decode reads them.)
+    x_field <= unsigned(fetched_reg(22 downto 19));
+    y_field <= unsigned(fetched_reg(26 downto 23));
     read_field <= control_reg(27);
     read_address_field <= unsigned(control_reg(34 downto 28));
     gate_field <= unsigned(control_reg(37 downto 35));

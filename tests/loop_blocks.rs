@@ -688,7 +688,12 @@ fn the_folded_loops_rtl_slices_the_models_control_word_fields() {
             std::fs::read_to_string(hdl(&format!("gyrofx_gyro_loop_serial.{language}"))).unwrap();
         let mut sliced = Vec::new();
         for line in text.lines() {
-            let Some((left, right)) = line.split_once("control_reg") else {
+            // Most fields act from the word executing (control_reg); x and y are decoded a
+            // clock earlier from the word fetched (fetched_reg).
+            let Some((left, right)) = line
+                .split_once("control_reg")
+                .or_else(|| line.split_once("fetched_reg"))
+            else {
                 continue;
             };
             let Some(name) = left
@@ -716,6 +721,7 @@ fn the_folded_loops_rtl_slices_the_models_control_word_fields() {
                 sliced.push((name.to_string(), high, low));
             }
         }
+        sliced.sort_by_key(|(_, _, low)| *low);
         assert_eq!(sliced, layout, "gyrofx_gyro_loop_serial.{language}");
     }
 }
