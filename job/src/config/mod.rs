@@ -82,6 +82,13 @@ pub struct Config {
     /// The resonators' front end (`PhysicsSettings` without its sample rate, which is
     /// `[loop]`'s).
     pub front_end: toml::Table,
+    /// Gyro A's own front-end keys over `[front_end]` (optional; left out of the resolved
+    /// config when empty).
+    #[serde(default, skip_serializing_if = "toml::Table::is_empty")]
+    pub front_end_a: toml::Table,
+    /// Gyro B's own front-end keys over `[front_end]`.
+    #[serde(default, skip_serializing_if = "toml::Table::is_empty")]
+    pub front_end_b: toml::Table,
     /// One gyro's digital loop (`LoopSettings` without rounding and overflow, which are the
     /// config's).
     #[serde(rename = "loop")]
@@ -160,6 +167,11 @@ const OPTIONAL_KEYS: [&str; 5] = [
 /// (`deny_unknown_fields`).
 const OPTIONAL_SECTIONS: [&str; 1] = ["population"];
 
+/// Optional sections the default leaves out that overlay a section of it for one gyro: their
+/// keys are that section's.
+const GYRO_OVERLAYS: [(&str, &str); 2] =
+    [("front_end_a", "front_end"), ("front_end_b", "front_end")];
+
 /// Refuses a key of `user` that neither the default nor [`OPTIONAL_KEYS`] has, naming it and
 /// the line it stands on.
 fn check_known_keys(
@@ -171,7 +183,11 @@ fn check_known_keys(
 ) -> Result<()> {
     for (key, value) in user {
         let path = format!("{prefix}{key}");
-        match (default.get(key), value) {
+        let overlaid = GYRO_OVERLAYS
+            .iter()
+            .find(|(overlay, _)| prefix.is_empty() && overlay == key)
+            .and_then(|(_, section)| default.get(*section));
+        match (default.get(key).or(overlaid), value) {
             (Some(toml::Value::Table(d)), toml::Value::Table(u)) => {
                 check_known_keys(u, d, &format!("{path}."), text, origin)?
             }
@@ -259,7 +275,7 @@ fn line_of(text: &str, path: &str) -> Option<usize> {
 }
 
 /// Merges `overlay` into `base`, table by table.
-fn merge(base: &mut toml::Table, overlay: toml::Table) {
+pub(crate) fn merge(base: &mut toml::Table, overlay: toml::Table) {
     for (key, value) in overlay {
         match (base.get_mut(&key), value) {
             (Some(toml::Value::Table(b)), toml::Value::Table(o)) => merge(b, o),

@@ -1,5 +1,6 @@
 //! `[resonator_a]`, `[resonator_b]` (each gyro's structure, SPEC §1.6), `[front_end]` (pick-off,
-//! ADC, DAC, thermal and electronic noise, drift: shared by both gyros) and `[loop]` (one gyro's
+//! ADC, DAC, thermal and electronic noise, drift: both gyros'), the optional `[front_end_a]` and
+//! `[front_end_b]` (one gyro's own front-end keys over `[front_end]`) and `[loop]` (one gyro's
 //! digital drive and sense loop, the same for both): what `gyrofx loop` runs.
 //!
 //! `[front_end]`'s sample rate is `[loop]`'s `adc_rate_hz`, and `[loop]`'s rounding and
@@ -78,7 +79,31 @@ impl Config {
         }
         let mut front_end = self.front_end.clone();
         front_end.insert("sample_rate_hz".into(), 1.0.into());
-        typed::<PhysicsSettings>("front_end", front_end).err()
+        typed::<PhysicsSettings>("front_end", front_end.clone())
+            .err()
+            .or_else(|| {
+                [("a", &self.front_end_a), ("b", &self.front_end_b)]
+                    .into_iter()
+                    .find_map(|(gyro, overlay)| {
+                        // `[front_end]` alone is typed: what fails now is the overlay's.
+                        typed::<PhysicsSettings>(
+                            &format!("front_end_{gyro}"),
+                            overlaid(&front_end, overlay),
+                        )
+                        .err()
+                    })
+            })
+    }
+
+    /// Gyro `gyro`'s (`a` or `b`) front-end table: `[front_end]` with `[front_end_<gyro>]`
+    /// over it, and the section a key of it is named by in errors.
+    fn front_end_of(&self, gyro: &str) -> (toml::Table, &toml::Table) {
+        let overlay = if gyro == "a" {
+            &self.front_end_a
+        } else {
+            &self.front_end_b
+        };
+        (overlaid(&self.front_end, overlay), overlay)
     }
 
     /// Both gyros' loops, validated and designed.
@@ -91,17 +116,26 @@ impl Config {
         table.insert("rounding".into(), self.rounding.clone().into());
         table.insert("overflow".into(), self.overflow.clone().into());
         let settings: LoopSettings = section("loop", table)?;
-        let mut front_end = self.front_end.clone();
-        front_end.insert("sample_rate_hz".into(), settings.adc_rate_hz.into());
-        let front_end: PhysicsSettings = section("front_end", front_end)?;
         let resolve = |name: &'static str, params: &ResonatorParams| -> Result<GyroLoop> {
             let key = format!("resonator_{name}");
             params
                 .validate()
                 .map_err(|e| prefixed(&key, e.to_string()))?;
-            front_end
-                .validate(params)
-                .map_err(|e| prefixed("front_end", e.to_string()))?;
+            let (mut front_end, overlay) = self.front_end_of(name);
+            let own = format!("front_end_{name}");
+            front_end.insert("sample_rate_hz".into(), settings.adc_rate_hz.into());
+            let front_end: PhysicsSettings = section(&own, front_end)?;
+            front_end.validate(params).map_err(|e| {
+                let message = e.to_string();
+                // A value gyro `name`'s own section set is named there.
+                let field = message.split(" = ").next().unwrap_or_default();
+                let section = if overlay.contains_key(field) {
+                    own.as_str()
+                } else {
+                    "front_end"
+                };
+                prefixed(section, message)
+            })?;
             let plan = Plan::new(&Spec {
                 settings: settings.clone(),
                 resonator: *params,
@@ -189,6 +223,13 @@ pub(super) fn check_chain(
     Ok(())
 }
 
+/// `base` with `overlay`'s keys over it (inline tables merged key by key).
+fn overlaid(base: &toml::Table, overlay: &toml::Table) -> toml::Table {
+    let mut table = base.clone();
+    super::merge(&mut table, overlay.clone());
+    table
+}
+
 /// The model's "`field = value is not allowed: …`" under the section's name.
 fn prefixed(section: &str, message: String) -> Error {
     match message.split_once(" = ") {
@@ -258,5 +299,52 @@ mod tests {
             floor.gyro_loops().unwrap()[0].plan.settings.rounding,
             "floor"
         );
+    }
+
+    /// `[front_end_b]` sets gyro B's own keys over `[front_end]` (an inline table key by key)
+    /// and leaves gyro A's; its unknown keys, wrong types and bad values are named in it.
+    #[test]
+    fn a_gyros_own_front_end_overlays_the_shared_one() {
+        let text = "[front_end]\npickoff_noise_v_per_sqrt_hz = 2e-9\n\
+                    [front_end_b]\npickoff_noise_v_per_sqrt_hz = 3e-9\n\
+                    phase_drift = { std = 0.001 }\n";
+        let config = Config::from_toml(text, "test.toml").unwrap();
+        let [a, b] = config.gyro_loops().unwrap();
+        assert_eq!(a.front_end.pickoff_noise_v_per_sqrt_hz, 2e-9);
+        assert_eq!(b.front_end.pickoff_noise_v_per_sqrt_hz, 3e-9);
+        assert_eq!(a.front_end.phase_drift.std, 0.02);
+        assert_eq!(b.front_end.phase_drift.std, 0.001);
+        assert_eq!(
+            b.front_end.phase_drift.correlation_time_s,
+            a.front_end.phase_drift.correlation_time_s
+        );
+        // The resolved config keeps the overlay, and an empty one stays out of it.
+        let again = Config::from_toml(&config.to_toml(), "resolved").unwrap();
+        assert_eq!(again.gyro_loops().unwrap()[1].front_end, b.front_end);
+        assert!(!Config::embedded().to_toml().contains("front_end_a"));
+        for (text, named) in [
+            (
+                "[front_end_a]\npickoff_gain = 1.0\n",
+                "unknown key front_end_a.pickoff_gain (line 2)",
+            ),
+            (
+                "[front_end_b]\ntemperature_k = \"warm\"\n",
+                "front_end_b.temperature_k",
+            ),
+            (
+                "[front_end_b]\npickoff_noise_v_per_sqrt_hz = -1.0\n",
+                "front_end_b.pickoff_noise_v_per_sqrt_hz = -1 is not allowed",
+            ),
+            (
+                "[front_end]\ntemperature_k = -4.0\n[front_end_a]\nnoise = false\n",
+                "front_end.temperature_k = -4 is not allowed",
+            ),
+        ] {
+            let err = Config::from_toml(text, "test.toml")
+                .and_then(|c| c.gyro_loops().map(|_| ()))
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains(named), "{text}: {err}");
+        }
     }
 }
