@@ -616,6 +616,43 @@ fn reproduce_paper_004_compares_its_table_2() {
     let out = ok(&["reproduce", "--paper", "004", "--samples", "20000"]);
     assert!(out.contains("| N (°/√s) | 1.180e-4 \\|"), "{out}");
     assert!(out.contains("ADEV at 1 s"), "{out}");
+    // Through the real loops (the first Table 2): the calibrated front ends give each raw
+    // gyro the paper's N with its drifts off, and reversal cancels the drift at long τ.
+    let gyrofx_cells = |label: &str| -> Vec<f64> {
+        out.lines()
+            .find(|l| l.starts_with(&format!("| {label}")))
+            .unwrap_or_else(|| panic!("no {label} row: {out}"))
+            .split(" | ")
+            .skip(1)
+            .filter_map(|cell| {
+                cell.rsplit("\\| ")
+                    .next()?
+                    .trim_end_matches(" |")
+                    .parse()
+                    .ok()
+            })
+            .collect()
+    };
+    let adev_128 = gyrofx_cells("ADEV at 128 s");
+    assert_eq!(adev_128.len(), 4, "{adev_128:?}");
+    assert!(
+        adev_128[2] < 0.25 * adev_128[0].min(adev_128[1]),
+        "reversal left the drift: {adev_128:?}"
+    );
+    for (gyro, paper) in [("A", 1.18e-4), ("B", 2.04e-4)] {
+        let row = out
+            .lines()
+            .find(|l| l.starts_with(&format!("| {gyro} | ")))
+            .unwrap_or_else(|| panic!("no calibration row of {gyro}: {out}"));
+        let measured: f64 = row
+            .trim_end_matches(" |")
+            .rsplit("| ")
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap();
+        assert!((measured / paper - 1.0).abs() < 0.06, "{row}");
+    }
     // At resonator level: the damping coupling is the same in both modes and leaves nothing
     // after reversal; the quadrature leak leaves the residual, measured on the closed loop
     // within a few mdps of its closed form.

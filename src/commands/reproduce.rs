@@ -72,7 +72,8 @@ pub fn run(args: Args) -> Result<ExitCode> {
         }
         "004" => {
             let p = reproduce::paper_004(samples.unwrap_or(reproduce::SAMPLES_004), seed)?;
-            (p.markdown(), p.curves, None)
+            let curves = p.resonator.curves.iter().chain(&p.rate.curves).cloned();
+            (p.markdown(), curves.collect(), None)
         }
         other => usage!("--paper {other:?} is not one of the papers: use 000, 002, 003 or 004"),
     };
