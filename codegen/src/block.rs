@@ -231,6 +231,10 @@ pub struct Block {
     pub params: Vec<Param>,
     /// ROM images the DUT reads (file name, content).
     pub roms: Vec<(String, String)>,
+    /// Images a synthesis run adds under the file names its submodules' parameter defaults
+    /// give (file name, content): yosys elaborates every module with its own defaults while
+    /// reading it, and a submodule reads its ROM image then.
+    pub elaboration_images: Vec<(String, String)>,
     /// Inputs driven each sample (after `rst`).
     pub inputs: Vec<Signal>,
     /// Outputs and how they are checked.
@@ -345,6 +349,7 @@ impl Block {
             title,
             params: Vec::new(),
             roms: Vec::new(),
+            elaboration_images: Vec::new(),
             inputs,
             outputs,
             extra: Vec::new(),

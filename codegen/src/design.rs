@@ -5,7 +5,7 @@
 use crate::block::Block;
 use crate::hdl;
 
-/// One gyro's loop module, whose submodules read ROM images while yosys elaborates them.
+/// One gyro's loop module in the parallel architecture.
 pub const LOOP_TOP: &str = "gyrofx_gyro_loop";
 
 /// The module name of a block's wrapper: the block's module with the job's parameters.
@@ -66,36 +66,76 @@ pub fn design_files(block: &Block) -> Vec<(String, String)> {
         .map(|(n, s)| (n.to_string(), s.to_string()))
         .collect();
     files.extend(block.roms.iter().cloned());
-    // yosys elaborates every module with its own defaults while reading it, and the loop's
-    // NCO and CIC read their ROM images then: give them the images under their default names.
-    if block.module == LOOP_TOP {
-        let image = |rom: &str| {
+    files.extend(block.elaboration_images.iter().cloned());
+    files.push((CONFIGURED_FILE.into(), configured_module(block)));
+    files
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::blocks::{checked_job, find, RomImages};
+    use crate::text::Provenance;
+    use gyrofx_job::config::Config;
+
+    /// A synthesis run gets the ROM images the submodules read under their defaults' names,
+    /// as each block declares them: the parallel loop's NCO and CIC images, and the folded
+    /// system's own chain program under the serial engine's default names.
+    #[test]
+    fn the_design_carries_each_submodules_images_under_its_default_names() {
+        let provenance = Provenance {
+            version: "test".into(),
+            command: "test".into(),
+            config_sha256: "0".repeat(64),
+        };
+        let file = |files: &[(String, String)], name: &str| -> String {
+            files
+                .iter()
+                .find(|(n, _)| n == name)
+                .unwrap_or_else(|| panic!("no {name}"))
+                .1
+                .clone()
+        };
+        let rom = |block: &Block, prefix: &str| -> String {
             block
                 .roms
                 .iter()
-                .find(|(name, _)| name.starts_with(rom))
-                .map(|(_, text)| text.clone())
-                .expect("the loop block carries both ROMs")
+                .find(|(n, _)| n.starts_with(prefix))
+                .unwrap_or_else(|| panic!("no {prefix} ROM"))
+                .1
+                .clone()
         };
-        files.push(("nco_sine.mem".into(), image("gyro_loop_nco_sine")));
-        files.push(("cic_taps.mem".into(), image("gyro_loop_cic_taps")));
+        let job = checked_job(Config::embedded()).unwrap();
+        let roms = RomImages::new(&job, &provenance);
+        let parallel = find("gyro_loop").block(&job, &roms);
+        let files = design_files(&parallel);
+        assert_eq!(
+            file(&files, "nco_sine.mem"),
+            rom(&parallel, "gyro_loop_nco_sine")
+        );
+        assert_eq!(
+            file(&files, "cic_taps.mem"),
+            rom(&parallel, "gyro_loop_cic_taps")
+        );
+
+        let serial = Config::from_toml("architecture = \"serial\"\n", "test").unwrap();
+        let job = checked_job(serial).unwrap();
+        let roms = RomImages::new(&job, &provenance);
+        let system = find("system").block(&job, &roms);
+        assert_eq!(system.module, "gyrofx_system_serial");
+        let files = design_files(&system);
+        assert_eq!(
+            file(&files, "serial_program.mem"),
+            rom(&system, "system_serial_program")
+        );
+        assert_eq!(
+            file(&files, "serial_coefficients.mem"),
+            rom(&system, "system_serial_coefficients")
+        );
+        // The folded loop names its images by parameter: nothing under a default name.
+        let folded = find("gyro_loop").block(&job, &roms);
+        assert!(design_files(&folded)
+            .iter()
+            .all(|(n, _)| n != "nco_sine.mem"));
     }
-    // Likewise the serial engine inside the folded system: its defaults name the serial
-    // chain's images, the system carries its own chain's.
-    if block.module == "gyrofx_system_serial" {
-        for (default, rom) in [
-            ("serial_program.mem", "system_serial_program"),
-            ("serial_coefficients.mem", "system_serial_coefficients"),
-        ] {
-            let image = block
-                .roms
-                .iter()
-                .find(|(name, _)| name.starts_with(rom))
-                .map(|(_, text)| text.clone())
-                .expect("the folded system carries its chain's ROMs");
-            files.push((default.into(), image));
-        }
-    }
-    files.push((CONFIGURED_FILE.into(), configured_module(block)));
-    files
 }

@@ -326,6 +326,13 @@ impl RtlBlock for GyroLoop {
         block.params = parameters(plan, &roms.entry(SINE_ROM).0, &roms.entry(TAPS_ROM).0);
         block.roms.push(roms.entry(SINE_ROM));
         block.roms.push(roms.entry(TAPS_ROM));
+        if job.loop_schedule.is_none() {
+            // The parallel loop's NCO and CIC read their images under their defaults' names.
+            block.elaboration_images = vec![
+                ("nco_sine.mem".into(), roms.entry(SINE_ROM).1),
+                ("cic_taps.mem".into(), roms.entry(TAPS_ROM).1),
+            ];
+        }
         if let Some(schedule) = &job.loop_schedule {
             block.module = SERIAL_MODULE;
             block.title = "one gyro's drive/sense loop, folded onto one multiplier, one accumulator and one RAM";

@@ -312,6 +312,12 @@ impl RtlBlock for System {
                 pipeline::system_chain_delay(job).into(),
                 "ADC samples from the chain's take to its outputs",
             ));
+            // The serial engine inside reads the serial chain's images under its defaults'
+            // names; the system carries its own chain's.
+            block.elaboration_images = vec![
+                ("serial_program.mem".into(), code.1.clone()),
+                ("serial_coefficients.mem".into(), limbs.1.clone()),
+            ];
             block.roms.extend([code, limbs, sine, taps, rom]);
             return block;
         }
