@@ -85,18 +85,24 @@ fn the_chain_and_loop_synthesize_place_and_route_and_their_netlists_pass_the_vec
 
 /// `architecture = "serial"`: `synth` synthesizes the folded gyro loop (and the serial chain),
 /// and the folded loop's netlist passes the loop's 40 000 vectors in Verilator, sample for
-/// sample at the schedule's spacing.
+/// sample at the schedule's spacing; placing the folded system builds its netlist, which
+/// passes the system's 44 000 with `GYROFX_SLOW_TESTS=1`.
 #[test]
 fn the_folded_loops_netlist_passes_the_loop_vectors() {
     let dir = tempfile::tempdir().unwrap();
     let config = write_config(dir.path(), "serial.toml", "architecture = \"serial\"\n");
     let synth = dir.path().join("synth");
+    // Placing the folded system (on the Xilinx target: yosys only) builds its netlist too.
     let log = ok(&[
         "synth",
         "--out",
         synth.to_str().unwrap(),
         "--config",
         &config,
+        "--target",
+        "xilinx",
+        "--blocks",
+        "system_serial",
     ]);
     assert!(log.contains("synthesis check passed"), "{log}");
     let [_, netlist] = gyrofx_lab::synth::netlist_files("gyrofx_gyro_loop_serial");
@@ -104,7 +110,53 @@ fn the_folded_loops_netlist_passes_the_loop_vectors() {
         synth.join("gyro_loop").join(&netlist).is_file(),
         "no folded loop netlist {netlist}"
     );
+    let [_, system_netlist] = gyrofx_lab::synth::netlist_files("gyrofx_system_serial");
+    assert!(
+        synth.join("system").join(&system_netlist).is_file(),
+        "no folded system netlist {system_netlist}"
+    );
+    let listed = manifest(&synth)["netlists"].to_string();
+    assert!(
+        listed.contains("system/netlist/gyrofx_system_serial_netlist.v"),
+        "{listed}"
+    );
+    let report = std::fs::read_to_string(synth.join("report.md")).unwrap();
+    assert!(
+        report.contains("# Synthesis check: gyrofx_system_serial"),
+        "{report}"
+    );
     the_loop_netlist_passes_the_vectors(dir.path(), &config, &synth);
+    // The system's netlist over its 44 000 samples is five minutes of Verilator.
+    if std::env::var("GYROFX_SLOW_TESTS").as_deref() == Ok("1") {
+        the_system_netlist_passes_the_vectors(dir.path(), &config, &synth);
+    }
+}
+
+/// The folded system's netlist runs the package's system testbench bit-exact in Verilator.
+fn the_system_netlist_passes_the_vectors(dir: &Path, config: &str, synth: &Path) {
+    let package = dir.join("system-package");
+    ok(&[
+        "generate",
+        "--out",
+        package.to_str().unwrap(),
+        "--samples",
+        "3000",
+        "--config",
+        config,
+    ]);
+    let log = ok(&[
+        "verify",
+        "--out",
+        package.to_str().unwrap(),
+        "--netlist",
+        synth.to_str().unwrap(),
+        "--sim",
+        "verilator",
+        "--blocks",
+        "system",
+        "--quiet",
+    ]);
+    assert!(log.contains("PASS n=44000"), "{log}");
 }
 
 /// The placement `p`'s Fmax is what nextpnr's `report.json` in `folder` achieved; returns it.

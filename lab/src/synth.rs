@@ -34,6 +34,14 @@ const TOP_BLOCK: &str = "top";
 const LOOP_BLOCK: &str = "gyro_loop";
 /// The folder of the loop's scripts, logs and RTL in the synthesis package.
 pub const LOOP_FOLDER: &str = "gyro_loop";
+/// Its block in the registry.
+const SYSTEM_BLOCK: &str = "system";
+/// The system block's module in the serial architecture.
+const SERIAL_SYSTEM: &str = "gyrofx_system_serial";
+/// The placed block whose place and route also builds the folded system's netlist.
+const SYSTEM_PLACED: &str = "system_serial";
+/// The folder of the folded system's design and netlist in the synthesis package.
+pub const SYSTEM_FOLDER: &str = "system";
 
 /// Generic (technology-independent) resources of the flattened chain.
 #[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -362,6 +370,7 @@ fn report_section(top: &Block, resources: &Resources) -> String {
 fn report(
     top: &Block,
     gyro_loop: &Block,
+    system: Option<(&Block, &Resources)>,
     synthesis: &Synthesis,
     provenance: &Provenance,
 ) -> String {
@@ -376,7 +385,14 @@ fn report(
         report_section(top, &synthesis.chain),
         gyro_loop.module,
         report_section(gyro_loop, &synthesis.gyro_loop),
-    ) + &place_route_section(&synthesis.placements)
+    ) + &system.map_or(String::new(), |(block, resources)| {
+        format!(
+            "\n# Synthesis check: {} (both folded loops and the serial chain; files in \
+             `{SYSTEM_FOLDER}/`)\n\n{}",
+            block.module,
+            report_section(block, resources)
+        )
+    }) + &place_route_section(&synthesis.placements)
 }
 
 /// The report's place-and-route section (empty when nothing was placed).
@@ -416,8 +432,14 @@ pub struct Synthesis {
     pub chain_module: &'static str,
     /// The chain.
     pub chain: Resources,
+    /// The loop's module: `gyrofx_gyro_loop`, or `gyrofx_gyro_loop_serial` (folded).
+    #[serde(skip)]
+    pub loop_module: &'static str,
     /// `gyrofx_gyro_loop` (gyro A's parameters).
     pub gyro_loop: Resources,
+    /// `gyrofx_system_serial`, when the folded system was placed (its netlist is built then:
+    /// its flows take minutes, which its place and route has already taken).
+    pub system: Option<Resources>,
     /// Each placed block on each target (none unless asked for).
     pub placements: Vec<place_route::Placement>,
 }
@@ -519,12 +541,22 @@ pub fn synthesize(
     let gyro_loop = blocks::find(LOOP_BLOCK).block(job, &roms);
     let chain_inputs = inputs(&top);
     let loop_inputs = inputs(&gyro_loop);
+    let system = Some(blocks::find(SYSTEM_BLOCK).block(job, &roms)).filter(|system| {
+        system.module == SERIAL_SYSTEM
+            && !place.targets.is_empty()
+            && place.blocks.contains(&SYSTEM_PLACED)
+    });
+    let system_inputs = system.as_ref().map(inputs);
 
     let work = output_folder::WorkFolder::new()
         .map_err(|e| Error::io(Path::new("temporary folder"), e))?;
     let loop_work = work.path().join(LOOP_FOLDER);
+    let system_work = work.path().join(SYSTEM_FOLDER);
     write_inputs(work.path(), &loop_work, &loop_inputs)?;
     write_inputs(work.path(), work.path(), &chain_inputs)?;
+    if let Some(system_inputs) = &system_inputs {
+        write_inputs(work.path(), &system_work, system_inputs)?;
+    }
     let placing = if place.targets.is_empty() {
         None
     } else {
@@ -539,12 +571,19 @@ pub fn synthesize(
     };
     // The longest first (the loop's flows, over a minute each at the defaults), so that none
     // runs alone at the end.
-    let mut tasks = vec![
+    let mut tasks = Vec::new();
+    if system.is_some() {
+        tasks.extend([
+            Task::Flow(&system_work, Flow::Generic),
+            Task::Flow(&system_work, Flow::Xilinx),
+        ]);
+    }
+    tasks.extend([
         Task::Flow(&loop_work, Flow::Generic),
         Task::Flow(&loop_work, Flow::Xilinx),
         Task::Flow(work.path(), Flow::Generic),
         Task::Flow(work.path(), Flow::Xilinx),
-    ];
+    ]);
     tasks.extend(placing.iter().flat_map(|p| p.tasks()).map(Task::Place));
     let placed = crate::pool::try_map(&tasks, place.jobs, |task| match *task {
         Task::Flow(dir, flow) => flow.run(dir).map(|()| None),
@@ -557,7 +596,12 @@ pub fn synthesize(
     let synthesis = Synthesis {
         chain_module: top.module,
         chain: resources(work.path())?,
+        loop_module: gyro_loop.module,
         gyro_loop: resources(&loop_work)?,
+        system: system
+            .as_ref()
+            .map(|_| resources(&system_work))
+            .transpose()?,
         placements: placed.into_iter().flatten().collect(),
     };
 
@@ -567,7 +611,13 @@ pub fn synthesize(
     }
     package.add(
         "report.md",
-        report(&top, &gyro_loop, &synthesis, provenance),
+        report(
+            &top,
+            &gyro_loop,
+            system.as_ref().zip(synthesis.system.as_ref()),
+            &synthesis,
+            provenance,
+        ),
     );
     if !synthesis.placements.is_empty() {
         package.add(
@@ -586,11 +636,31 @@ pub fn synthesize(
         &gyro_loop,
         &loop_inputs,
     )?;
+    if let (Some(system), Some(system_inputs)) = (&system, &system_inputs) {
+        add_design(
+            &mut package,
+            &format!("{SYSTEM_FOLDER}/"),
+            &system_work,
+            system,
+            system_inputs,
+        )?;
+    }
     let parameters_of = |block: &Block| {
         parameter_values(block)
             .into_iter()
             .collect::<std::collections::BTreeMap<_, _>>()
     };
+    let mut netlists = vec![
+        serde_json::json!({"block": TOP_BLOCK, "module": top.module, "files": netlist_files(top.module)}),
+        serde_json::json!({"block": LOOP_BLOCK, "module": gyro_loop.module, "files": netlist_files(gyro_loop.module).map(|f| format!("{LOOP_FOLDER}/{f}"))}),
+    ];
+    if let Some(system) = &system {
+        netlists.push(serde_json::json!({
+            "block": SYSTEM_BLOCK,
+            "module": system.module,
+            "files": netlist_files(system.module).map(|f| format!("{SYSTEM_FOLDER}/{f}")),
+        }));
+    }
     let manifest = serde_json::json!({
         "tool": "gyrofx",
         "version": provenance.version,
@@ -606,10 +676,7 @@ pub fn synthesize(
             "parameters": parameters_of(&gyro_loop),
             "resources": synthesis.gyro_loop,
         },
-    "netlists": [
-            {"block": TOP_BLOCK, "module": top.module, "files": netlist_files(top.module)},
-            {"block": LOOP_BLOCK, "module": gyro_loop.module, "files": netlist_files(gyro_loop.module).map(|f| format!("{LOOP_FOLDER}/{f}"))},
-        ],
+        "netlists": netlists,
         "netlist_cells": "yosys's internal gate library: simulate with its simcells.v",
         "place_and_route": synthesis.placements,
         "files": package.entries(),

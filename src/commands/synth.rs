@@ -5,11 +5,10 @@ use std::process::ExitCode;
 
 use anyhow::Result;
 
-use gyrofx_codegen::design::LOOP_TOP;
 use gyrofx_codegen::generate::Output;
 use gyrofx_lab::place_route::PlaceRequest;
 use gyrofx_lab::place_route::{self, Target};
-use gyrofx_lab::synth::synthesize;
+use gyrofx_lab::synth::{synthesize, Resources};
 
 use super::options::{ConfigSource, OutputFolder};
 
@@ -95,15 +94,24 @@ pub fn run(args: Args) -> Result<ExitCode> {
     let synthesis = synthesize(&job, out, folder.replace(), &provenance, &place);
     spinner.finish_and_clear();
     let synthesis = synthesis?;
+    let system = synthesis
+        .system
+        .as_ref()
+        .map(|resources| ("gyrofx_system_serial", resources));
+    let designs: Vec<(&str, &Resources)> = [
+        (synthesis.chain_module, &synthesis.chain),
+        (synthesis.loop_module, &synthesis.gyro_loop),
+    ]
+    .into_iter()
+    .chain(system)
+    .collect();
+    let modules: Vec<&str> = designs.iter().map(|(module, _)| *module).collect();
     println!(
-        "synthesis check passed: {}, {LOOP_TOP}; report in {}",
-        synthesis.chain_module,
+        "synthesis check passed: {}; report in {}",
+        modules.join(", "),
         out.join("report.md").display()
     );
-    for (module, resources) in [
-        (synthesis.chain_module, &synthesis.chain),
-        (LOOP_TOP, &synthesis.gyro_loop),
-    ] {
+    for (module, resources) in designs {
         let (g, x) = (&resources.generic, &resources.xilinx);
         println!(
             "{module} generic: {} cells, {} flip-flops, {} multipliers; xilinx 7-series: {} LUTs, {} flip-flops, {} DSP48E1, {} block RAM",
