@@ -128,35 +128,8 @@ fn the_folded_loops_netlist_passes_the_loop_vectors() {
     the_loop_netlist_passes_the_vectors(dir.path(), &config, &synth);
     // The system's netlist over its 44 000 samples is five minutes of Verilator.
     if std::env::var("GYROFX_SLOW_TESTS").as_deref() == Ok("1") {
-        the_system_netlist_passes_the_vectors(dir.path(), &config, &synth);
+        a_netlist_passes_the_vectors(dir.path(), &config, &synth, "system", 44_000);
     }
-}
-
-/// The folded system's netlist runs the package's system testbench bit-exact in Verilator.
-fn the_system_netlist_passes_the_vectors(dir: &Path, config: &str, synth: &Path) {
-    let package = dir.join("system-package");
-    ok(&[
-        "generate",
-        "--out",
-        package.to_str().unwrap(),
-        "--samples",
-        "3000",
-        "--config",
-        config,
-    ]);
-    let log = ok(&[
-        "verify",
-        "--out",
-        package.to_str().unwrap(),
-        "--netlist",
-        synth.to_str().unwrap(),
-        "--sim",
-        "verilator",
-        "--blocks",
-        "system",
-        "--quiet",
-    ]);
-    assert!(log.contains("PASS n=44000"), "{log}");
 }
 
 /// The placement `p`'s Fmax is what nextpnr's `report.json` in `folder` achieved; returns it.
@@ -619,7 +592,19 @@ fn flip_flops(generic_json: &Path) -> u64 {
 /// The loop's netlist (57 000 cells at [`SLOW`]'s formats) in Verilator: 40 000 closed-loop
 /// samples, bit-exact.
 fn the_loop_netlist_passes_the_vectors(dir: &Path, config: &str, synth: &Path) {
-    let package = dir.join("loop-package");
+    a_netlist_passes_the_vectors(dir, config, synth, "gyro_loop", 40_000);
+}
+
+/// `block`'s netlist in `synth` runs the package's testbench of `block` bit-exact in
+/// Verilator over its `vectors` samples.
+fn a_netlist_passes_the_vectors(
+    dir: &Path,
+    config: &str,
+    synth: &Path,
+    block: &str,
+    vectors: usize,
+) {
+    let package = dir.join(format!("{block}-package"));
     ok(&[
         "generate",
         "--out",
@@ -638,10 +623,10 @@ fn the_loop_netlist_passes_the_vectors(dir: &Path, config: &str, synth: &Path) {
         "--sim",
         "verilator",
         "--blocks",
-        "gyro_loop",
+        block,
         "--quiet",
     ]);
-    assert!(log.contains("PASS n=40000"), "{log}");
+    assert!(log.contains(&format!("PASS n={vectors}")), "{log}");
 }
 
 /// The synthesized chain runs the package's testbench bit-exact in Icarus; the
