@@ -25,7 +25,8 @@
  *                     after its issue; the weight travels with it)
  *     accumulator:    acc <= x + y                        (x: acc, 0, RAM word, setpoint, PI
  *                     integrator aligned; y: pp, -RAM word, p, -I, I, ...)
- *     RAM:            rd <= ram[read address] (0, or the PLL preset, when its gate says);
+ *     RAM:            rd <= ram[read address] (0 when its gate says; the PLL integrator
+ *                     operand the PLL preset instead, when its gate says);
  *                     ram[write address] <= acc, a quantized acc, rd or c
  *     quantization:   one point a clock loads its register from acc (gyrofx_quantize at
  *                     the formats of the parallel loop's point); the demodulator's output
@@ -362,29 +363,8 @@ always @(posedge clk) begin
     executing_last_reg <= last_word && !rst;
 end
 
-// The accumulator's x and y decoded from the fetched word into one-hot selects, a clock
-// before the word executes: a clock runs an AND-OR of registered selects into the adder, not
-// the ROM's output through a decoder (gyrofx_model::gyro_loop::folded::AccX, AccY codes).
-// (The control word's x and y fields, read from the fetched word: only the decode reads them.)
-wire [3:0] x_field = fetched_reg[22:19];
-wire [3:0] y_field = fetched_reg[26:23];
-// (x code 1 and y code 0 select nothing, 0: their bits stay 0.)
-/* verilator lint_off UNUSEDSIGNAL */
-reg [8:0] x_select_reg = 9'd0;
-reg [9:0] y_select_reg = 10'd0;
-/* verilator lint_on UNUSEDSIGNAL */
-reg y_negate_reg = 1'b0;
+// Whether the executing word accumulates (decoded with its operands, below).
 reg accumulate_reg = 1'b0;
-always @(posedge clk) begin
-    x_select_reg <= {x_field == 4'd8, x_field == 4'd7, x_field == 4'd6,
-        x_field == 4'd5, x_field == 4'd4, x_field == 4'd3, x_field == 4'd2,
-        1'b0, x_field == 4'd0};
-    y_select_reg <= {y_field == 4'd9, y_field == 4'd8, y_field == 4'd7,
-        y_field == 4'd6, y_field == 4'd5, y_field == 4'd4, y_field == 4'd3,
-        y_field == 4'd2, y_field == 4'd1, 1'b0};
-    y_negate_reg <= y_field == 4'd2 || y_field == 4'd4 || y_field == 4'd7;
-    accumulate_reg <= x_field != 4'd0 || y_field != 4'd0;
-end
 
 // The control word's fields (gyrofx_model::gyro_loop::folded::Control): a fixed layout, whose
 // widest fields a small loop does not use in full.
@@ -457,9 +437,17 @@ wire signed [NCO_SIN_W-1:0] reference = ref_negative_reg ? -$signed(ref_magnitud
                                                           : $signed(ref_magnitude_reg);
 
 // ---- RAM of states ---------------------------------------------------------------------------
+// The schedule never reads and writes one word in the same clock
+// (gyrofx_model::gyro_loop::folded::Control::merge refuses it), so the block RAM needs no
+// logic around it to return the old word then. The read register has no initial value, as a
+// block RAM's has none: it loads before it is read.
+(* no_rw_check *)
 reg [RAM_W-1:0] ram [0:RAM_WORDS-1];
-reg [RAM_W-1:0] ram_data_reg = {RAM_W{1'b0}};
-// How the read register reads: 0 (a cleared word), the PLL preset, or the word.
+reg [RAM_W-1:0] ram_data_reg;
+// The read register's gates: it reads as 0 (a cleared word), or the PLL integrator operand as
+// the PLL's preset. The accumulator's operands take them in their selects, decoded a clock
+// early; the other readers of the word (a delay line's shift, the multiplier, the previous
+// read) in their multiplexers.
 reg read_zero_reg = 1'b0;
 reg read_preset_reg = 1'b0;
 reg signed [RAM_W-1:0] previous_rd_reg = {RAM_W{1'b0}};
@@ -470,16 +458,48 @@ initial begin
     end
 end
 
-wire signed [PLL_INT_W-1:0] preset_value = mode_reg ? PLL_PRESET_N : PLL_PRESET_R;
-wire signed [PLL_INT_W-1:0] preset_clamped =
-    preset_value < PLL_INT_MIN ? PLL_INT_MIN : (preset_value > PLL_INT_MAX ? PLL_INT_MAX : preset_value);
-wire signed [RAM_W-1:0] preset_word = {{(RAM_W-PLL_INT_W){preset_clamped[PLL_INT_W-1]}}, preset_clamped};
-wire signed [RAM_W-1:0] rd = read_zero_reg ? {RAM_W{1'b0}}
-                             : (read_preset_reg ? preset_word : $signed(ram_data_reg));
+wire signed [RAM_W-1:0] rd = $signed(ram_data_reg);
 // gate_field: 1 switch, 2 preset, 3 first sample, 4 fewer than seen decimations.
 wire read_zero = (gate_field == 3'd1 && switching_reg) || (gate_field == 3'd3 && first_reg)
     || (gate_field == 3'd4 && seen_reg < seen_field);
 wire read_preset = gate_field == 3'd2 && switching_reg;
+// The gates as they stand when the word being decoded acts: this clock's read sets them.
+wire zero_next = read_en ? read_zero : read_zero_reg;
+wire preset_next = read_en ? read_preset : read_preset_reg;
+
+// The accumulator's x and y decoded from the fetched word into one-hot selects, a clock
+// before the word executes: a clock runs an AND-OR of registered selects into the adder, not
+// the ROM's output through a decoder (gyrofx_model::gyro_loop::folded::AccX, AccY codes). A
+// read gated to 0 selects nothing; the PLL's preset is an x source of its own; a negated y
+// is selected inverted and the adder's carry in adds the 1. Nothing but one AND-OR level
+// stands between a register and the adder.
+wire [3:0] x_field = fetched_reg[22:19];
+wire [3:0] y_field = fetched_reg[26:23];
+// (x code 1 and y code 0 select nothing, 0: their bits stay 0; x code 4 and the preset select
+// through setpoint_select_reg and preset_select_reg.)
+/* verilator lint_off UNUSEDSIGNAL */
+reg [8:0] x_select_reg = 9'd0;
+reg [9:0] y_select_reg = 10'd0;
+/* verilator lint_on UNUSEDSIGNAL */
+// A constant of two modes, per bit: set in both modes' values, in this mode's only (normal,
+// reverse); so that each bit of the operand is one registered select or 0.
+reg [2:0] setpoint_select_reg = 3'd0;
+reg [2:0] preset_select_reg = 3'd0;
+reg y_carry_reg = 1'b0;
+wire x_preset = x_field == 4'd5 && preset_next;
+always @(posedge clk) begin
+    x_select_reg <= {x_field == 4'd8, x_field == 4'd7 && !zero_next, x_field == 4'd6,
+        x_field == 4'd5 && !zero_next && !preset_next, 1'b0, x_field == 4'd3 && !zero_next,
+        x_field == 4'd2 && !zero_next, 1'b0, x_field == 4'd0};
+    setpoint_select_reg <= {x_field == 4'd4 && !mode_reg, x_field == 4'd4 && mode_reg,
+        x_field == 4'd4};
+    preset_select_reg <= {x_preset && !mode_reg, x_preset && mode_reg, x_preset};
+    y_select_reg <= {y_field == 4'd9, y_field == 4'd8, y_field == 4'd7 && !zero_next,
+        y_field == 4'd6, y_field == 4'd5, y_field == 4'd4, y_field == 4'd3,
+        y_field == 4'd2 && !zero_next, y_field == 4'd1, 1'b0};
+    y_carry_reg <= ((y_field == 4'd2 || y_field == 4'd7) && !zero_next) || y_field == 4'd4;
+    accumulate_reg <= x_field != 4'd0 || y_field != 4'd0;
+end
 
 // ---- multiplier: a 15-bit limb of a times all of b -------------------------------------------
 reg signed [DEMOD_OUT_W-1:0] drive_q_reg = {DEMOD_OUT_W{1'b0}};
@@ -502,7 +522,8 @@ wire signed [A_EXT_W-1:0] a_error =
     {{(A_EXT_W-AGC_ERR_W){amplitude_error_reg[AGC_ERR_W-1]}}, amplitude_error_reg};
 wire signed [A_EXT_W-1:0] a_amplitude = {{(A_EXT_W-AGC_OUT_W){amplitude_reg[AGC_OUT_W-1]}}, amplitude_reg};
 wire signed [A_EXT_W-1:0] a_c = {{(A_EXT_W-CIC_MID_W){c_reg[CIC_MID_W-1]}}, c_reg};
-wire signed [A_EXT_W-1:0] a_line = {{(A_EXT_W-CIC_MID_W){rd[CIC_MID_W-1]}}, rd[CIC_MID_W-1:0]};
+wire signed [A_EXT_W-1:0] a_line = {{(A_EXT_W-CIC_MID_W){rd[CIC_MID_W-1]}}, rd[CIC_MID_W-1:0]}
+    & {A_EXT_W{!read_zero_reg}};
 wire signed [A_EXT_W-1:0] a_cic_output =
     {{(A_EXT_W-CIC_OUT_W){cic_output_reg[CIC_OUT_W-1]}}, cic_output_reg};
 // (Continuous assignments, not always @*: a simulator evaluates them at time 0 too. The top
@@ -631,10 +652,30 @@ reg signed [V_W-1:0] v_reg = {V_W{1'b0}};
 wire signed [DEMOD_OUT_W-1:0] demod_output;
 
 wire signed [ACC_W-1:0] rd_acc = {{(ACC_W-RAM_W){rd[RAM_W-1]}}, rd};
+// The two modes' constants, and the bits set in both, in the normal's only, in the reverse's.
+function signed [ACC_W-1:0] preset_aligned;
+    input signed [PLL_INT_W-1:0] preset;
+    reg signed [PLL_INT_W-1:0] clamped;
+    begin
+        clamped = preset < PLL_INT_MIN ? PLL_INT_MIN : (preset > PLL_INT_MAX ? PLL_INT_MAX : preset);
+        preset_aligned = {{(ACC_W-PLL_INT_W){clamped[PLL_INT_W-1]}}, clamped} <<< (PLL_UPD_F - PLL_INT_F);
+    end
+endfunction
+localparam signed [ACC_W-1:0] SETPOINT_N_ACC = {{(ACC_W-DEMOD_OUT_W){SETPOINT_N[DEMOD_OUT_W-1]}}, SETPOINT_N};
+localparam signed [ACC_W-1:0] SETPOINT_R_ACC = {{(ACC_W-DEMOD_OUT_W){SETPOINT_R[DEMOD_OUT_W-1]}}, SETPOINT_R};
+localparam signed [ACC_W-1:0] PRESET_N_ACC = preset_aligned(PLL_PRESET_N);
+localparam signed [ACC_W-1:0] PRESET_R_ACC = preset_aligned(PLL_PRESET_R);
+function [ACC_W-1:0] of_modes;
+    input [2:0] select;
+    input [ACC_W-1:0] normal;
+    input [ACC_W-1:0] reverse;
+    begin
+        of_modes = ({ACC_W{select[0]}} & normal & reverse) | ({ACC_W{select[1]}} & normal & ~reverse)
+            | ({ACC_W{select[2]}} & ~normal & reverse);
+    end
+endfunction
 wire signed [ACC_W-1:0] previous_rd_acc = {{(ACC_W-RAM_W){previous_rd_reg[RAM_W-1]}}, previous_rd_reg};
 wire signed [ACC_W-1:0] v_acc = {{(ACC_W-V_W){v_reg[V_W-1]}}, v_reg};
-wire signed [DEMOD_OUT_W-1:0] setpoint = mode_reg ? SETPOINT_N : SETPOINT_R;
-wire signed [ACC_W-1:0] setpoint_acc = {{(ACC_W-DEMOD_OUT_W){setpoint[DEMOD_OUT_W-1]}}, setpoint};
 wire signed [ACC_W-1:0] p_acc = {{(ACC_W-DEMOD_PROD_W){p_reg[DEMOD_PROD_W-1]}}, p_reg};
 // Q_O of the state register, registered: the value of the clock before.
 reg signed [DEMOD_OUT_W-1:0] output_reg = {DEMOD_OUT_W{1'b0}};
@@ -652,24 +693,25 @@ wire signed [ACC_W-1:0] x_value =
       ({ACC_W{x_select_reg[0]}} & acc_reg)
     | ({ACC_W{x_select_reg[2]}} & rd_acc)
     | ({ACC_W{x_select_reg[3]}} & (rd_acc <<< DEMOD_SHIFT))
-    | ({ACC_W{x_select_reg[4]}} & setpoint_acc)
+    | of_modes(setpoint_select_reg, SETPOINT_N_ACC, SETPOINT_R_ACC)
     | ({ACC_W{x_select_reg[5]}} & (rd_acc <<< (PLL_UPD_F - PLL_INT_F)))
+    | of_modes(preset_select_reg, PRESET_N_ACC, PRESET_R_ACC)
     | ({ACC_W{x_select_reg[6]}} & (v_acc <<< (PLL_SUM_F - PLL_INT_F)))
     | ({ACC_W{x_select_reg[7]}} & (rd_acc <<< (AGC_UPD_F - AGC_INT_F)))
     | ({ACC_W{x_select_reg[8]}} & (v_acc <<< (AGC_SUM_F - AGC_INT_F)));
 
-// y, and whether it enters negated (x + ~y + 1).
+// y, a negated one inverted (x + ~y + 1: the carry in adds the 1).
 wire signed [ACC_W-1:0] y_value =
       ({ACC_W{y_select_reg[1]}} & pp_reg)
-    | ({ACC_W{y_select_reg[2]}} & rd_acc)
+    | ({ACC_W{y_select_reg[2]}} & ~rd_acc)
     | ({ACC_W{y_select_reg[3]}} & (p_acc <<< DEMOD_ALIGN))
-    | ({ACC_W{y_select_reg[4] | y_select_reg[5]}} & output_acc)
+    | ({ACC_W{y_select_reg[4]}} & ~output_acc)
+    | ({ACC_W{y_select_reg[5]}} & output_acc)
     | ({ACC_W{y_select_reg[6]}} & previous_rd_acc)
-    | ({ACC_W{y_select_reg[7]}} & (rd_acc >>> LOCK_SHIFT))
+    | ({ACC_W{y_select_reg[7]}} & ~(rd_acc >>> LOCK_SHIFT))
     | ({ACC_W{y_select_reg[8]}} & drive_q_acc)
     | ({ACC_W{y_select_reg[9]}} & error_acc);
-wire signed [ACC_W-1:0] acc_next =
-    x_value + (y_negate_reg ? ~y_value : y_value) + {{(ACC_W-1){1'b0}}, y_negate_reg};
+wire signed [ACC_W-1:0] acc_next = x_value + y_value + {{(ACC_W-1){1'b0}}, y_carry_reg};
 
 // ---- quantization points, at the parallel loop's formats -----------------------------------
 wire signed [DEMOD_PROD_W-1:0] p_next;
@@ -807,7 +849,7 @@ wire signed [RAM_W-1:0] write_data =
     data_field == 3'd1 ? {{(RAM_W-Z_W){z[Z_W-1]}}, z}
     : data_field == 3'd2 ? {{(RAM_W-DEMOD_STATE_W){y_reg[DEMOD_STATE_W-1]}}, y_reg}
     : data_field == 3'd3 ? {{(RAM_W-V_W){v_reg[V_W-1]}}, v_reg}
-    : data_field == 3'd4 ? rd
+    : data_field == 3'd4 ? rd & {RAM_W{!read_zero_reg}}
     : data_field == 3'd5 ? {{(RAM_W-CIC_MID_W){c_reg[CIC_MID_W-1]}}, c_reg}
     : {{(RAM_W-REG_W){acc_reg[REG_W-1]}}, acc_reg[REG_W-1:0]};
 
@@ -851,7 +893,7 @@ end
 
 always @(posedge clk) begin
     out_valid_reg <= 1'b0;
-    previous_rd_reg <= rd;
+    previous_rd_reg <= rd & {RAM_W{!read_zero_reg}};
 
     if (ce) begin
         busy_reg <= 1'b1;

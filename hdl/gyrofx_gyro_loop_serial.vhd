@@ -22,7 +22,8 @@
 --                     after its issue; the weight travels with it)
 --     accumulator:    acc <= x + y                        (x: acc, 0, RAM word, setpoint, PI
 --                     integrator aligned; y: pp, -RAM word, p, -I, I, ...)
---     RAM:            rd <= ram[read address] (0, or the PLL preset, when its gate says);
+--     RAM:            rd <= ram[read address] (0 when its gate says; the PLL integrator
+--                     operand the PLL preset instead, when its gate says);
 --                     ram[write address] <= acc, a quantized acc, rd or c
 --     quantization:   one point a clock loads its register from acc (gyrofx_quantize at
 --                     the formats of the parallel loop's point); the demodulator's output
@@ -436,10 +437,13 @@ architecture rtl of gyrofx_gyro_loop_serial is
     signal control_reg : std_logic_vector(63 downto 0) := (others => '0');
     signal executing_reg : std_logic := '0';
     signal executing_last_reg : std_logic := '0';
-    -- The fetched word's x and y codes, registered (the Verilog's one-hot selects), and
-    -- whether it accumulates and negates y.
+    -- The fetched word's x and y codes, registered (the Verilog's one-hot selects), the read
+    -- gates as they stand when it acts (a read gated to 0 selects nothing; the PLL's preset
+    -- is an x source of its own), and whether it accumulates.
     signal x_code_reg : unsigned(3 downto 0) := (others => '0');
     signal y_code_reg : unsigned(3 downto 0) := (others => '0');
+    signal operand_zero_reg : std_logic := '0';
+    signal operand_preset_reg : std_logic := '0';
     signal accumulate_reg : std_logic := '0';
     signal mode_reg : std_logic := '1';
     signal start_reg : std_logic := '1';
@@ -501,7 +505,8 @@ architecture rtl of gyrofx_gyro_loop_serial is
     -- ---- RAM of states ----
     signal ram : ram_array := (others => (others => '0'));
     signal ram_data_reg : std_logic_vector(RAM_W - 1 downto 0) := (others => '0');
-    -- How the read register reads: 0 (a cleared word), the PLL preset, or the word.
+    -- The read register's gates: it reads as 0 (a cleared word), or the PLL integrator
+    -- operand as the PLL's preset.
     signal read_zero_reg : std_logic := '0';
     signal read_preset_reg : std_logic := '0';
     signal previous_rd_reg : signed(RAM_W - 1 downto 0) := (others => '0');
@@ -510,6 +515,10 @@ architecture rtl of gyrofx_gyro_loop_serial is
     signal rd : signed(RAM_W - 1 downto 0);
     signal read_zero : std_logic;
     signal read_preset : std_logic;
+    signal zero_next : std_logic;
+    signal preset_next : std_logic;
+    -- The word as the accumulator's operands read it (0 when gated).
+    signal operand_rd : signed(RAM_W - 1 downto 0);
     signal read_address : unsigned(RAM_ADDR_W - 1 downto 0);
     signal write_address : unsigned(RAM_ADDR_W - 1 downto 0);
     signal write_data : signed(RAM_W - 1 downto 0);
@@ -644,6 +653,8 @@ begin
             executing_last_reg <= last_word and not rst;
             x_code_reg <= x_field;
             y_code_reg <= y_field;
+            operand_zero_reg <= zero_next;
+            operand_preset_reg <= preset_next;
             if x_field /= 0 or y_field /= 0 then
                 accumulate_reg <= '1';
             else
@@ -719,14 +730,16 @@ begin
     preset_clamped <= PLL_INT_MIN_C when preset_value < PLL_INT_MIN_C else
                       PLL_INT_MAX_C when preset_value > PLL_INT_MAX_C else
                       preset_value;
-    rd <= (others => '0') when read_zero_reg = '1' else
-          resize(preset_clamped, RAM_W) when read_preset_reg = '1' else
-          signed(ram_data_reg);
+    rd <= (others => '0') when read_zero_reg = '1' else signed(ram_data_reg);
     -- gate_field: 1 switch, 2 preset, 3 first sample, 4 fewer than seen decimations.
     read_zero <= '1' when (gate_field = 1 and switching_reg = '1')
                           or (gate_field = 3 and first_reg = '1')
                           or (gate_field = 4 and seen_reg < seen_field) else '0';
     read_preset <= '1' when gate_field = 2 and switching_reg = '1' else '0';
+    -- The gates as they stand when the word being decoded acts: this clock's read sets them.
+    zero_next <= read_zero when read_en = '1' else read_zero_reg;
+    preset_next <= read_preset when read_en = '1' else read_preset_reg;
+    operand_rd <= (others => '0') when operand_zero_reg = '1' else signed(ram_data_reg);
 
     -- ---- multiplier: a 15-bit limb of a times all of b ----
     adc_drive <= adc_x_reg when mode_reg = '1' else adc_y_reg;
@@ -849,12 +862,17 @@ begin
     begin
         case to_integer(x_code_reg) is
             when 1 => x_value <= (others => '0');
-            when 2 => x_value <= resize(rd, ACC_W);
-            when 3 => x_value <= shift_left(resize(rd, ACC_W), DEMOD_SHIFT);
+            when 2 => x_value <= resize(operand_rd, ACC_W);
+            when 3 => x_value <= shift_left(resize(operand_rd, ACC_W), DEMOD_SHIFT);
             when 4 => x_value <= resize(setpoint, ACC_W);
-            when 5 => x_value <= shift_left(resize(rd, ACC_W), PLL_UPD_SHIFT);
+            when 5 =>
+                if operand_preset_reg = '1' then
+                    x_value <= shift_left(resize(preset_clamped, ACC_W), PLL_UPD_SHIFT);
+                else
+                    x_value <= shift_left(resize(operand_rd, ACC_W), PLL_UPD_SHIFT);
+                end if;
             when 6 => x_value <= shift_left(resize(v_reg, ACC_W), PLL_SUM_SHIFT);
-            when 7 => x_value <= shift_left(resize(rd, ACC_W), AGC_UPD_SHIFT);
+            when 7 => x_value <= shift_left(resize(operand_rd, ACC_W), AGC_UPD_SHIFT);
             when 8 => x_value <= shift_left(resize(v_reg, ACC_W), AGC_SUM_SHIFT);
             when others => x_value <= acc_reg;
         end case;
@@ -867,7 +885,7 @@ begin
         case to_integer(y_code_reg) is
             when 1 => y_value <= pp_reg;
             when 2 =>
-                y_value <= resize(rd, ACC_W);
+                y_value <= resize(operand_rd, ACC_W);
                 y_negate <= '1';
             when 3 => y_value <= shift_left(resize(p_reg, ACC_W), DEMOD_ALIGN);
             when 4 =>
@@ -876,7 +894,7 @@ begin
             when 5 => y_value <= resize(output_reg, ACC_W);
             when 6 => y_value <= resize(previous_rd_reg, ACC_W);
             when 7 =>
-                y_value <= shift_right(resize(rd, ACC_W), LOCK_SHIFT);
+                y_value <= shift_right(resize(operand_rd, ACC_W), LOCK_SHIFT);
                 y_negate <= '1';
             when 8 => y_value <= resize(drive_q_reg, ACC_W);
             when 9 => y_value <= resize(amplitude_error_reg, ACC_W);

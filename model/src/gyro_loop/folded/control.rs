@@ -187,7 +187,10 @@ field_enum!(
         None = 0,
         /// In a sample that switches mode (demodulator states, AGC integrator, lock filters).
         Switch = 1,
-        /// In a sample that switches mode, the PLL's preset (clamped) instead.
+        /// In a sample that switches mode, the PLL's preset (clamped) instead, for the
+        /// accumulator's [`AccX::PllIntegrator`]: the preset is an operand of its own, chosen
+        /// with the operand a clock early, so the read register itself holds the word (which
+        /// its other readers see).
         Preset = 2,
         /// In the first sample after reset (CIC integrators).
         First = 3,
@@ -440,6 +443,13 @@ impl Control {
             (Quantize::None, q) | (q, Quantize::None) => q,
             _ => return Err(Busy("quantizer")),
         };
+        // A block RAM's read of the word it writes in the same clock is undefined (the RTL
+        // does not pay for the logic that would return the old word).
+        let read = self.read.or(other.read);
+        let write = self.write.or(other.write);
+        if read.zip(write).is_some_and(|(r, w)| r.address == w.address) {
+            return Err(Busy("RAM word (read and written)"));
+        }
         Ok(Control {
             rom,
             advance: self.advance || other.advance,

@@ -113,6 +113,8 @@ pub struct FoldedGyroLoop {
     freq: u64,
     reference: i128,
     rd: i128,
+    /// The read register's preset gate: [`AccX::PllIntegrator`] reads the PLL's preset.
+    rd_preset: bool,
     previous_rd: i128,
     /// The multiplier's operand registers: the limb of `a`, `b`, and the product's weight
     /// (a left shift).
@@ -259,6 +261,7 @@ impl FoldedGyroLoop {
             freq: 0,
             reference: 0,
             rd: 0,
+            rd_preset: false,
             previous_rd: 0,
             operands: (0, 0, 0),
             product: (0, 0),
@@ -374,7 +377,10 @@ impl FoldedGyroLoop {
                 AccX::Read => rd,
                 AccX::ReadLowpass => rd << self.shifts.lowpass,
                 AccX::Setpoint => m.setpoint,
-                AccX::PllIntegrator => rd << self.shifts.pll_v_to_update,
+                AccX::PllIntegrator => {
+                    let integrator = if self.rd_preset { m.pll_preset } else { rd };
+                    integrator << self.shifts.pll_v_to_update
+                }
                 AccX::PllSum => self.v << self.shifts.pll_v_to_sum,
                 AccX::AgcIntegrator => rd << self.shifts.agc_v_to_update,
                 AccX::AgcSum => self.v << self.shifts.agc_v_to_sum,
@@ -395,18 +401,17 @@ impl FoldedGyroLoop {
         });
         let read = control.read.map(|read| {
             let word = self.ram[usize::from(read.address)];
-            match read.gate {
-                ReadGate::None => word,
+            assert!(
+                control.write.is_none_or(|w| w.address != read.address),
+                "word {} read and written in one clock: {control}",
+                read.address
+            );
+            let preset = read.gate == ReadGate::Preset && self.switching;
+            let value = match read.gate {
+                ReadGate::None | ReadGate::Preset => word,
                 ReadGate::Switch => {
                     if self.switching {
                         0
-                    } else {
-                        word
-                    }
-                }
-                ReadGate::Preset => {
-                    if self.switching {
-                        m.pll_preset
                     } else {
                         word
                     }
@@ -425,7 +430,8 @@ impl FoldedGyroLoop {
                         word
                     }
                 }
-            }
+            };
+            (value, preset)
         });
         if let Some(write) = control.write {
             let value = match write.data {
@@ -442,8 +448,9 @@ impl FoldedGyroLoop {
 
         // The loads.
         self.previous_rd = rd;
-        if let Some(value) = read {
+        if let Some((value, preset)) = read {
             self.rd = value;
+            self.rd_preset = preset;
         }
         self.output = self.points.output.apply(y_register);
         self.pp = pp;

@@ -27,7 +27,9 @@
 //!   the `y` of the clock before (no clock runs a quantizer into the accumulator's adder).
 //! - **RAM.** Every state: the four demodulator low-pass states, the two PI integrators, the
 //!   two lock filters, the CICs' integrators and combs, the compensators' delay lines. One
-//!   read and one write a clock; a read lands in `rd` on the next clock; a quantized state
+//!   read and one write a clock, never of the same word (a block RAM's read of the word it
+//!   writes is undefined; [`Control::merge`] refuses it); a read lands in `rd` on the next
+//!   clock; a quantized state
 //!   is written from the register its point loaded, the clock after ([`WriteData`]). Clears
 //!   at a mode switch and at reset are read gates ([`ReadGate`]), not clocks spent writing
 //!   zeros.
@@ -35,7 +37,9 @@
 //!   computes the reference's phase and address.
 //!
 //! The RTL fetches each control word two clocks before it acts and decodes the accumulator's
-//! operand selects from it in the clock between; the model's clocks are the words' own.
+//! operand selects from it in the clock between (with the read gates: a word gated to 0
+//! selects nothing, the PLL's preset is an operand of its own); the model's clocks are the
+//! words' own.
 //!
 //! The schedule ([`Schedule`]) is derived from the loop's plan: which unit does what in each
 //! clock of a sample, the regular part every sample and the decimation part (combs,
