@@ -802,18 +802,32 @@ gyrofx_quantize #(
 /* verilator lint_on PINCONNECTEMPTY */
 
 // The PI integrators' clamps: the limits bound the result, so its low INT_W bits are exact.
-wire signed [PLL_RND_W-1:0] pll_low = {{(PLL_RND_W-PLL_INT_W){PLL_INT_MIN[PLL_INT_W-1]}}, PLL_INT_MIN};
-wire signed [PLL_RND_W-1:0] pll_high = {{(PLL_RND_W-PLL_INT_W){PLL_INT_MAX[PLL_INT_W-1]}}, PLL_INT_MAX};
+// They compare the floor q of the update (the accumulator's bits), beside the rounding's carry
+// rather than after it: the rounded value is q + inc (inc 0 or 1, its low bit q's flipped
+// when inc is 1), below the low limit L when q < L - 1 or q = L - 1 and inc = 0, above the
+// high one H when q > H or q = H and inc = 1.
+localparam integer PLL_DROP = PLL_UPD_F - PLL_INT_F;
+localparam signed [PLL_RND_W-1:0] PLL_LOW = {{(PLL_RND_W-PLL_INT_W){PLL_INT_MIN[PLL_INT_W-1]}}, PLL_INT_MIN};
+localparam signed [PLL_RND_W-1:0] PLL_HIGH = {{(PLL_RND_W-PLL_INT_W){PLL_INT_MAX[PLL_INT_W-1]}}, PLL_INT_MAX};
+localparam signed [PLL_RND_W-1:0] PLL_LOW_LESS = PLL_LOW - 1;
+wire signed [PLL_RND_W-1:0] pll_floor = {acc_reg[PLL_UPD_W-1], acc_reg[PLL_UPD_W-1:PLL_DROP]};
+wire pll_increment = pll_rounded[0] ^ pll_floor[0];
+wire pll_below = pll_floor < PLL_LOW_LESS || (pll_floor == PLL_LOW_LESS && !pll_increment);
+wire pll_above = pll_floor > PLL_HIGH || (pll_floor == PLL_HIGH && pll_increment);
 /* verilator lint_off UNUSEDSIGNAL */
-wire signed [PLL_RND_W-1:0] pll_clamped =
-    pll_rounded < pll_low ? pll_low : (pll_rounded > pll_high ? pll_high : pll_rounded);
+wire signed [PLL_RND_W-1:0] pll_clamped = pll_below ? PLL_LOW : (pll_above ? PLL_HIGH : pll_rounded);
 /* verilator lint_on UNUSEDSIGNAL */
 wire signed [PLL_INT_W-1:0] pll_v_next = pll_clamped[PLL_INT_W-1:0];
-wire signed [AGC_RND_W-1:0] agc_low = {{(AGC_RND_W-AGC_INT_W){AGC_INT_MIN[AGC_INT_W-1]}}, AGC_INT_MIN};
-wire signed [AGC_RND_W-1:0] agc_high = {{(AGC_RND_W-AGC_INT_W){AGC_INT_MAX[AGC_INT_W-1]}}, AGC_INT_MAX};
+localparam integer AGC_DROP = AGC_UPD_F - AGC_INT_F;
+localparam signed [AGC_RND_W-1:0] AGC_LOW = {{(AGC_RND_W-AGC_INT_W){AGC_INT_MIN[AGC_INT_W-1]}}, AGC_INT_MIN};
+localparam signed [AGC_RND_W-1:0] AGC_HIGH = {{(AGC_RND_W-AGC_INT_W){AGC_INT_MAX[AGC_INT_W-1]}}, AGC_INT_MAX};
+localparam signed [AGC_RND_W-1:0] AGC_LOW_LESS = AGC_LOW - 1;
+wire signed [AGC_RND_W-1:0] agc_floor = {acc_reg[AGC_UPD_W-1], acc_reg[AGC_UPD_W-1:AGC_DROP]};
+wire agc_increment = agc_rounded[0] ^ agc_floor[0];
+wire agc_below = agc_floor < AGC_LOW_LESS || (agc_floor == AGC_LOW_LESS && !agc_increment);
+wire agc_above = agc_floor > AGC_HIGH || (agc_floor == AGC_HIGH && agc_increment);
 /* verilator lint_off UNUSEDSIGNAL */
-wire signed [AGC_RND_W-1:0] agc_clamped =
-    agc_rounded < agc_low ? agc_low : (agc_rounded > agc_high ? agc_high : agc_rounded);
+wire signed [AGC_RND_W-1:0] agc_clamped = agc_below ? AGC_LOW : (agc_above ? AGC_HIGH : agc_rounded);
 /* verilator lint_on UNUSEDSIGNAL */
 wire signed [AGC_INT_W-1:0] agc_v_next = agc_clamped[AGC_INT_W-1:0];
 

@@ -400,6 +400,8 @@ architecture rtl of gyrofx_gyro_loop_serial is
     constant PLL_HIGH : signed(PLL_RND_W - 1 downto 0) := resize(PLL_INT_MAX_C, PLL_RND_W);
     constant AGC_LOW : signed(AGC_RND_W - 1 downto 0) := resize(AGC_INT_MIN_C, AGC_RND_W);
     constant AGC_HIGH : signed(AGC_RND_W - 1 downto 0) := resize(AGC_INT_MAX_C, AGC_RND_W);
+    constant PLL_LOW_LESS : signed(PLL_RND_W - 1 downto 0) := PLL_LOW - 1;
+    constant AGC_LOW_LESS : signed(AGC_RND_W - 1 downto 0) := AGC_LOW - 1;
     -- The schedule's last word of a regular and of a decimating sample; the count's last.
     constant REGULAR_END : unsigned(PC_W - 1 downto 0) := to_unsigned(SCHEDULE_REGULAR - 1, PC_W);
     constant DECIMATING_END : unsigned(PC_W - 1 downto 0) := to_unsigned(SCHEDULE_LEN - 1, PC_W);
@@ -576,8 +578,16 @@ architecture rtl of gyrofx_gyro_loop_serial is
     signal c_next : signed(CIC_MID_W - 1 downto 0);
     signal cic_output_next : signed(CIC_OUT_W - 1 downto 0);
     signal rate_next : signed(OUT_W - 1 downto 0);
+    signal pll_floor : signed(PLL_RND_W - 1 downto 0);
+    signal pll_increment : std_logic;
+    signal pll_below : std_logic;
+    signal pll_above : std_logic;
     signal pll_clamped : signed(PLL_RND_W - 1 downto 0);
     signal pll_v_next : signed(PLL_INT_W - 1 downto 0);
+    signal agc_floor : signed(AGC_RND_W - 1 downto 0);
+    signal agc_increment : std_logic;
+    signal agc_below : std_logic;
+    signal agc_above : std_logic;
     signal agc_clamped : signed(AGC_RND_W - 1 downto 0);
     signal agc_v_next : signed(AGC_INT_W - 1 downto 0);
     signal z : signed(Z_W - 1 downto 0);
@@ -1006,12 +1016,28 @@ begin
         );
 
     -- The PI integrators' clamps: the limits bound the result, so its low INT_W bits are exact.
-    pll_clamped <= PLL_LOW when pll_rounded < PLL_LOW else
-                   PLL_HIGH when pll_rounded > PLL_HIGH else
+    -- They compare the floor q of the update (the accumulator's bits), beside the rounding's
+    -- carry rather than after it: the rounded value is q + inc (inc 0 or 1, its low bit q's
+    -- flipped when inc is 1), below the low limit L when q < L - 1 or q = L - 1 and inc = 0,
+    -- above the high one H when q > H or q = H and inc = 1.
+    pll_floor <= resize(acc_reg(PLL_UPD_W - 1 downto PLL_UPD_SHIFT), PLL_RND_W);
+    pll_increment <= pll_rounded(0) xor pll_floor(0);
+    pll_below <= '1' when pll_floor < PLL_LOW_LESS
+                          or (pll_floor = PLL_LOW_LESS and pll_increment = '0') else '0';
+    pll_above <= '1' when pll_floor > PLL_HIGH
+                          or (pll_floor = PLL_HIGH and pll_increment = '1') else '0';
+    pll_clamped <= PLL_LOW when pll_below = '1' else
+                   PLL_HIGH when pll_above = '1' else
                    pll_rounded;
     pll_v_next <= pll_clamped(PLL_INT_W - 1 downto 0);
-    agc_clamped <= AGC_LOW when agc_rounded < AGC_LOW else
-                   AGC_HIGH when agc_rounded > AGC_HIGH else
+    agc_floor <= resize(acc_reg(AGC_UPD_W - 1 downto AGC_UPD_SHIFT), AGC_RND_W);
+    agc_increment <= agc_rounded(0) xor agc_floor(0);
+    agc_below <= '1' when agc_floor < AGC_LOW_LESS
+                          or (agc_floor = AGC_LOW_LESS and agc_increment = '0') else '0';
+    agc_above <= '1' when agc_floor > AGC_HIGH
+                          or (agc_floor = AGC_HIGH and agc_increment = '1') else '0';
+    agc_clamped <= AGC_LOW when agc_below = '1' else
+                   AGC_HIGH when agc_above = '1' else
                    agc_rounded;
     agc_v_next <= agc_clamped(AGC_INT_W - 1 downto 0);
 
