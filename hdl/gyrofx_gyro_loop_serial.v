@@ -424,8 +424,6 @@ localparam [R_W-1:0] HALF_BIN = ONES ^ (ONES >> 1);
 wire [T_W-1:0] t_sin = phase[NCO_PHASE_W-1:NCO_PHASE_W-T_W];
 wire [T_W-1:0] t = cosine ? t_sin + {2'b01, {NCO_ADDR_W{1'b0}}} : t_sin;
 wire [NCO_ADDR_W-1:0] rom_address = t[NCO_ADDR_W] ? ~t[NCO_ADDR_W-1:0] : t[NCO_ADDR_W-1:0];
-wire [NCO_PHASE_W-1:0] freq_sample = switching_reg ? (mode_reg ? FREQ_WORD_N : FREQ_WORD_R)
-                                                   : freq_reg;
 
 always @(posedge clk) begin
     if (rom_en) begin
@@ -486,6 +484,11 @@ reg [9:0] y_select_reg = 10'd0;
 reg [2:0] setpoint_select_reg = 3'd0;
 reg [2:0] preset_select_reg = 3'd0;
 reg y_carry_reg = 1'b0;
+// The RAM write's source (data_field's codes), decoded as the operands are.
+wire [2:0] data_field_next = fetched_reg[52:50];
+reg [5:0] write_select_reg = 6'd0;
+wire [3:0] a_field_next = fetched_reg[7:4];
+reg [7:0] a_select_reg = 8'd0;
 wire x_preset = x_field == 4'd5 && preset_next;
 always @(posedge clk) begin
     x_select_reg <= {x_field == 4'd8, x_field == 4'd7 && !zero_next, x_field == 4'd6,
@@ -498,6 +501,13 @@ always @(posedge clk) begin
         y_field == 4'd6, y_field == 4'd5, y_field == 4'd4, y_field == 4'd3,
         y_field == 4'd2 && !zero_next, y_field == 4'd1, 1'b0};
     y_carry_reg <= ((y_field == 4'd2 || y_field == 4'd7) && !zero_next) || y_field == 4'd4;
+    a_select_reg <= {a_field_next == 4'd8, a_field_next == 4'd7 && !zero_next,
+        a_field_next == 4'd6, a_field_next == 4'd5, a_field_next == 4'd4, a_field_next == 4'd3,
+        (a_field_next == 4'd1 && !mode_reg) || (a_field_next == 4'd2 && mode_reg),
+        (a_field_next == 4'd1 && mode_reg) || (a_field_next == 4'd2 && !mode_reg)};
+    write_select_reg <= {data_field_next == 3'd5, data_field_next == 3'd4 && !zero_next,
+        data_field_next == 3'd3, data_field_next == 3'd2, data_field_next == 3'd1,
+        data_field_next == 3'd0};
     accumulate_reg <= x_field != 4'd0 || y_field != 4'd0;
 end
 
@@ -512,33 +522,22 @@ initial begin
     $readmemh(CIC_ROM_FILE, taps_rom);
 end
 
-wire signed [DEMOD_ADC_W-1:0] adc_drive = mode_reg ? adc_x_reg : adc_y_reg;
-wire signed [DEMOD_ADC_W-1:0] adc_sense = mode_reg ? adc_y_reg : adc_x_reg;
-// Every a operand sign-extended to A_EXT_W bits (the RAM word holds a CIC output c).
-wire signed [A_EXT_W-1:0] a_adc_drive = {{(A_EXT_W-DEMOD_ADC_W){adc_drive[DEMOD_ADC_W-1]}}, adc_drive};
-wire signed [A_EXT_W-1:0] a_adc_sense = {{(A_EXT_W-DEMOD_ADC_W){adc_sense[DEMOD_ADC_W-1]}}, adc_sense};
-wire signed [A_EXT_W-1:0] a_drive_q = {{(A_EXT_W-DEMOD_OUT_W){drive_q_reg[DEMOD_OUT_W-1]}}, drive_q_reg};
-wire signed [A_EXT_W-1:0] a_error =
-    {{(A_EXT_W-AGC_ERR_W){amplitude_error_reg[AGC_ERR_W-1]}}, amplitude_error_reg};
-wire signed [A_EXT_W-1:0] a_amplitude = {{(A_EXT_W-AGC_OUT_W){amplitude_reg[AGC_OUT_W-1]}}, amplitude_reg};
-wire signed [A_EXT_W-1:0] a_c = {{(A_EXT_W-CIC_MID_W){c_reg[CIC_MID_W-1]}}, c_reg};
-wire signed [A_EXT_W-1:0] a_line = {{(A_EXT_W-CIC_MID_W){rd[CIC_MID_W-1]}}, rd[CIC_MID_W-1:0]}
-    & {A_EXT_W{!read_zero_reg}};
-wire signed [A_EXT_W-1:0] a_cic_output =
-    {{(A_EXT_W-CIC_OUT_W){cic_output_reg[CIC_OUT_W-1]}}, cic_output_reg};
+// Every a operand sign-extended to A_EXT_W bits (the RAM word holds a CIC output c), as an
+// AND-OR of one-hot selects decoded a clock early (a_select_reg: the ADC codes of x and y,
+// whichever axis the mode drives, Q_D, e_A, the amplitude, c, the delay line's word unless
+// its read is gated to 0, the compensator's output).
 // (Continuous assignments, not always @*: a simulator evaluates them at time 0 too. The top
 // bit, a guard bit, is never a limb's.)
 /* verilator lint_off UNUSEDSIGNAL */
 wire signed [A_EXT_W-1:0] a_value =
-    a_field == 4'd1 ? a_adc_drive
-    : a_field == 4'd2 ? a_adc_sense
-    : a_field == 4'd3 ? a_drive_q
-    : a_field == 4'd4 ? a_error
-    : a_field == 4'd5 ? a_amplitude
-    : a_field == 4'd6 ? a_c
-    : a_field == 4'd7 ? a_line
-    : a_field == 4'd8 ? a_cic_output
-    : {A_EXT_W{1'b0}};
+      ({A_EXT_W{a_select_reg[0]}} & {{(A_EXT_W-DEMOD_ADC_W){adc_x_reg[DEMOD_ADC_W-1]}}, adc_x_reg})
+    | ({A_EXT_W{a_select_reg[1]}} & {{(A_EXT_W-DEMOD_ADC_W){adc_y_reg[DEMOD_ADC_W-1]}}, adc_y_reg})
+    | ({A_EXT_W{a_select_reg[2]}} & {{(A_EXT_W-DEMOD_OUT_W){drive_q_reg[DEMOD_OUT_W-1]}}, drive_q_reg})
+    | ({A_EXT_W{a_select_reg[3]}} & {{(A_EXT_W-AGC_ERR_W){amplitude_error_reg[AGC_ERR_W-1]}}, amplitude_error_reg})
+    | ({A_EXT_W{a_select_reg[4]}} & {{(A_EXT_W-AGC_OUT_W){amplitude_reg[AGC_OUT_W-1]}}, amplitude_reg})
+    | ({A_EXT_W{a_select_reg[5]}} & {{(A_EXT_W-CIC_MID_W){c_reg[CIC_MID_W-1]}}, c_reg})
+    | ({A_EXT_W{a_select_reg[6]}} & {{(A_EXT_W-CIC_MID_W){rd[CIC_MID_W-1]}}, rd[CIC_MID_W-1:0]})
+    | ({A_EXT_W{a_select_reg[7]}} & {{(A_EXT_W-CIC_OUT_W){cic_output_reg[CIC_OUT_W-1]}}, cic_output_reg});
 /* verilator lint_on UNUSEDSIGNAL */
 // Limb k of a: a chain of A_LIMBS choices (bits 15k .. 15k + 15), not a barrel shifter.
 genvar n;
@@ -717,9 +716,14 @@ wire signed [ACC_W-1:0] acc_next = x_value + y_value + {{(ACC_W-1){1'b0}}, y_car
 wire signed [DEMOD_PROD_W-1:0] p_next;
 wire signed [DEMOD_STATE_W-1:0] y_next;
 wire signed [DEMOD_OUT_W-1:0] error_next;
+// (The integrators' rounded updates: v takes their low INT_W bits, the clamp the rest.)
+/* verilator lint_off UNUSEDSIGNAL */
 wire signed [PLL_RND_W-1:0] pll_rounded;
+/* verilator lint_on UNUSEDSIGNAL */
 wire signed [PLL_OUT_W-1:0] pll_out;
+/* verilator lint_off UNUSEDSIGNAL */
 wire signed [AGC_RND_W-1:0] agc_rounded;
+/* verilator lint_on UNUSEDSIGNAL */
 wire signed [AGC_OUT_W-1:0] agc_out;
 wire signed [DAC_W-1:0] drive;
 wire signed [CIC_MID_W-1:0] c_next;
@@ -814,10 +818,6 @@ wire signed [PLL_RND_W-1:0] pll_floor = {acc_reg[PLL_UPD_W-1], acc_reg[PLL_UPD_W
 wire pll_increment = pll_rounded[0] ^ pll_floor[0];
 wire pll_below = pll_floor < PLL_LOW_LESS || (pll_floor == PLL_LOW_LESS && !pll_increment);
 wire pll_above = pll_floor > PLL_HIGH || (pll_floor == PLL_HIGH && pll_increment);
-/* verilator lint_off UNUSEDSIGNAL */
-wire signed [PLL_RND_W-1:0] pll_clamped = pll_below ? PLL_LOW : (pll_above ? PLL_HIGH : pll_rounded);
-/* verilator lint_on UNUSEDSIGNAL */
-wire signed [PLL_INT_W-1:0] pll_v_next = pll_clamped[PLL_INT_W-1:0];
 localparam integer AGC_DROP = AGC_UPD_F - AGC_INT_F;
 localparam signed [AGC_RND_W-1:0] AGC_LOW = {{(AGC_RND_W-AGC_INT_W){AGC_INT_MIN[AGC_INT_W-1]}}, AGC_INT_MIN};
 localparam signed [AGC_RND_W-1:0] AGC_HIGH = {{(AGC_RND_W-AGC_INT_W){AGC_INT_MAX[AGC_INT_W-1]}}, AGC_INT_MAX};
@@ -826,10 +826,19 @@ wire signed [AGC_RND_W-1:0] agc_floor = {acc_reg[AGC_UPD_W-1], acc_reg[AGC_UPD_W
 wire agc_increment = agc_rounded[0] ^ agc_floor[0];
 wire agc_below = agc_floor < AGC_LOW_LESS || (agc_floor == AGC_LOW_LESS && !agc_increment);
 wire agc_above = agc_floor > AGC_HIGH || (agc_floor == AGC_HIGH && agc_increment);
-/* verilator lint_off UNUSEDSIGNAL */
-wire signed [AGC_RND_W-1:0] agc_clamped = agc_below ? AGC_LOW : (agc_above ? AGC_HIGH : agc_rounded);
-/* verilator lint_on UNUSEDSIGNAL */
-wire signed [AGC_INT_W-1:0] agc_v_next = agc_clamped[AGC_INT_W-1:0];
+// v_reg's next value at either PI's point (its low INT_W bits, sign-extended): the point's
+// rounded update and limits chosen first (the point is known early), the comparisons last.
+wire pll_point = quantize_field == 4'd5;
+wire [V_W-1:0] v_rounded = pll_point
+    ? {{(V_W-PLL_INT_W){pll_rounded[PLL_INT_W-1]}}, pll_rounded[PLL_INT_W-1:0]}
+    : {{(V_W-AGC_INT_W){agc_rounded[AGC_INT_W-1]}}, agc_rounded[AGC_INT_W-1:0]};
+wire [V_W-1:0] v_low = pll_point ? {{(V_W-PLL_INT_W){PLL_INT_MIN[PLL_INT_W-1]}}, PLL_INT_MIN}
+                                 : {{(V_W-AGC_INT_W){AGC_INT_MIN[AGC_INT_W-1]}}, AGC_INT_MIN};
+wire [V_W-1:0] v_high = pll_point ? {{(V_W-PLL_INT_W){PLL_INT_MAX[PLL_INT_W-1]}}, PLL_INT_MAX}
+                                  : {{(V_W-AGC_INT_W){AGC_INT_MAX[AGC_INT_W-1]}}, AGC_INT_MAX};
+wire v_below = pll_point ? pll_below : agc_below;
+wire v_above = pll_point ? pll_above : agc_above;
+wire [V_W-1:0] v_next = v_below ? v_low : (v_above ? v_high : v_rounded);
 
 // The lock filters' check |z| < limit as -limit < z < limit: two comparisons side by side, not
 // a negation then one, in Z_W + 2 bits. |z| < 2^(Z_W-1), so a limit clipped to +-2^Z_W decides
@@ -859,13 +868,64 @@ wire signed [CMP_W-1:0] lock_floor = quantize_field == 4'd14 ? (mode_reg ? -LIMI
 wire within_limit = z_cmp < lock_limit && z_cmp > lock_floor;
 
 // ---- RAM writes ---------------------------------------------------------------------------
-wire signed [RAM_W-1:0] write_data =
-    data_field == 3'd1 ? {{(RAM_W-Z_W){z[Z_W-1]}}, z}
-    : data_field == 3'd2 ? {{(RAM_W-DEMOD_STATE_W){y_reg[DEMOD_STATE_W-1]}}, y_reg}
-    : data_field == 3'd3 ? {{(RAM_W-V_W){v_reg[V_W-1]}}, v_reg}
-    : data_field == 3'd4 ? rd & {RAM_W{!read_zero_reg}}
-    : data_field == 3'd5 ? {{(RAM_W-CIC_MID_W){c_reg[CIC_MID_W-1]}}, c_reg}
-    : {{(RAM_W-REG_W){acc_reg[REG_W-1]}}, acc_reg[REG_W-1:0]};
+// What a write stores, as an AND-OR of one-hot selects decoded a clock early (data_field:
+// 0 the accumulator at the CIC registers' width, 1 at the lock filters', 2 y, 3 v, 4 the read
+// register, 5 c). The narrow sources share one multiplexer whose sign extends past them.
+localparam integer NARROW_W = max2(max2(Z_W, DEMOD_STATE_W), max2(V_W, CIC_MID_W));
+wire [NARROW_W-1:0] write_narrow =
+      ({NARROW_W{write_select_reg[1]}} & {{(NARROW_W-Z_W){z[Z_W-1]}}, z})
+    | ({NARROW_W{write_select_reg[2]}} & {{(NARROW_W-DEMOD_STATE_W){y_reg[DEMOD_STATE_W-1]}}, y_reg})
+    | ({NARROW_W{write_select_reg[3]}} & {{(NARROW_W-V_W){v_reg[V_W-1]}}, v_reg})
+    | ({NARROW_W{write_select_reg[5]}} & {{(NARROW_W-CIC_MID_W){c_reg[CIC_MID_W-1]}}, c_reg});
+wire [RAM_W-1:0] write_data =
+      {{(RAM_W-NARROW_W){write_narrow[NARROW_W-1]}}, write_narrow}
+    | ({RAM_W{write_select_reg[4]}} & rd)
+    | ({RAM_W{write_select_reg[0]}} & {{(RAM_W-REG_W){acc_reg[REG_W-1]}}, acc_reg[REG_W-1:0]});
+
+// The DAC point loads the driven axis's code and clears the other's (clears: synchronous
+// resets, not multiplexers).
+always @(posedge clk) begin
+    if (rst || (point == 4'd9 && !mode_reg)) begin
+        dac_x_reg <= {DAC_W{1'b0}};
+    end else if (point == 4'd9) begin
+        dac_x_reg <= dac_now;
+    end
+    if (rst || (point == 4'd9 && mode_reg)) begin
+        dac_y_reg <= {DAC_W{1'b0}};
+    end else if (point == 4'd9) begin
+        dac_y_reg <= dac_now;
+    end
+end
+
+// The DAC codes' delay line shifts at the DAC point and clears in a sample that switches mode;
+// the lock count counts on the clock after the lock check and clears when the check fails or
+// the mode switches (clears: synchronous resets).
+always @(posedge clk) begin
+    if (rst || (ce && switching && point != 4'd9)) begin
+        for (d = 0; d < DELAY_N; d = d + 1) begin
+            delay_reg[d] <= {DAC_W{1'b0}};
+        end
+    end else if (point == 4'd9) begin
+        delay_reg[0] <= drive;
+        for (d = 1; d < DELAY_N; d = d + 1) begin
+            delay_reg[d] <= delay_reg[d-1];
+        end
+    end
+    if (rst || (count_pending_reg && !inside_reg) || (ce && switching && !count_pending_reg)) begin
+        lock_count_reg <= {COUNT_W{1'b0}};
+    end else if (count_pending_reg) begin
+        lock_count_reg <= lock_count_reg >= lock_hold ? lock_hold : lock_count_reg + 1'b1;
+    end
+end
+
+// The read register of the clock before, 0 when its read was gated (a synchronous clear).
+always @(posedge clk) begin
+    if (read_zero_reg) begin
+        previous_rd_reg <= {RAM_W{1'b0}};
+    end else begin
+        previous_rd_reg <= rd;
+    end
+end
 
 always @(posedge clk) begin
     if (write_en) begin
@@ -899,6 +959,7 @@ wire [COUNT_W-1:0] lock_count_next = inside_reg
     ? (lock_count_reg >= lock_hold ? lock_hold : lock_count_reg + 1'b1) : {COUNT_W{1'b0}};
 
 integer i;
+integer d;
 initial begin
     for (i = 0; i < DELAY_N; i = i + 1) begin
         delay_reg[i] = {DAC_W{1'b0}};
@@ -907,7 +968,6 @@ end
 
 always @(posedge clk) begin
     out_valid_reg <= 1'b0;
-    previous_rd_reg <= rd & {RAM_W{!read_zero_reg}};
 
     if (ce) begin
         busy_reg <= 1'b1;
@@ -916,16 +976,15 @@ always @(posedge clk) begin
         start_reg <= 1'b0;
         switching_reg <= switching;
         first_reg <= start_reg;
+        // The first sample of a mode runs at its nominal word (the PLL's output point loads
+        // the next one's, after the NCO's advance).
+        if (switching) begin
+            freq_reg <= mode ? FREQ_WORD_N : FREQ_WORD_R;
+        end
         adc_x_reg <= adc_x;
         adc_y_reg <= adc_y;
         decimate_reg <= count_reg == last_count[CNT_W-1:0];
         count_reg <= count_reg == last_count[CNT_W-1:0] ? {CNT_W{1'b0}} : count_reg + 1'b1;
-        if (switching) begin
-            lock_count_reg <= {COUNT_W{1'b0}};
-            for (i = 0; i < DELAY_N; i = i + 1) begin
-                delay_reg[i] <= {DAC_W{1'b0}};
-            end
-        end
     end else if (busy_reg) begin
         if (last_word) begin
             busy_reg <= 1'b0;
@@ -944,7 +1003,7 @@ always @(posedge clk) begin
         end
     end
     if (executing_reg && advance_field) begin
-        nco_acc_reg <= nco_acc_reg + freq_sample;
+        nco_acc_reg <= nco_acc_reg + freq_reg;
     end
     if (read_en) begin
         read_zero_reg <= read_zero;
@@ -959,17 +1018,11 @@ always @(posedge clk) begin
         4'd2: y_reg <= y_next;
         4'd3: drive_q_reg <= output_reg;
         4'd4: amplitude_error_reg <= error_next;
-        4'd5: v_reg <= {{(V_W-PLL_INT_W+1){pll_v_next[PLL_INT_W-1]}}, pll_v_next[PLL_INT_W-2:0]};
+        4'd5: v_reg <= v_next;
         4'd6: freq_reg <= pll_out[NCO_PHASE_W-1:0];
-        4'd7: v_reg <= {{(V_W-AGC_INT_W+1){agc_v_next[AGC_INT_W-1]}}, agc_v_next[AGC_INT_W-2:0]};
+        4'd7: v_reg <= v_next;
         4'd8: amplitude_reg <= agc_out;
         4'd9: begin
-            dac_x_reg <= mode_reg ? dac_now : {DAC_W{1'b0}};
-            dac_y_reg <= mode_reg ? {DAC_W{1'b0}} : dac_now;
-            delay_reg[0] <= drive;
-            for (i = 1; i < DELAY_N; i = i + 1) begin
-                delay_reg[i] <= delay_reg[i-1];
-            end
         end
         4'd10: c_reg <= c_next;
         4'd11: cic_output_reg <= cic_output_next;
@@ -985,7 +1038,6 @@ always @(posedge clk) begin
     endcase
     count_pending_reg <= point == 4'd15;
     if (count_pending_reg) begin
-        lock_count_reg <= lock_count_next;
         locked_reg <= lock_count_next >= lock_hold;
     end
 
@@ -1017,18 +1069,12 @@ always @(posedge clk) begin
         amplitude_reg <= {AGC_OUT_W{1'b0}};
         c_reg <= {CIC_MID_W{1'b0}};
         cic_output_reg <= {CIC_OUT_W{1'b0}};
-        for (i = 0; i < DELAY_N; i = i + 1) begin
-            delay_reg[i] <= {DAC_W{1'b0}};
-        end
-        dac_x_reg <= {DAC_W{1'b0}};
-        dac_y_reg <= {DAC_W{1'b0}};
         rate_reg <= {OUT_W{1'b0}};
         quad_reg <= {OUT_W{1'b0}};
         out_valid_reg <= 1'b0;
         inside_q_reg <= 1'b0;
         inside_reg <= 1'b0;
         count_pending_reg <= 1'b0;
-        lock_count_reg <= {COUNT_W{1'b0}};
         locked_reg <= 1'b0;
     end
 end

@@ -501,7 +501,6 @@ architecture rtl of gyrofx_gyro_loop_serial is
     signal t_sin : unsigned(T_W - 1 downto 0);
     signal t : unsigned(T_W - 1 downto 0);
     signal rom_address : unsigned(NCO_ADDR_W - 1 downto 0);
-    signal freq_sample : unsigned(NCO_PHASE_W - 1 downto 0);
     signal reference : signed(NCO_SIN_W - 1 downto 0);
 
     -- ---- RAM of states ----
@@ -718,11 +717,6 @@ begin
     t <= t_sin + to_unsigned(2 ** NCO_ADDR_W, T_W) when cosine = '1' else t_sin;
     rom_address <= not t(NCO_ADDR_W - 1 downto 0) when t(NCO_ADDR_W) = '1'
                    else t(NCO_ADDR_W - 1 downto 0);
-    -- The first sample of a mode runs at its nominal word, the others at the PLL's last output.
-    freq_sample <= FREQ_WORD_N_C when switching_reg = '1' and mode_reg = '1' else
-                   FREQ_WORD_R_C when switching_reg = '1' else
-                   freq_reg;
-
     sine_rom : process (clk)
     begin
         if rising_edge(clk) then
@@ -1122,6 +1116,13 @@ begin
                 if switching = '1' then
                     lock_count_reg <= (others => '0');
                     delay_reg <= (others => (others => '0'));
+                    -- The first sample of a mode runs at its nominal word (the PLL's output
+                    -- point loads the next one's, after the NCO's advance).
+                    if mode = '1' then
+                        freq_reg <= FREQ_WORD_N_C;
+                    else
+                        freq_reg <= FREQ_WORD_R_C;
+                    end if;
                 end if;
             elsif busy_reg = '1' then
                 if last_word = '1' then
@@ -1144,7 +1145,7 @@ begin
                 end if;
             end if;
             if executing_reg = '1' and advance_field = '1' then
-                nco_acc_reg <= nco_acc_reg + freq_sample;
+                nco_acc_reg <= nco_acc_reg + freq_reg;
             end if;
             if read_en = '1' then
                 read_zero_reg <= read_zero;

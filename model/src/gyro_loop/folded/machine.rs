@@ -326,8 +326,8 @@ impl FoldedGyroLoop {
         }
     }
 
-    /// The `ce` clock: the sample's inputs, the mode switch's register clears, the
-    /// decimation count.
+    /// The `ce` clock: the sample's inputs, the mode switch's register clears and nominal
+    /// frequency word, the decimation count.
     fn capture(&mut self, adc: [i64; 2], mode: Mode) {
         self.switching = mode != self.mode || self.start;
         self.first = self.start;
@@ -337,6 +337,9 @@ impl FoldedGyroLoop {
         if self.switching {
             self.delay.iter_mut().for_each(|d| *d = 0);
             self.lock_count = 0;
+            // The first sample of a mode runs at its nominal word; the PLL's output point
+            // loads the next sample's after the NCO's advance.
+            self.freq = self.constants().frequency_word;
         }
         self.decimate = self.count == self.decimation - 1;
         self.count = if self.decimate { 0 } else { self.count + 1 };
@@ -357,12 +360,7 @@ impl FoldedGyroLoop {
 
         let reference = self.rom_read(control.rom, &m);
         if control.advance {
-            let freq = if self.switching {
-                m.frequency_word
-            } else {
-                self.freq
-            };
-            self.nco_acc = self.nco_acc.wrapping_add(freq) & self.nco.mask;
+            self.nco_acc = self.nco_acc.wrapping_add(self.freq) & self.nco.mask;
         }
         let operands = control
             .issue
