@@ -265,7 +265,19 @@ localparam integer ACC_W = max2(max2(max2(X_W, U_W), max2(EA_W, DRIVE_W)),
     max2(max2(max2(PLL_UPD_W, PLL_SUM_W), max2(AGC_UPD_W, AGC_SUM_W)),
     max2(max2(max2(REG_W, FIR_W), max2(RATE_W, Z_W)), 16 + 15 * limbs(max2(max2(max2(NCO_SIN_W,
     COEF_W), max2(CIC_COEF_W, PLL_KP_W)), max2(PLL_KI_W, max2(AGC_KP_W, AGC_KI_W)))) + 2))) + 1;
-localparam integer RAM_W = max2(max2(max2(DEMOD_STATE_W, PLL_INT_W), max2(AGC_INT_W, Z_W)),
+// The PI integrators as v_reg and the RAM hold them: one of them shifted left so that both
+// PIs' output sums take v_reg at one alignment (one x source, not two).
+localparam integer PLL_SUM_SHIFT = PLL_SUM_F - PLL_INT_F;
+localparam integer AGC_SUM_SHIFT = AGC_SUM_F - AGC_INT_F;
+localparam integer PLL_V_SHIFT = PLL_SUM_SHIFT > AGC_SUM_SHIFT ? PLL_SUM_SHIFT - AGC_SUM_SHIFT : 0;
+localparam integer AGC_V_SHIFT = AGC_SUM_SHIFT > PLL_SUM_SHIFT ? AGC_SUM_SHIFT - PLL_SUM_SHIFT : 0;
+localparam integer V_SUM_SHIFT = PLL_SUM_SHIFT - PLL_V_SHIFT;
+localparam integer V_W = max2(PLL_INT_W + PLL_V_SHIFT, AGC_INT_W + AGC_V_SHIFT);
+// The integrators' words read into their updates' fraction bits (a negative shift is right:
+// the word's low bits are the shift's zeros).
+localparam integer PLL_READ_SHIFT = PLL_UPD_F - PLL_INT_F - PLL_V_SHIFT;
+localparam integer AGC_READ_SHIFT = AGC_UPD_F - AGC_INT_F - AGC_V_SHIFT;
+localparam integer RAM_W = max2(max2(max2(DEMOD_STATE_W, V_W), max2(AGC_INT_W, Z_W)),
     max2(REG_W, CIC_MID_W)) + 1;
 // a operands: ADC codes, the demodulator output (PLL error), the AGC error and output, the
 // CIC output (and its delay line), the compensator output
@@ -294,7 +306,6 @@ localparam integer COUNT_W = LOCK_HOLD > 0 ? ceil_log2(LOCK_HOLD + 1) : 1;
 localparam integer PC_W = SCHEDULE_LEN > 1 ? ceil_log2(SCHEDULE_LEN) : 1;
 localparam integer RAM_ADDR_W = RAM_WORDS > 1 ? ceil_log2(RAM_WORDS) : 1;
 localparam integer TAP_ADDR_W = CIC_TAPS > 1 ? ceil_log2(CIC_TAPS) : 1;
-localparam integer V_W = max2(PLL_INT_W, AGC_INT_W);
 
 initial begin
     if (CIC_DELAY != 1) begin
@@ -474,7 +485,8 @@ wire preset_next = read_en ? read_preset : read_preset_reg;
 wire [3:0] x_field = fetched_reg[22:19];
 wire [3:0] y_field = fetched_reg[26:23];
 // (x code 1 and y code 0 select nothing, 0: their bits stay 0; x code 4 and the preset select
-// through setpoint_select_reg and preset_select_reg.)
+// through setpoint_select_reg and preset_select_reg; x codes 6 and 8, either PI's sum, the
+// integrator register at the one alignment both take.)
 /* verilator lint_off UNUSEDSIGNAL */
 reg [8:0] x_select_reg = 9'd0;
 reg [9:0] y_select_reg = 10'd0;
@@ -491,7 +503,7 @@ wire [3:0] a_field_next = fetched_reg[7:4];
 reg [7:0] a_select_reg = 8'd0;
 wire x_preset = x_field == 4'd5 && preset_next;
 always @(posedge clk) begin
-    x_select_reg <= {x_field == 4'd8, x_field == 4'd7 && !zero_next, x_field == 4'd6,
+    x_select_reg <= {1'b0, x_field == 4'd7 && !zero_next, x_field == 4'd6 || x_field == 4'd8,
         x_field == 4'd5 && !zero_next && !preset_next, 1'b0, x_field == 4'd3 && !zero_next,
         x_field == 4'd2 && !zero_next, 1'b0, x_field == 4'd0};
     setpoint_select_reg <= {x_field == 4'd4 && !mode_reg, x_field == 4'd4 && mode_reg,
@@ -651,6 +663,18 @@ reg signed [V_W-1:0] v_reg = {V_W{1'b0}};
 wire signed [DEMOD_OUT_W-1:0] demod_output;
 
 wire signed [ACC_W-1:0] rd_acc = {{(ACC_W-RAM_W){rd[RAM_W-1]}}, rd};
+// value << amount, or >> -amount (exact where used: the low bits shifted out are zeros).
+function signed [ACC_W-1:0] shifted;
+    input signed [ACC_W-1:0] value;
+    input integer amount;
+    begin
+        if (amount >= 0) begin
+            shifted = value <<< amount;
+        end else begin
+            shifted = value >>> (-amount);
+        end
+    end
+endfunction
 // The two modes' constants, and the bits set in both, in the normal's only, in the reverse's.
 function signed [ACC_W-1:0] preset_aligned;
     input signed [PLL_INT_W-1:0] preset;
@@ -693,11 +717,10 @@ wire signed [ACC_W-1:0] x_value =
     | ({ACC_W{x_select_reg[2]}} & rd_acc)
     | ({ACC_W{x_select_reg[3]}} & (rd_acc <<< DEMOD_SHIFT))
     | of_modes(setpoint_select_reg, SETPOINT_N_ACC, SETPOINT_R_ACC)
-    | ({ACC_W{x_select_reg[5]}} & (rd_acc <<< (PLL_UPD_F - PLL_INT_F)))
+    | ({ACC_W{x_select_reg[5]}} & shifted(rd_acc, PLL_READ_SHIFT))
     | of_modes(preset_select_reg, PRESET_N_ACC, PRESET_R_ACC)
-    | ({ACC_W{x_select_reg[6]}} & (v_acc <<< (PLL_SUM_F - PLL_INT_F)))
-    | ({ACC_W{x_select_reg[7]}} & (rd_acc <<< (AGC_UPD_F - AGC_INT_F)))
-    | ({ACC_W{x_select_reg[8]}} & (v_acc <<< (AGC_SUM_F - AGC_INT_F)));
+    | ({ACC_W{x_select_reg[6]}} & (v_acc <<< V_SUM_SHIFT))
+    | ({ACC_W{x_select_reg[7]}} & shifted(rd_acc, AGC_READ_SHIFT));
 
 // y, a negated one inverted (x + ~y + 1: the carry in adds the 1).
 wire signed [ACC_W-1:0] y_value =
@@ -830,12 +853,14 @@ wire agc_above = agc_floor > AGC_HIGH || (agc_floor == AGC_HIGH && agc_increment
 // rounded update and limits chosen first (the point is known early), the comparisons last.
 wire pll_point = quantize_field == 4'd5;
 wire [V_W-1:0] v_rounded = pll_point
-    ? {{(V_W-PLL_INT_W){pll_rounded[PLL_INT_W-1]}}, pll_rounded[PLL_INT_W-1:0]}
-    : {{(V_W-AGC_INT_W){agc_rounded[AGC_INT_W-1]}}, agc_rounded[AGC_INT_W-1:0]};
-wire [V_W-1:0] v_low = pll_point ? {{(V_W-PLL_INT_W){PLL_INT_MIN[PLL_INT_W-1]}}, PLL_INT_MIN}
-                                 : {{(V_W-AGC_INT_W){AGC_INT_MIN[AGC_INT_W-1]}}, AGC_INT_MIN};
-wire [V_W-1:0] v_high = pll_point ? {{(V_W-PLL_INT_W){PLL_INT_MAX[PLL_INT_W-1]}}, PLL_INT_MAX}
-                                  : {{(V_W-AGC_INT_W){AGC_INT_MAX[AGC_INT_W-1]}}, AGC_INT_MAX};
+    ? {{(V_W-PLL_INT_W){pll_rounded[PLL_INT_W-1]}}, pll_rounded[PLL_INT_W-1:0]} << PLL_V_SHIFT
+    : {{(V_W-AGC_INT_W){agc_rounded[AGC_INT_W-1]}}, agc_rounded[AGC_INT_W-1:0]} << AGC_V_SHIFT;
+wire [V_W-1:0] v_low = pll_point
+    ? {{(V_W-PLL_INT_W){PLL_INT_MIN[PLL_INT_W-1]}}, PLL_INT_MIN} << PLL_V_SHIFT
+    : {{(V_W-AGC_INT_W){AGC_INT_MIN[AGC_INT_W-1]}}, AGC_INT_MIN} << AGC_V_SHIFT;
+wire [V_W-1:0] v_high = pll_point
+    ? {{(V_W-PLL_INT_W){PLL_INT_MAX[PLL_INT_W-1]}}, PLL_INT_MAX} << PLL_V_SHIFT
+    : {{(V_W-AGC_INT_W){AGC_INT_MAX[AGC_INT_W-1]}}, AGC_INT_MAX} << AGC_V_SHIFT;
 wire v_below = pll_point ? pll_below : agc_below;
 wire v_above = pll_point ? pll_above : agc_above;
 wire [V_W-1:0] v_next = v_below ? v_low : (v_above ? v_high : v_rounded);
@@ -918,6 +943,24 @@ always @(posedge clk) begin
     end
 end
 
+// The NCO's frequency word: the PLL's output, or in the first sample of a mode (from ce) its
+// nominal word; bit by bit, so that a bit both modes' words share is a synchronous set or
+// reset, not a multiplexer.
+genvar f;
+generate
+    for (f = 0; f < NCO_PHASE_W; f = f + 1) begin : g_freq
+        always @(posedge clk) begin
+            if (rst) begin
+                freq_reg[f] <= 1'b0;
+            end else if (point == 4'd6) begin
+                freq_reg[f] <= pll_out[f];
+            end else if (ce && switching) begin
+                freq_reg[f] <= mode ? FREQ_WORD_N[f] : FREQ_WORD_R[f];
+            end
+        end
+    end
+endgenerate
+
 // The read register of the clock before, 0 when its read was gated (a synchronous clear).
 always @(posedge clk) begin
     if (read_zero_reg) begin
@@ -976,11 +1019,6 @@ always @(posedge clk) begin
         start_reg <= 1'b0;
         switching_reg <= switching;
         first_reg <= start_reg;
-        // The first sample of a mode runs at its nominal word (the PLL's output point loads
-        // the next one's, after the NCO's advance).
-        if (switching) begin
-            freq_reg <= mode ? FREQ_WORD_N : FREQ_WORD_R;
-        end
         adc_x_reg <= adc_x;
         adc_y_reg <= adc_y;
         decimate_reg <= count_reg == last_count[CNT_W-1:0];
@@ -1019,7 +1057,6 @@ always @(posedge clk) begin
         4'd3: drive_q_reg <= output_reg;
         4'd4: amplitude_error_reg <= error_next;
         4'd5: v_reg <= v_next;
-        4'd6: freq_reg <= pll_out[NCO_PHASE_W-1:0];
         4'd7: v_reg <= v_next;
         4'd8: amplitude_reg <= agc_out;
         4'd9: begin
@@ -1054,7 +1091,6 @@ always @(posedge clk) begin
         adc_x_reg <= {DEMOD_ADC_W{1'b0}};
         adc_y_reg <= {DEMOD_ADC_W{1'b0}};
         nco_acc_reg <= {NCO_PHASE_W{1'b0}};
-        freq_reg <= {NCO_PHASE_W{1'b0}};
         residue_reg[0] <= {R_W{1'b0}};
         residue_reg[1] <= {R_W{1'b0}};
         residue_reg[2] <= {R_W{1'b0}};

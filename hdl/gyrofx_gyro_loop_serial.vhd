@@ -209,6 +209,16 @@ architecture rtl of gyrofx_gyro_loop_serial is
         end loop;
         return result;
     end function;
+    -- value shifted left by amount, or right by -amount (exact where used: the low bits
+    -- shifted out are zeros).
+    function shifted(value : signed; amount : integer) return signed is
+    begin
+        if amount >= 0 then
+            return shift_left(value, amount);
+        else
+            return shift_right(value, -amount);
+        end if;
+    end function;
 
     -- ceil(log2(value)), 0 for value 1.
     function ceil_log2(value : positive) return natural is
@@ -296,8 +306,20 @@ architecture rtl of gyrofx_gyro_loop_serial is
     -- (Each one bit wider than its widest value, so that every value sign-extends into it.)
     constant ACC_W : positive := largest((X_W, U_W, EA_W, DRIVE_W, PLL_UPD_W, PLL_SUM_W,
         AGC_UPD_W, AGC_SUM_W, REG_W, FIR_W, RATE_W, Z_W, PP_W)) + 1;
+    -- The PI integrators as v_reg and the RAM hold them: one of them shifted left so that both
+    -- PIs' output sums take v_reg at one alignment (one x source, not two), and their words
+    -- read into their updates' fraction bits (a negative shift is right: the word's low bits
+    -- are the shift's zeros).
+    constant PLL_V_SHIFT : natural :=
+        maximum((PLL_SUM_F - PLL_INT_F) - (AGC_SUM_F - AGC_INT_F), 0);
+    constant AGC_V_SHIFT : natural :=
+        maximum((AGC_SUM_F - AGC_INT_F) - (PLL_SUM_F - PLL_INT_F), 0);
+    constant V_SUM_SHIFT : natural := PLL_SUM_F - PLL_INT_F - PLL_V_SHIFT;
+    constant PLL_READ_SHIFT : integer := PLL_UPD_F - PLL_INT_F - PLL_V_SHIFT;
+    constant AGC_READ_SHIFT : integer := AGC_UPD_F - AGC_INT_F - AGC_V_SHIFT;
+    constant V_W : positive := maximum(PLL_INT_W + PLL_V_SHIFT, AGC_INT_W + AGC_V_SHIFT);
     constant RAM_W : positive :=
-        largest((DEMOD_STATE_W, PLL_INT_W, AGC_INT_W, Z_W, REG_W, CIC_MID_W)) + 1;
+        largest((DEMOD_STATE_W, V_W, AGC_INT_W, Z_W, REG_W, CIC_MID_W)) + 1;
     -- a operands: ADC codes, the demodulator output (PLL error), the AGC error and output, the
     -- CIC output (and its delay line), the compensator output
     constant A_W : positive :=
@@ -309,11 +331,9 @@ architecture rtl of gyrofx_gyro_loop_serial is
     constant PLL_KP_ALIGN : natural := PLL_SUM_F - PLL_KPE_F;
     constant AGC_KI_ALIGN : natural := AGC_UPD_F - AGC_KIE_F;
     constant AGC_KP_ALIGN : natural := AGC_SUM_F - AGC_KPE_F;
-    -- the PI integrators aligned to their update and output sums
+    -- the PI integrators' drops from their updates' fraction bits (the PLL's preset aligned)
     constant PLL_UPD_SHIFT : natural := PLL_UPD_F - PLL_INT_F;
-    constant PLL_SUM_SHIFT : natural := PLL_SUM_F - PLL_INT_F;
     constant AGC_UPD_SHIFT : natural := AGC_UPD_F - AGC_INT_F;
-    constant AGC_SUM_SHIFT : natural := AGC_SUM_F - AGC_INT_F;
     constant T_W : positive := NCO_ADDR_W + 2;
     constant R_W : positive := maximum(NCO_PHASE_W - T_W, 1);
     constant DELAY_N : positive := maximum(LATENCY, 1);
@@ -323,7 +343,6 @@ architecture rtl of gyrofx_gyro_loop_serial is
     constant PC_W : positive := maximum(ceil_log2(SCHEDULE_LEN), 1);
     constant RAM_ADDR_W : positive := maximum(ceil_log2(RAM_WORDS), 1);
     constant TAP_ADDR_W : positive := maximum(ceil_log2(CIC_TAPS), 1);
-    constant V_W : positive := maximum(PLL_INT_W, AGC_INT_W);
 
     constant PLL_KP_C : signed(PLL_KP_W - 1 downto 0) :=
         signed(code_of("PLL_KP", PLL_KP, PLL_KP_W));
@@ -873,11 +892,10 @@ begin
                 if operand_preset_reg = '1' then
                     x_value <= shift_left(resize(preset_clamped, ACC_W), PLL_UPD_SHIFT);
                 else
-                    x_value <= shift_left(resize(operand_rd, ACC_W), PLL_UPD_SHIFT);
+                    x_value <= shifted(resize(operand_rd, ACC_W), PLL_READ_SHIFT);
                 end if;
-            when 6 => x_value <= shift_left(resize(v_reg, ACC_W), PLL_SUM_SHIFT);
-            when 7 => x_value <= shift_left(resize(operand_rd, ACC_W), AGC_UPD_SHIFT);
-            when 8 => x_value <= shift_left(resize(v_reg, ACC_W), AGC_SUM_SHIFT);
+            when 6 | 8 => x_value <= shift_left(resize(v_reg, ACC_W), V_SUM_SHIFT);
+            when 7 => x_value <= shifted(resize(operand_rd, ACC_W), AGC_READ_SHIFT);
             when others => x_value <= acc_reg;
         end case;
     end process;
@@ -1160,9 +1178,9 @@ begin
                 when 2 => y_reg <= y_next;
                 when 3 => drive_q_reg <= output_reg;
                 when 4 => amplitude_error_reg <= error_next;
-                when 5 => v_reg <= resize(pll_v_next, V_W);
+                when 5 => v_reg <= shift_left(resize(pll_v_next, V_W), PLL_V_SHIFT);
                 when 6 => freq_reg <= unsigned(pll_out(NCO_PHASE_W - 1 downto 0));
-                when 7 => v_reg <= resize(agc_v_next, V_W);
+                when 7 => v_reg <= shift_left(resize(agc_v_next, V_W), AGC_V_SHIFT);
                 when 8 => amplitude_reg <= agc_out;
                 when 9 =>
                     if mode_reg = '1' then

@@ -211,7 +211,8 @@ field_enum!(
         AccLock = 1,
         /// The demodulator state register `y`.
         DemodState = 2,
-        /// The PI integrator register `v` (the PLL's or the AGC's).
+        /// The PI integrator register `v` (the PLL's or the AGC's, one of them held shifted
+        /// left so that both output sums take `v` at one alignment: the RAM holds it so too).
         Integrator = 3,
         /// The RAM read register (the delay lines' shift).
         Read = 4,

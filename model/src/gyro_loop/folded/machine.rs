@@ -60,9 +60,12 @@ struct Shifts {
     lowpass: u32,
     product_to_state: u32,
     pll_v_to_update: u32,
-    pll_v_to_sum: u32,
     agc_v_to_update: u32,
-    agc_v_to_sum: u32,
+    /// How the integrator register `v` and the RAM hold each PI's integrator (PLL, AGC): shifted
+    /// left by these, so that both output sums take `v` at one alignment, `v_to_sum` (one
+    /// operand of the accumulator, not two).
+    v_held: [u32; 2],
+    v_to_sum: u32,
     /// The PI products' alignments, by [`BSource::alignment`].
     align: [u32; 5],
     lock: u32,
@@ -130,6 +133,7 @@ pub struct FoldedGyroLoop {
     output: i128,
     drive_q: i128,
     amplitude_error: i128,
+    /// The integrator register: a PI's integrator, held as `Shifts::v_held` says.
     v: i128,
     amplitude: i128,
     c: i128,
@@ -172,6 +176,8 @@ impl FoldedGyroLoop {
         let width = nco.phase.width;
         let below = width - nco.address_bits - 2;
         let words = schedule.words.count();
+        let pll_v_to_sum = shift_of(pll.output.from.frac, pll.integrator.frac);
+        let agc_v_to_sum = shift_of(agc.output.from.frac, agc.integrator.frac);
         FoldedGyroLoop {
             datapath: Datapath::new(plan),
             modes: [mode(&plan.modes[0]), mode(&plan.modes[1])],
@@ -206,9 +212,12 @@ impl FoldedGyroLoop {
                 lowpass: demod.lowpass_shift,
                 product_to_state: shift_of(demod.state.to.frac, demod.product.to.frac),
                 pll_v_to_update: shift_of(pll.integrator_point.from.frac, pll.integrator.frac),
-                pll_v_to_sum: shift_of(pll.output.from.frac, pll.integrator.frac),
                 agc_v_to_update: shift_of(agc.integrator_point.from.frac, agc.integrator.frac),
-                agc_v_to_sum: shift_of(agc.output.from.frac, agc.integrator.frac),
+                v_held: [
+                    pll_v_to_sum.saturating_sub(agc_v_to_sum),
+                    agc_v_to_sum.saturating_sub(pll_v_to_sum),
+                ],
+                v_to_sum: pll_v_to_sum.min(agc_v_to_sum),
                 align: [
                     0,
                     shift_of(
@@ -375,13 +384,16 @@ impl FoldedGyroLoop {
                 AccX::Read => rd,
                 AccX::ReadLowpass => rd << self.shifts.lowpass,
                 AccX::Setpoint => m.setpoint,
-                AccX::PllIntegrator => {
-                    let integrator = if self.rd_preset { m.pll_preset } else { rd };
-                    integrator << self.shifts.pll_v_to_update
+                AccX::PllIntegrator if self.rd_preset => {
+                    m.pll_preset << self.shifts.pll_v_to_update
                 }
-                AccX::PllSum => self.v << self.shifts.pll_v_to_sum,
-                AccX::AgcIntegrator => rd << self.shifts.agc_v_to_update,
-                AccX::AgcSum => self.v << self.shifts.agc_v_to_sum,
+                AccX::PllIntegrator => {
+                    held_to(rd, self.shifts.v_held[0], self.shifts.pll_v_to_update)
+                }
+                AccX::AgcIntegrator => {
+                    held_to(rd, self.shifts.v_held[1], self.shifts.agc_v_to_update)
+                }
+                AccX::PllSum | AccX::AgcSum => self.v << self.shifts.v_to_sum,
             };
             let y = match op.y {
                 AccY::Zero => 0,
@@ -568,12 +580,12 @@ impl FoldedGyroLoop {
             Quantize::AmplitudeError => {
                 self.amplitude_error = self.points.agc_error.apply(sign_extend(acc, e.agc_error));
             }
-            Quantize::PllIntegrator => self.v = self.pll_integrator(acc),
+            Quantize::PllIntegrator => self.v = self.pll_integrator(acc) << self.shifts.v_held[0],
             Quantize::PllOutput => {
                 let u = self.points.pll_output.apply(sign_extend(acc, e.pll_sum));
                 self.freq = (u as u64) & self.nco.mask;
             }
-            Quantize::AgcIntegrator => self.v = self.agc_integrator(acc),
+            Quantize::AgcIntegrator => self.v = self.agc_integrator(acc) << self.shifts.v_held[1],
             Quantize::AgcOutput => {
                 self.amplitude = self.points.agc_output.apply(sign_extend(acc, e.agc_sum));
             }
@@ -613,5 +625,15 @@ impl FoldedGyroLoop {
                 self.locked = self.lock_count >= self.lock_hold;
             }
         }
+    }
+}
+
+/// An integrator's word, held shifted left by `held`, at the update's alignment `to` (a right
+/// shift when `held` is the larger: the word's low bits are the hold's zeros).
+fn held_to(word: i128, held: u32, to: u32) -> i128 {
+    if to >= held {
+        word << (to - held)
+    } else {
+        word >> (held - to)
     }
 }
