@@ -6,9 +6,10 @@
 //! same random streams as the system's (one seed per gyro), so the columns differ only by
 //! what reversal does.
 //!
-//! The three runs, and each gyro's drift-free white noise and loop floor, go side by side on
-//! the lab's pool: at about 10 M gyro-samples a second a core, 1000 s (8·10⁸ gyro-samples in
-//! all) takes about 40 s on two cores.
+//! The four runs (the system also drift-free, for at most 200 s), and each gyro's drift-free
+//! white noise and loop floor, go side by side on the lab's pool, longest first: 1000 s
+//! (9.6·10⁸ gyro-samples in all) takes 65 s of `reproduce --paper 004` on two cores. The
+//! system is one run, half the work: more cores than two shorten it little.
 
 use gyrofx_job::config::GyroLoop;
 use gyrofx_job::error::{Error, Result};
