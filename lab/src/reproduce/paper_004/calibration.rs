@@ -115,6 +115,16 @@ pub fn bias_sensitivities(params: &ResonatorParams) -> [f64; 3] {
     [phase, angle, split]
 }
 
+/// `front_end` with its three drifts off (its white sources kept).
+pub fn drift_free(front_end: &PhysicsSettings) -> PhysicsSettings {
+    PhysicsSettings {
+        phase_drift: GaussMarkov::OFF,
+        damping_angle_drift: GaussMarkov::OFF,
+        damping_split_drift: GaussMarkov::OFF,
+        ..*front_end
+    }
+}
+
 /// The white-noise level of a rate record at 50 Hz, °/√s: the Allan deviation times `√τ`,
 /// averaged over τ = 0.1–1 s.
 pub(super) fn white_level(rate_dps: &[f64], rate_hz: f64) -> f64 {
@@ -135,12 +145,7 @@ pub(super) fn white_level(rate_dps: &[f64], rate_hz: f64) -> f64 {
 /// # Errors
 /// Invalid physics.
 pub fn white_noise(gyro: &GyroLoop, front_end: &PhysicsSettings, seed: u64) -> Result<f64> {
-    let drift_free = PhysicsSettings {
-        phase_drift: GaussMarkov::OFF,
-        damping_angle_drift: GaussMarkov::OFF,
-        damping_split_drift: GaussMarkov::OFF,
-        ..*front_end
-    };
+    let drift_free = drift_free(front_end);
     let mut closed = FixedClosedLoop::new(&gyro.plan, &gyro.params, &drift_free, seed)
         .map_err(|e| Error::Simulation(format!("gyro {}: {e}", gyro.name)))?;
     let rate_hz = gyro.plan.chain_rate_hz();

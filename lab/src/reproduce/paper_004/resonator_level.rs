@@ -16,7 +16,7 @@ use gyrofx_job::error::{Error, Result};
 use gyrofx_job::gyros::RESONATOR_STARTUP_S;
 use gyrofx_model::chain::Plan as ChainPlan;
 use gyrofx_model::gyro_loop::closed::FixedClosedLoop;
-use gyrofx_model::resonator::{GaussMarkov, Mode, PhysicsSettings};
+use gyrofx_model::resonator::Mode;
 use gyrofx_model::system::{record, GyroPhysics};
 
 use super::calibration::{self, Calibration};
@@ -193,16 +193,10 @@ fn reversal(
     let rate_hz = loops[0].plan.chain_rate_hz();
     let decimation = (loops[0].plan.adc_rate_hz / rate_hz).round() as usize;
     let front_ends = [0, 1].map(|g| {
-        let front_end = loops[g].front_end;
         if drift_free {
-            PhysicsSettings {
-                phase_drift: GaussMarkov::OFF,
-                damping_angle_drift: GaussMarkov::OFF,
-                damping_split_drift: GaussMarkov::OFF,
-                ..front_end
-            }
+            calibration::drift_free(&loops[g].front_end)
         } else {
-            front_end
+            loops[g].front_end
         }
     });
     let physics = [0, 1].map(|g| GyroPhysics {
