@@ -36,8 +36,6 @@ const LOOP_BLOCK: &str = "gyro_loop";
 pub const LOOP_FOLDER: &str = "gyro_loop";
 /// Its block in the registry.
 const SYSTEM_BLOCK: &str = "system";
-/// The system block's module in the serial architecture.
-const SERIAL_SYSTEM: &str = "gyrofx_system_serial";
 /// The placed block whose place and route also builds the folded system's netlist.
 const SYSTEM_PLACED: &str = "system_serial";
 /// The folder of the folded system's design and netlist in the synthesis package.
@@ -440,6 +438,9 @@ pub struct Synthesis {
     /// `gyrofx_system_serial`, when the folded system was placed (its netlist is built then:
     /// its flows take minutes, which its place and route has already taken).
     pub system: Option<Resources>,
+    /// Its module, when it was synthesized.
+    #[serde(skip)]
+    pub system_module: Option<&'static str>,
     /// Each placed block on each target (none unless asked for).
     pub placements: Vec<place_route::Placement>,
 }
@@ -541,11 +542,11 @@ pub fn synthesize(
     let gyro_loop = blocks::find(LOOP_BLOCK).block(job, &roms);
     let chain_inputs = inputs(&top);
     let loop_inputs = inputs(&gyro_loop);
-    let system = Some(blocks::find(SYSTEM_BLOCK).block(job, &roms)).filter(|system| {
-        system.module == SERIAL_SYSTEM
-            && !place.targets.is_empty()
-            && place.blocks.contains(&SYSTEM_PLACED)
-    });
+    // The folded system (the job has its chain program in the serial architecture).
+    let system = (job.system_serial.is_some()
+        && !place.targets.is_empty()
+        && place.blocks.contains(&SYSTEM_PLACED))
+    .then(|| blocks::find(SYSTEM_BLOCK).block(job, &roms));
     let system_inputs = system.as_ref().map(inputs);
 
     let work = output_folder::WorkFolder::new()
@@ -602,6 +603,7 @@ pub fn synthesize(
             .as_ref()
             .map(|_| resources(&system_work))
             .transpose()?,
+        system_module: system.as_ref().map(|block| block.module),
         placements: placed.into_iter().flatten().collect(),
     };
 

@@ -94,10 +94,7 @@ pub fn run(args: Args) -> Result<ExitCode> {
     let synthesis = synthesize(&job, out, folder.replace(), &provenance, &place);
     spinner.finish_and_clear();
     let synthesis = synthesis?;
-    let system = synthesis
-        .system
-        .as_ref()
-        .map(|resources| ("gyrofx_system_serial", resources));
+    let system = synthesis.system_module.zip(synthesis.system.as_ref());
     let designs: Vec<(&str, &Resources)> = [
         (synthesis.chain_module, &synthesis.chain),
         (synthesis.loop_module, &synthesis.gyro_loop),
