@@ -395,7 +395,9 @@ wire write_field = control_reg[42];
 wire [6:0] write_address_field = control_reg[49:43];
 wire [2:0] data_field = control_reg[52:50];
 wire [3:0] quantize_field = control_reg[56:53];
-wire [6:0] spare_field = control_reg[63:57];
+// The folded pair's fields (which gyro each unit serves, the decimating-only write): 0 in a
+// one-gyro schedule.
+wire [6:0] pair_bits = control_reg[63:57];
 /* verilator lint_on UNUSEDSIGNAL */
 
 wire rom_en = executing_reg && rom_field != 3'd0;

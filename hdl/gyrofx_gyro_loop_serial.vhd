@@ -482,7 +482,8 @@ architecture rtl of gyrofx_gyro_loop_serial is
     signal fetch_address : unsigned(PC_W - 1 downto 0);
 
     -- The control word's fields (gyrofx_model::gyro_loop::folded::Control): a fixed layout,
-    -- whose widest fields a small loop does not use in full (bits 63 to 57 are spare).
+    -- whose widest fields a small loop does not use in full (bits 63 to 57 are the folded
+    -- pair's, which gyro each unit serves and the decimating-only write: 0 for one gyro).
     signal rom_field : unsigned(2 downto 0);
     signal advance_field : std_logic;
     signal a_field : unsigned(3 downto 0);

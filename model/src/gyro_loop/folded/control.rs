@@ -23,7 +23,17 @@
 //! | 43–49 | `write_address` | its word |
 //! | 50–52 | `data` | [`WriteData`]: what is written |
 //! | 53–56 | `quantize` | [`Quantize`]: the quantization point that fires |
-//! | 57–63 | `spare` | 0 |
+//! | 57 | `rom_gyro` | whose NCO the sine ROM read uses (0 gyro A, 1 gyro B: [`Control::rom_gyro`]) |
+//! | 58 | `advance_gyro` | whose NCO advances |
+//! | 59 | `issue_gyro` | whose operands the multiplier takes |
+//! | 60 | `accumulate_gyro` | whose registers and constants the accumulator's `x`, `y` read |
+//! | 61 | `read_gyro` | whose mode switch the read's gate follows |
+//! | 62 | `quantize_gyro` | whose register the quantization point loads |
+//! | 63 | `decimating_write` | the RAM write acts only in a decimating sample |
+//!
+//! The gyro fields are 0 in a one-gyro schedule; in the folded pair (both gyros on one
+//! datapath, [`super::Schedule::pair`]) each unit's field names the gyro whose template
+//! placed the unit's work in that clock.
 //!
 //! A product's weight (its limb's `2^(15·limb)` and a PI's alignment, which follows from
 //! its `b`, [`BSource::alignment`]) travels with it down the multiplier's pipeline, so the
@@ -218,6 +228,8 @@ field_enum!(
         Read = 4,
         /// The CIC output register `c`.
         Cic = 5,
+        /// The accumulator, a compensator's partial sum (wrapped to the sum's exact width).
+        AccFir = 6,
     }
 );
 
@@ -269,6 +281,8 @@ pub struct Read {
     pub gate: ReadGate,
     /// For [`ReadGate::Seen`]: decimations since reset below which it returns 0.
     pub seen: u8,
+    /// Whose mode switch the gate follows (0 gyro A, 1 gyro B).
+    pub gyro: u8,
 }
 
 /// A RAM write.
@@ -278,6 +292,8 @@ pub struct Write {
     pub address: u8,
     /// What is written.
     pub data: WriteData,
+    /// Only in a decimating sample (the pair's snapshot of a CIC's last integrator).
+    pub decimating: bool,
 }
 
 /// Clocks from a product's issue to the clock whose accumulation adds it: the operand
@@ -299,6 +315,8 @@ pub struct Issue {
     pub b: BSource,
     /// The tap, for [`BSource::Tap`].
     pub tap: u8,
+    /// Whose operands (0 gyro A, 1 gyro B).
+    pub gyro: u8,
 }
 
 impl BSource {
@@ -323,6 +341,8 @@ pub struct Accumulate {
     pub x: AccX,
     /// Addend.
     pub y: AccY,
+    /// Whose registers and constants `x` and `y` read (0 gyro A, 1 gyro B).
+    pub gyro: u8,
 }
 
 /// One clock of the schedule. `None` fields leave their unit idle.
@@ -342,6 +362,12 @@ pub struct Control {
     pub write: Option<Write>,
     /// Quantization point.
     pub quantize: Quantize,
+    /// Whose NCO the ROM read uses (0 gyro A, 1 gyro B).
+    pub rom_gyro: u8,
+    /// Whose NCO advances.
+    pub advance_gyro: u8,
+    /// Whose register the quantization point loads.
+    pub quantize_gyro: u8,
 }
 
 /// Two controls asked for the same unit in one clock (a schedule conflict).
@@ -350,7 +376,7 @@ pub struct Busy(pub &'static str);
 
 /// The control word's fields, least significant first: name and width in bits (the
 /// [module doc](self)'s table; 64 bits in all).
-pub const FIELDS: [(&str, u32); 18] = [
+pub const FIELDS: [(&str, u32); 24] = [
     ("rom", 3),
     ("advance", 1),
     ("a", 4),
@@ -368,26 +394,44 @@ pub const FIELDS: [(&str, u32); 18] = [
     ("write_address", ADDRESS_BITS),
     ("data", 3),
     ("quantize", 4),
-    ("spare", 7),
+    ("rom_gyro", 1),
+    ("advance_gyro", 1),
+    ("issue_gyro", 1),
+    ("accumulate_gyro", 1),
+    ("read_gyro", 1),
+    ("quantize_gyro", 1),
+    ("decimating_write", 1),
 ];
 
 impl Control {
     /// Each field's value, in [`FIELDS`] order.
-    pub fn fields(&self) -> [u64; 18] {
+    pub fn fields(&self) -> [u64; 24] {
         let issue = self.issue.unwrap_or(Issue {
             a: ASource::None,
             limb: 0,
             top: false,
             b: BSource::Reference,
             tap: 0,
+            gyro: 0,
         });
         let acc = self.accumulate.unwrap_or_default();
-        let read = self.read.map_or((0, 0, 0, 0), |r| {
-            (1, u64::from(r.address), r.gate.code(), u64::from(r.seen))
+        let read = self.read.map_or((0, 0, 0, 0, 0), |r| {
+            (
+                1,
+                u64::from(r.address),
+                r.gate.code(),
+                u64::from(r.seen),
+                u64::from(r.gyro),
+            )
         });
-        let write = self
-            .write
-            .map_or((0, 0, 0), |w| (1, u64::from(w.address), w.data.code()));
+        let write = self.write.map_or((0, 0, 0, 0), |w| {
+            (
+                1,
+                u64::from(w.address),
+                w.data.code(),
+                u64::from(w.decimating),
+            )
+        });
         [
             self.rom.code(),
             u64::from(self.advance),
@@ -406,7 +450,13 @@ impl Control {
             write.1,
             write.2,
             self.quantize.code(),
-            0,
+            u64::from(self.rom_gyro),
+            u64::from(self.advance_gyro),
+            u64::from(issue.gyro),
+            u64::from(acc.gyro),
+            read.4,
+            u64::from(self.quantize_gyro),
+            write.3,
         ]
     }
 
@@ -433,15 +483,22 @@ impl Control {
                 (a, b) => Ok(a.or(b)),
             }
         }
-        let rom = match (self.rom, other.rom) {
-            (RomRead::None, r) | (r, RomRead::None) => r,
+        let (rom, rom_gyro) = match (self.rom, other.rom) {
+            (RomRead::None, r) => (r, other.rom_gyro),
+            (r, RomRead::None) => (r, self.rom_gyro),
             _ => return Err(Busy("sine ROM")),
         };
         if self.advance && other.advance {
             return Err(Busy("NCO advance"));
         }
-        let quantize = match (self.quantize, other.quantize) {
-            (Quantize::None, q) | (q, Quantize::None) => q,
+        let advance_gyro = if self.advance {
+            self.advance_gyro
+        } else {
+            other.advance_gyro
+        };
+        let (quantize, quantize_gyro) = match (self.quantize, other.quantize) {
+            (Quantize::None, q) => (q, other.quantize_gyro),
+            (q, Quantize::None) => (q, self.quantize_gyro),
             _ => return Err(Busy("quantizer")),
         };
         // A block RAM's read of the word it writes in the same clock is undefined (the RTL
@@ -459,6 +516,9 @@ impl Control {
             read: one(self.read, other.read, "RAM read port")?,
             write: one(self.write, other.write, "RAM write port")?,
             quantize,
+            rom_gyro,
+            advance_gyro,
+            quantize_gyro,
         })
     }
 }
@@ -488,13 +548,32 @@ impl std::fmt::Display for Control {
             parts.push(format!("read {} {:?}", r.address, r.gate));
         }
         if let Some(w) = self.write {
-            parts.push(format!("write {} {:?}", w.address, w.data));
+            let when = if w.decimating { " (decimating)" } else { "" };
+            parts.push(format!("write {} {:?}{when}", w.address, w.data));
         }
         if self.quantize != Quantize::None {
             parts.push(format!("{:?}", self.quantize));
         }
         if parts.is_empty() {
             parts.push("idle".into());
+        }
+        let gyros = [
+            self.rom_gyro,
+            self.advance_gyro,
+            self.issue.map_or(0, |i| i.gyro),
+            self.accumulate.map_or(0, |a| a.gyro),
+            self.read.map_or(0, |r| r.gyro),
+            self.quantize_gyro,
+        ];
+        if gyros.iter().any(|&g| g != 0) {
+            let names = ["rom", "advance", "issue", "acc", "read", "quantize"];
+            let b: Vec<&str> = names
+                .iter()
+                .zip(gyros)
+                .filter(|(_, g)| *g != 0)
+                .map(|(n, _)| *n)
+                .collect();
+            parts.push(format!("gyro B: {}", b.join(",")));
         }
         write!(f, "{}", parts.join("; "))
     }

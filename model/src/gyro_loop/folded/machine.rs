@@ -1,5 +1,8 @@
 //! The folded loop run clock by clock, register by register, as `hdl/gyrofx_gyro_loop_serial.v`
-//! runs it: the proof of a [`Schedule`] against the parallel model.
+//! runs it: the proof of a [`Schedule`] against the parallel model. One machine runs one gyro
+//! ([`FoldedGyroLoop`]) or the pair on one datapath ([`FoldedPair`]): the datapath's registers
+//! are shared, each gyro has its own mode, NCO, inter-template registers, DAC, lock and outputs,
+//! and each unit of a control word works on the gyro its field names.
 
 use super::control::{
     ASource, AccX, AccY, BSource, Control, Issue, Quantize, ReadGate, RomRead, WriteData, LIMB_BITS,
@@ -83,37 +86,89 @@ struct NcoConstants {
     half_bin: i64,
 }
 
-/// The folded loop of one gyro: the same ports and results as
-/// [`crate::gyro_loop::gyro::FixedGyroLoop`].
+/// One gyro's constants (its plan's values; the formats are the machine's).
 #[derive(Clone, Debug)]
-pub struct FoldedGyroLoop {
-    schedule: Schedule,
-    datapath: Datapath,
+struct GyroConstants {
     modes: [ModeConstants; 2],
-    points: Points,
-    exact: ExactWidths,
-    shifts: Shifts,
-    nco: NcoConstants,
     gains: [i128; 4],
-    taps: Vec<i128>,
     pll_limits: [i128; 2],
     agc_limits: [i128; 2],
-    decimation: u32,
-    latency: usize,
-    lock_hold: u32,
-    most_seen: u32,
-    // Registers.
+}
+
+/// One gyro's registers.
+#[derive(Clone, Debug)]
+struct GyroRegisters {
     mode: Mode,
-    start: bool,
     switching: bool,
-    first: bool,
-    decimate: bool,
-    count: u32,
-    seen: u32,
     adc: [i128; 2],
     nco_acc: u64,
     residue: [i64; 3],
     freq: u64,
+    drive_q: i128,
+    amplitude_error: i128,
+    amplitude: i128,
+    delay: Vec<i128>,
+    dac: [i128; 2],
+    rate: i128,
+    quadrature: i128,
+    inside_q: bool,
+    lock_count: u32,
+    locked: bool,
+    /// The mode and lock flag of the last decimating sample (the `1/SF` coefficients and the
+    /// decimated output's flag, which a pair produces samples later).
+    decimation_mode: Mode,
+    decimation_locked: bool,
+}
+
+impl GyroRegisters {
+    fn new(latency: usize) -> GyroRegisters {
+        GyroRegisters {
+            mode: Mode::Normal,
+            switching: false,
+            adc: [0; 2],
+            nco_acc: 0,
+            residue: [0; 3],
+            freq: 0,
+            drive_q: 0,
+            amplitude_error: 0,
+            amplitude: 0,
+            delay: vec![0; latency.max(1)],
+            dac: [0; 2],
+            rate: 0,
+            quadrature: 0,
+            inside_q: false,
+            lock_count: 0,
+            locked: false,
+            decimation_mode: Mode::Normal,
+            decimation_locked: false,
+        }
+    }
+}
+
+/// The folded datapath running a schedule for one or two gyros.
+#[derive(Clone, Debug)]
+struct Machine {
+    schedule: Schedule,
+    datapath: Datapath,
+    points: Points,
+    exact: ExactWidths,
+    shifts: Shifts,
+    nco: NcoConstants,
+    taps: Vec<i128>,
+    decimation: u32,
+    latency: usize,
+    lock_hold: u32,
+    most_seen: u32,
+    constants: Vec<GyroConstants>,
+    gyros: Vec<GyroRegisters>,
+    // Shared registers.
+    start: bool,
+    first: bool,
+    decimate: bool,
+    count: u32,
+    seen: u32,
+    /// The deferred segment the next sample runs (a pair after a decimating sample).
+    pending: Option<usize>,
     reference: i128,
     rd: i128,
     /// The read register's preset gate: [`AccX::PllIntegrator`] reads the PLL's preset.
@@ -131,21 +186,76 @@ pub struct FoldedGyroLoop {
     y: i128,
     /// `Q_O(y)` of the clock before.
     output: i128,
-    drive_q: i128,
-    amplitude_error: i128,
     /// The integrator register: a PI's integrator, held as `Shifts::v_held` says.
     v: i128,
-    amplitude: i128,
     c: i128,
     cic_output: i128,
-    delay: Vec<i128>,
-    dac: [i128; 2],
-    rate: i128,
-    quadrature: i128,
-    inside_q: bool,
-    lock_count: u32,
-    locked: bool,
     ram: Vec<i128>,
+}
+
+/// The folded loop of one gyro: the same ports and results as
+/// [`crate::gyro_loop::gyro::FixedGyroLoop`].
+#[derive(Clone, Debug)]
+pub struct FoldedGyroLoop {
+    machine: Machine,
+}
+
+/// What one ADC sample of the folded pair gives.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PairStep {
+    /// Each gyro's DAC codes `[x, y]` (DAC format); the sense axis's is 0.
+    pub dac: [[i64; 2]; 2],
+    /// Each gyro's lock flag after the sample.
+    pub locked: [bool; 2],
+    /// Whether this sample decimates (the parallel loops' chain sample comes now).
+    pub decimating: bool,
+    /// Both gyros' decimated outputs, in the sample whose deferred segment completes them
+    /// ([`FoldedPair::output_delay`] samples after their decimating sample).
+    pub chain: Option<[ChainSample; 2]>,
+}
+
+/// The folded pair: gyros A and B on one datapath ([`Schedule::pair`]), each the same loop as
+/// its [`crate::gyro_loop::gyro::FixedGyroLoop`] bit for bit but that each decimated output
+/// comes [`FoldedPair::output_delay`] samples after the sample that decimates.
+#[derive(Clone, Debug)]
+pub struct FoldedPair {
+    machine: Machine,
+}
+
+impl FoldedPair {
+    /// Gyro A's and B's loops of `plans` (one set of formats: the config checks it), reset.
+    ///
+    /// # Panics
+    /// When the plans have no pair schedule ([`Schedule::pair`] refuses them).
+    pub fn new(plans: [&Plan; 2]) -> Self {
+        let schedule = Schedule::pair(plans[0]).expect("the plans have a folded pair schedule");
+        FoldedPair {
+            machine: Machine::new(&plans, schedule),
+        }
+    }
+
+    /// The schedule the pair runs.
+    pub fn schedule(&self) -> &Schedule {
+        &self.machine.schedule
+    }
+
+    /// Samples from a decimating sample to the one that gives its outputs.
+    pub fn output_delay(&self) -> usize {
+        self.machine.schedule.deferred.len()
+    }
+
+    /// One ADC sample: each gyro's codes `[x, y]` (ADC format) and mode.
+    pub fn step(&mut self, adc: [[i64; 2]; 2], modes: [Mode; 2]) -> PairStep {
+        let m = &mut self.machine;
+        let done = m.sample(&adc, &modes);
+        let step = |g: usize| m.dac(g);
+        PairStep {
+            dac: [step(0), step(1)],
+            locked: [m.gyros[0].locked, m.gyros[1].locked],
+            decimating: m.decimate,
+            chain: done.then(|| [m.chain_sample(0), m.chain_sample(1)]),
+        }
+    }
 }
 
 impl FoldedGyroLoop {
@@ -160,6 +270,34 @@ impl FoldedGyroLoop {
 
     /// The folded loop of `plan` running `schedule`.
     pub fn with_schedule(plan: &Plan, schedule: Schedule) -> Self {
+        FoldedGyroLoop {
+            machine: Machine::new(&[plan], schedule),
+        }
+    }
+
+    /// The schedule this loop runs.
+    pub fn schedule(&self) -> &Schedule {
+        &self.machine.schedule
+    }
+
+    /// The lock flag.
+    pub fn locked(&self) -> bool {
+        self.machine.gyros[0].locked
+    }
+
+    /// One ADC sample: the clock with `ce` high, then the schedule's clocks.
+    pub fn step(&mut self, adc: [i64; 2], mode: Mode) -> FixedStep {
+        let m = &mut self.machine;
+        let done = m.sample(&[adc], &[mode]);
+        FixedStep {
+            dac: m.dac(0),
+            chain: done.then(|| m.chain_sample(0)),
+        }
+    }
+}
+
+impl GyroConstants {
+    fn new(plan: &Plan) -> GyroConstants {
         let mode = |m: &crate::gyro_loop::gyro::ModePlan| ModeConstants {
             setpoint: i128::from(m.setpoint_code),
             pll_preset: i128::from(m.pll_preset).clamp(plan.pll.limits[0], plan.pll.limits[1]),
@@ -168,6 +306,21 @@ impl FoldedGyroLoop {
             coefficients: [m.rate_coefficient.code, m.quadrature_coefficient.code],
             lock_limits: m.lock_limits.map(i128::from),
         };
+        let (pll, agc) = (&plan.pll, &plan.agc);
+        GyroConstants {
+            modes: [mode(&plan.modes[0]), mode(&plan.modes[1])],
+            gains: [pll.ki.code, pll.kp.code, agc.ki.code, agc.kp.code],
+            pll_limits: pll.limits,
+            agc_limits: agc.limits,
+        }
+    }
+}
+
+impl Machine {
+    /// The machine of `plans` (gyro A's, then B's; their formats are `plans[0]`'s) running
+    /// `schedule`, in the state of reset.
+    fn new(plans: &[&Plan], schedule: Schedule) -> Machine {
+        let plan = plans[0];
         let demod = &plan.demodulator;
         let shift_of = |to: i32, from: i32| (to - from) as u32;
         let pll = &plan.pll;
@@ -175,12 +328,11 @@ impl FoldedGyroLoop {
         let nco = &plan.nco;
         let width = nco.phase.width;
         let below = width - nco.address_bits - 2;
-        let words = schedule.words.count();
+        let words = schedule.ram_words();
         let pll_v_to_sum = shift_of(pll.output.from.frac, pll.integrator.frac);
         let agc_v_to_sum = shift_of(agc.output.from.frac, agc.integrator.frac);
-        FoldedGyroLoop {
+        Machine {
             datapath: Datapath::new(plan),
-            modes: [mode(&plan.modes[0]), mode(&plan.modes[1])],
             points: Points {
                 product: demod.product.quantizer(),
                 state: demod.state.quantizer(),
@@ -246,10 +398,7 @@ impl FoldedGyroLoop {
                     0
                 },
             },
-            gains: [pll.ki.code, pll.kp.code, agc.ki.code, agc.kp.code],
             taps: plan.cic.taps.iter().map(|h| h.code).collect(),
-            pll_limits: pll.limits,
-            agc_limits: agc.limits,
             decimation: plan.cic.decimation,
             latency: plan.latency as usize,
             lock_hold: plan.lock.hold_samples,
@@ -257,17 +406,17 @@ impl FoldedGyroLoop {
                 .cic
                 .differential_delay
                 .max(plan.cic.taps.len() as u32 - 1),
-            mode: Mode::Normal,
+            constants: plans.iter().map(|p| GyroConstants::new(p)).collect(),
+            gyros: plans
+                .iter()
+                .map(|_| GyroRegisters::new(plan.latency as usize))
+                .collect(),
             start: true,
-            switching: false,
             first: false,
             decimate: false,
             count: 0,
             seen: 0,
-            adc: [0; 2],
-            nco_acc: 0,
-            residue: [0; 3],
-            freq: 0,
+            pending: None,
             reference: 0,
             rd: 0,
             rd_preset: false,
@@ -279,105 +428,129 @@ impl FoldedGyroLoop {
             p: 0,
             y: 0,
             output: 0,
-            drive_q: 0,
-            amplitude_error: 0,
             v: 0,
-            amplitude: 0,
             c: 0,
             cic_output: 0,
-            delay: vec![0; plan.latency.max(1) as usize],
-            dac: [0; 2],
-            rate: 0,
-            quadrature: 0,
-            inside_q: false,
-            lock_count: 0,
-            locked: false,
             ram: vec![0; words],
             schedule,
         }
     }
 
-    /// The schedule this loop runs.
-    pub fn schedule(&self) -> &Schedule {
-        &self.schedule
-    }
-
-    /// The lock flag.
-    pub fn locked(&self) -> bool {
-        self.locked
-    }
-
-    /// One ADC sample: the clock with `ce` high, then the schedule's clocks.
-    pub fn step(&mut self, adc: [i64; 2], mode: Mode) -> FixedStep {
-        self.capture(adc, mode);
-        let clocks = if self.decimate {
-            self.schedule.controls.len()
+    /// One ADC sample: the `ce` clock, then the schedule's clocks; whether the sample completed
+    /// a decimation's outputs.
+    fn sample(&mut self, adc: &[[i64; 2]], modes: &[Mode]) -> bool {
+        self.capture(adc, modes);
+        let regular = self.schedule.regular;
+        let pair = self.schedule.words_b.is_some();
+        let segment: Option<usize> = if pair {
+            self.pending
         } else {
-            self.schedule.regular
+            self.decimate.then_some(0)
         };
-        for t in 0..clocks {
+        for t in 0..regular {
             let control = self.schedule.controls[t];
             self.clock(&control);
         }
         if self.decimate {
+            for g in &mut self.gyros {
+                g.decimation_locked = g.locked;
+            }
+        }
+        let mut done = false;
+        if let Some(k) = segment {
+            let words = if pair {
+                self.schedule.deferred[k].clone()
+            } else {
+                self.schedule.controls[regular..].to_vec()
+            };
+            for control in &words {
+                self.clock(control);
+            }
+            done = !pair || k + 1 == self.schedule.deferred.len();
+            self.pending = (!done).then_some(k + 1);
+        }
+        if pair && self.decimate {
+            self.pending = Some(0);
+        }
+        if done {
             self.seen = (self.seen + 1).min(self.most_seen);
         }
-        let [driven, _] = mode.axes();
+        done
+    }
+
+    /// Gyro `g`'s DAC codes after a sample (the sense axis's 0).
+    fn dac(&self, g: usize) -> [i64; 2] {
+        let regs = &self.gyros[g];
+        let [driven, _] = regs.mode.axes();
         let mut dac = [0i64; 2];
-        dac[driven] = self.dac[driven] as i64;
-        FixedStep {
-            dac,
-            chain: self.decimate.then_some(ChainSample {
-                rate: self.rate as i64,
-                quadrature: self.quadrature as i64,
-                locked: self.locked,
-            }),
+        dac[driven] = regs.dac[driven] as i64;
+        dac
+    }
+
+    /// Gyro `g`'s decimated output of the last decimation.
+    fn chain_sample(&self, g: usize) -> ChainSample {
+        let regs = &self.gyros[g];
+        ChainSample {
+            rate: regs.rate as i64,
+            quadrature: regs.quadrature as i64,
+            locked: regs.decimation_locked,
         }
     }
 
-    /// The `ce` clock: the sample's inputs, the mode switch's register clears and nominal
-    /// frequency word, the decimation count.
-    fn capture(&mut self, adc: [i64; 2], mode: Mode) {
-        self.switching = mode != self.mode || self.start;
-        self.first = self.start;
+    /// The `ce` clock: the sample's inputs, the mode switches' register clears and nominal
+    /// frequency words, the decimation count.
+    fn capture(&mut self, adc: &[[i64; 2]], modes: &[Mode]) {
+        let start = self.start;
+        self.first = start;
         self.start = false;
-        self.mode = mode;
-        self.adc = adc.map(i128::from);
-        if self.switching {
-            self.delay.iter_mut().for_each(|d| *d = 0);
-            self.lock_count = 0;
-            // The first sample of a mode runs at its nominal word; the PLL's output point
-            // loads the next sample's after the NCO's advance.
-            self.freq = self.constants().frequency_word;
-        }
         self.decimate = self.count == self.decimation - 1;
         self.count = if self.decimate { 0 } else { self.count + 1 };
+        let decimate = self.decimate;
+        for (g, regs) in self.gyros.iter_mut().enumerate() {
+            let mode = modes[g];
+            regs.switching = mode != regs.mode || start;
+            regs.mode = mode;
+            regs.adc = adc[g].map(i128::from);
+            if regs.switching {
+                regs.delay.iter_mut().for_each(|d| *d = 0);
+                regs.lock_count = 0;
+                // The first sample of a mode runs at its nominal word; the PLL's output point
+                // loads the next sample's after the NCO's advance.
+                regs.freq = self.constants[g].modes[mode_index(mode)].frequency_word;
+            }
+            if decimate {
+                regs.decimation_mode = mode;
+            }
+        }
     }
 
-    /// The sample's mode constants.
-    fn constants(&self) -> ModeConstants {
-        self.modes[mode_index(self.mode)]
+    /// Gyro `g`'s constants of its sample's mode.
+    fn mode_constants(&self, g: u8) -> ModeConstants {
+        let g = usize::from(g);
+        self.constants[g].modes[mode_index(self.gyros[g].mode)]
     }
 
     /// One clock of `control`: every unit reads the registers as they were, then loads.
     fn clock(&mut self, control: &Control) {
-        let m = self.constants();
         let acc = self.acc;
         let rd = self.rd;
         let previous_rd = self.previous_rd;
         let y_register = self.y;
 
-        let reference = self.rom_read(control.rom, &m);
+        let reference = self.rom_read(control.rom, control.rom_gyro);
         if control.advance {
-            self.nco_acc = self.nco_acc.wrapping_add(self.freq) & self.nco.mask;
+            let regs = &mut self.gyros[usize::from(control.advance_gyro)];
+            regs.nco_acc = regs.nco_acc.wrapping_add(regs.freq) & self.nco.mask;
         }
         let operands = control
             .issue
-            .map_or((0, 0, 0), |issue| self.operands(&issue, &m));
+            .map_or((0, 0, 0), |issue| self.operands(&issue));
         let (a_limb, b, shift) = self.operands;
         let product = (a_limb * b, shift);
         let pp = self.product.0 << self.product.1;
         let acc_next = control.accumulate.map(|op| {
+            let m = self.mode_constants(op.gyro);
+            let regs = &self.gyros[usize::from(op.gyro)];
             let x = match op.x {
                 AccX::Keep => acc,
                 AccX::Zero => 0,
@@ -404,8 +577,8 @@ impl FoldedGyroLoop {
                 AccY::DemodOutput => self.output,
                 AccY::PreviousRead => previous_rd,
                 AccY::NegReadShifted => -(rd >> self.shifts.lock),
-                AccY::DriveQ => self.drive_q,
-                AccY::AmplitudeError => self.amplitude_error,
+                AccY::DriveQ => regs.drive_q,
+                AccY::AmplitudeError => regs.amplitude_error,
             };
             sign_extend(x.wrapping_add(y), self.datapath.accumulator_width)
         });
@@ -416,37 +589,21 @@ impl FoldedGyroLoop {
                 "word {} read and written in one clock: {control}",
                 read.address
             );
-            let preset = read.gate == ReadGate::Preset && self.switching;
-            let value = match read.gate {
-                ReadGate::None | ReadGate::Preset => word,
-                ReadGate::Switch => {
-                    if self.switching {
-                        0
-                    } else {
-                        word
-                    }
-                }
-                ReadGate::First => {
-                    if self.first {
-                        0
-                    } else {
-                        word
-                    }
-                }
-                ReadGate::Seen => {
-                    if self.seen < u32::from(read.seen) {
-                        0
-                    } else {
-                        word
-                    }
-                }
+            let switching = self.gyros[usize::from(read.gyro)].switching;
+            let preset = read.gate == ReadGate::Preset && switching;
+            let zero = match read.gate {
+                ReadGate::None | ReadGate::Preset => false,
+                ReadGate::Switch => switching,
+                ReadGate::First => self.first,
+                ReadGate::Seen => self.seen < u32::from(read.seen),
             };
-            (value, preset)
+            (if zero { 0 } else { word }, preset)
         });
-        if let Some(write) = control.write {
+        if let Some(write) = control.write.filter(|w| !w.decimating || self.decimate) {
             let value = match write.data {
                 WriteData::AccCic => sign_extend(acc, self.exact.register),
                 WriteData::AccLock => sign_extend(acc, self.datapath.lock_width),
+                WriteData::AccFir => sign_extend(acc, self.exact.fir),
                 WriteData::DemodState => y_register,
                 WriteData::Integrator => self.v,
                 WriteData::Read => rd,
@@ -454,7 +611,7 @@ impl FoldedGyroLoop {
             };
             self.ram[usize::from(write.address)] = value;
         }
-        self.quantize(control.quantize, acc, &m);
+        self.quantize(control.quantize, control.quantize_gyro, acc);
 
         // The loads.
         self.previous_rd = rd;
@@ -474,9 +631,9 @@ impl FoldedGyroLoop {
         }
     }
 
-    /// A sine ROM read: the reference (loaded at the clock's end) and, on a cosine read, the
-    /// reference's new truncation error.
-    fn rom_read(&mut self, rom: RomRead, m: &ModeConstants) -> Option<i128> {
+    /// A sine ROM read of gyro `g`'s NCO: the reference (loaded at the clock's end) and, on a
+    /// cosine read, the reference's new truncation error.
+    fn rom_read(&mut self, rom: RomRead, g: u8) -> Option<i128> {
         let (nco, cos) = match rom {
             RomRead::None => return None,
             RomRead::DriveSin => (0, false),
@@ -485,12 +642,14 @@ impl FoldedGyroLoop {
             RomRead::SenseSin => (2, false),
             RomRead::SenseCos => (2, true),
         };
+        let m = self.mode_constants(g);
         let n = &self.nco;
-        let mut phase = self.nco_acc.wrapping_add(m.offsets[nco]) & n.mask;
+        let regs = &mut self.gyros[usize::from(g)];
+        let mut phase = regs.nco_acc.wrapping_add(m.offsets[nco]) & n.mask;
         if n.error_feedback {
-            phase = phase.wrapping_add(self.residue[nco] as u64) & n.mask;
+            phase = phase.wrapping_add(regs.residue[nco] as u64) & n.mask;
             if cos {
-                self.residue[nco] = (phase & n.below_truncation) as i64 - n.half_bin;
+                regs.residue[nco] = (phase & n.below_truncation) as i64 - n.half_bin;
             }
         }
         let t = (phase >> n.truncation_shift) as u32 + if cos { 1 << n.address_bits } else { 0 };
@@ -511,8 +670,8 @@ impl FoldedGyroLoop {
 
     /// The operand registers' values for `issue`: the limb of `a`, `b`, and the product's
     /// weight (the limb's and the PI's alignment).
-    fn operands(&self, issue: &Issue, m: &ModeConstants) -> (i128, i128, u32) {
-        let a = self.a_operand(issue.a);
+    fn operands(&self, issue: &Issue) -> (i128, i128, u32) {
+        let a = self.a_operand(issue.a, issue.gyro);
         let shift = LIMB_BITS * u32::from(issue.limb);
         let limb = if issue.top {
             a >> shift
@@ -523,106 +682,117 @@ impl FoldedGyroLoop {
             (-(1 << 15)..(1 << 15)).contains(&limb),
             "limb {limb} of {a}"
         );
-        let b = self.b_operand(issue.b, issue.tap, m);
+        let b = self.b_operand(issue.b, issue.tap, issue.gyro);
         (limb, b, shift + self.shifts.align[issue.b.alignment()])
     }
 
-    fn a_operand(&self, a: ASource) -> i128 {
-        let [driven, sensed] = self.mode.axes();
+    fn a_operand(&self, a: ASource, g: u8) -> i128 {
+        let regs = &self.gyros[usize::from(g)];
+        let [driven, sensed] = regs.mode.axes();
         match a {
             ASource::None => 0,
-            ASource::AdcDrive => self.adc[driven],
-            ASource::AdcSense => self.adc[sensed],
-            ASource::DriveQ => self.drive_q,
-            ASource::AmplitudeError => self.amplitude_error,
-            ASource::Amplitude => self.amplitude,
+            ASource::AdcDrive => regs.adc[driven],
+            ASource::AdcSense => regs.adc[sensed],
+            ASource::DriveQ => regs.drive_q,
+            ASource::AmplitudeError => regs.amplitude_error,
+            ASource::Amplitude => regs.amplitude,
             ASource::Cic => self.c,
             ASource::Read => self.rd,
             ASource::CicOutput => self.cic_output,
         }
     }
 
-    fn b_operand(&self, b: BSource, tap: u8, m: &ModeConstants) -> i128 {
+    fn b_operand(&self, b: BSource, tap: u8, g: u8) -> i128 {
+        let g = usize::from(g);
+        let constants = &self.constants[g];
+        // The 1/SF of the mode the decimation was taken in (a pair scales samples later).
+        let decimated = constants.modes[mode_index(self.gyros[g].decimation_mode)];
         match b {
             BSource::Reference => self.reference,
-            BSource::PllKi => self.gains[0],
-            BSource::PllKp => self.gains[1],
-            BSource::AgcKi => self.gains[2],
-            BSource::AgcKp => self.gains[3],
+            BSource::PllKi => constants.gains[0],
+            BSource::PllKp => constants.gains[1],
+            BSource::AgcKi => constants.gains[2],
+            BSource::AgcKp => constants.gains[3],
             BSource::Tap => self.taps[usize::from(tap)],
-            BSource::RateCoefficient => m.coefficients[0],
-            BSource::QuadratureCoefficient => m.coefficients[1],
+            BSource::RateCoefficient => decimated.coefficients[0],
+            BSource::QuadratureCoefficient => decimated.coefficients[1],
         }
     }
 
-    fn pll_integrator(&mut self, acc: i128) -> i128 {
-        let update = sign_extend(acc, self.exact.pll_update);
-        let [low, high] = self.pll_limits;
-        self.points.pll_integrator.apply(update).clamp(low, high)
-    }
-
-    fn agc_integrator(&mut self, acc: i128) -> i128 {
-        let update = sign_extend(acc, self.exact.agc_update);
-        let [low, high] = self.agc_limits;
-        self.points.agc_integrator.apply(update).clamp(low, high)
-    }
-
-    /// The quantization point of this clock, from the accumulator (or the state register).
-    fn quantize(&mut self, point: Quantize, acc: i128, m: &ModeConstants) {
-        let e = &self.exact;
+    /// The quantization point of this clock, from the accumulator (or the state register),
+    /// into gyro `g`'s register where it is the gyro's.
+    fn quantize(&mut self, point: Quantize, g: u8, acc: i128) {
+        let e = self.exact;
+        let m = self.mode_constants(g);
+        let latency = self.latency;
+        let lock_hold = self.lock_hold;
+        let lock_width = self.datapath.lock_width;
+        let constants = &self.constants[usize::from(g)];
+        let regs = &mut self.gyros[usize::from(g)];
+        let points = &mut self.points;
         match point {
             Quantize::None => {}
             Quantize::DemodProduct => {
-                self.p = self.points.product.apply(sign_extend(acc, e.product));
+                self.p = points.product.apply(sign_extend(acc, e.product));
             }
-            Quantize::DemodState => self.y = self.points.state.apply(sign_extend(acc, e.state)),
-            Quantize::DriveQ => self.drive_q = self.output,
+            Quantize::DemodState => self.y = points.state.apply(sign_extend(acc, e.state)),
+            Quantize::DriveQ => regs.drive_q = self.output,
             Quantize::AmplitudeError => {
-                self.amplitude_error = self.points.agc_error.apply(sign_extend(acc, e.agc_error));
+                regs.amplitude_error = points.agc_error.apply(sign_extend(acc, e.agc_error));
             }
-            Quantize::PllIntegrator => self.v = self.pll_integrator(acc) << self.shifts.v_held[0],
+            Quantize::PllIntegrator => {
+                let update = sign_extend(acc, e.pll_update);
+                let [low, high] = constants.pll_limits;
+                self.v =
+                    points.pll_integrator.apply(update).clamp(low, high) << self.shifts.v_held[0];
+            }
             Quantize::PllOutput => {
-                let u = self.points.pll_output.apply(sign_extend(acc, e.pll_sum));
-                self.freq = (u as u64) & self.nco.mask;
+                let u = points.pll_output.apply(sign_extend(acc, e.pll_sum));
+                regs.freq = (u as u64) & self.nco.mask;
             }
-            Quantize::AgcIntegrator => self.v = self.agc_integrator(acc) << self.shifts.v_held[1],
+            Quantize::AgcIntegrator => {
+                let update = sign_extend(acc, e.agc_update);
+                let [low, high] = constants.agc_limits;
+                self.v =
+                    points.agc_integrator.apply(update).clamp(low, high) << self.shifts.v_held[1];
+            }
             Quantize::AgcOutput => {
-                self.amplitude = self.points.agc_output.apply(sign_extend(acc, e.agc_sum));
+                regs.amplitude = points.agc_output.apply(sign_extend(acc, e.agc_sum));
             }
             Quantize::Dac => {
-                let drive = self.points.dac.apply(sign_extend(acc, e.dac));
-                let out = if self.latency == 0 {
+                let drive = points.dac.apply(sign_extend(acc, e.dac));
+                let out = if latency == 0 {
                     drive
                 } else {
-                    self.delay[self.latency - 1]
+                    regs.delay[latency - 1]
                 };
-                let [driven, sensed] = self.mode.axes();
-                self.dac[driven] = out;
-                self.dac[sensed] = 0;
-                self.delay.rotate_right(1);
-                self.delay[0] = drive;
+                let [driven, sensed] = regs.mode.axes();
+                regs.dac[driven] = out;
+                regs.dac[sensed] = 0;
+                regs.delay.rotate_right(1);
+                regs.delay[0] = drive;
             }
-            Quantize::Cic => self.c = self.points.cic.apply(sign_extend(acc, e.register)),
+            Quantize::Cic => self.c = points.cic.apply(sign_extend(acc, e.register)),
             Quantize::CicOutput => {
-                self.cic_output = self.points.cic_output.apply(sign_extend(acc, e.fir));
+                self.cic_output = points.cic_output.apply(sign_extend(acc, e.fir));
             }
-            Quantize::Rate => self.rate = self.points.rate.apply(sign_extend(acc, e.rate)),
+            Quantize::Rate => regs.rate = points.rate.apply(sign_extend(acc, e.rate)),
             Quantize::Quadrature => {
-                self.quadrature = self.points.rate.apply(sign_extend(acc, e.rate));
+                regs.quadrature = points.rate.apply(sign_extend(acc, e.rate));
             }
             Quantize::LockQ => {
-                let z = sign_extend(acc, self.datapath.lock_width);
-                self.inside_q = z.abs() < m.lock_limits[0];
+                let z = sign_extend(acc, lock_width);
+                regs.inside_q = z.abs() < m.lock_limits[0];
             }
             Quantize::LockA => {
-                let z = sign_extend(acc, self.datapath.lock_width);
-                let inside = self.inside_q && z.abs() < m.lock_limits[1];
-                self.lock_count = if inside {
-                    (self.lock_count + 1).min(self.lock_hold)
+                let z = sign_extend(acc, lock_width);
+                let inside = regs.inside_q && z.abs() < m.lock_limits[1];
+                regs.lock_count = if inside {
+                    (regs.lock_count + 1).min(lock_hold)
                 } else {
                     0
                 };
-                self.locked = self.lock_count >= self.lock_hold;
+                regs.locked = regs.lock_count >= lock_hold;
             }
         }
     }

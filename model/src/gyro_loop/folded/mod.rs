@@ -45,6 +45,21 @@
 //! clock of a sample, the regular part every sample and the decimation part (combs,
 //! compensators, `1/SF`) every `R`-th. [`FoldedGyroLoop`] runs it clock by clock as the RTL
 //! does, which is how the tests prove the schedule against the parallel model.
+//!
+//! # The pair
+//!
+//! [`Schedule::pair`] puts both gyros of the system on this one datapath ([`FoldedPair`]), so
+//! that the whole system fits a small FPGA. Every unit's work in a clock names its gyro (the
+//! control word's gyro fields): each gyro has its own mode, NCO, `Q_D`, `e_A`, amplitude, DAC,
+//! lock and outputs, and its own RAM words; the datapath's registers are shared, and the
+//! schedule keeps their values apart as for one gyro. Both regular parts run every sample
+//! (their templates interleaved); the decimation's work would not fit beside them, so the
+//! decimating sample only snapshots each CIC's last integrator (a RAM write that acts only
+//! then), and the combs, the compensators (their taps in groups, partial sums in RAM) and the
+//! `1/SF` products run in the spare clocks of the following samples (`deferred` segments).
+//! Each gyro's DAC codes and lock flags are the parallel loop's in every sample; its decimated
+//! outputs come [`FoldedPair::output_delay`] samples after the sample that decimates, the
+//! `1/SF` of the mode that sample was taken in.
 
 mod control;
 mod machine;
@@ -56,8 +71,8 @@ pub use control::{
     ASource, AccX, AccY, Accumulate, BSource, Busy, Control, Issue, Quantize, Read, ReadGate,
     RomRead, Write, WriteData, ADDRESS_BITS, CONTROL_BITS, FIELDS, LIMB_BITS, PRODUCT_LATENCY,
 };
-pub use machine::FoldedGyroLoop;
-pub use schedule::{Schedule, ScheduleError, Words};
+pub use machine::{FoldedGyroLoop, FoldedPair, PairStep};
+pub use schedule::{Schedule, ScheduleError, Words, PAIR_SAMPLE_WORDS};
 
 use super::gyro::Plan;
 

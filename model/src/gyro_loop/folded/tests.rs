@@ -188,6 +188,118 @@ proptest! {
         let difference = first_difference(&plan, &inputs);
         prop_assert!(difference.is_none(), "{:?} with {}", difference, Schedule::new(&plan).unwrap());
     }
+
+    /// Over random formats and settings and two random input streams, the folded pair gives
+    /// each gyro's parallel DAC codes and lock flags in every sample and its chain outputs
+    /// `output_delay` samples after they decimate.
+    #[test]
+    fn the_folded_pair_matches_two_parallel_loops_over_random_formats(
+        settings in settings(),
+        codes in proptest::collection::vec(
+            ((any::<i64>(), any::<i64>(), 0u8..40), (any::<i64>(), any::<i64>(), 0u8..40)),
+            400,
+        ),
+    ) {
+        let mut spec = Spec::paper_004();
+        spec.settings = settings;
+        let plan = Plan::new(&spec);
+        prop_assume!(plan.is_ok());
+        let plan = plan.unwrap();
+        prop_assume!(Schedule::pair(&plan).is_ok());
+        let width = plan.demodulator.input.width;
+        let code = |x: i64| sign_extend(i128::from(x), width) as i64;
+        let mut modes = [Mode::Normal; 2];
+        let inputs: Vec<_> = codes
+            .iter()
+            .map(|&(a, b)| {
+                let mut adc = [[0; 2]; 2];
+                for (g, (x, y, switch)) in [a, b].into_iter().enumerate() {
+                    if switch == 0 {
+                        modes[g] = if modes[g] == Mode::Normal { Mode::Reverse } else { Mode::Normal };
+                    }
+                    adc[g] = [code(x), code(y)];
+                }
+                (adc, modes)
+            })
+            .collect();
+        let difference = first_pair_difference([&plan, &plan], &inputs);
+        prop_assert!(difference.is_none(), "{:?} with {}", difference, Schedule::pair(&plan).unwrap());
+    }
+}
+
+/// Runs `inputs` (both gyros' codes and modes) through the pair and two parallel loops and
+/// returns the first sample where they differ.
+fn first_pair_difference(
+    plans: [&Plan; 2],
+    inputs: &[([[i64; 2]; 2], [Mode; 2])],
+) -> Option<(usize, String)> {
+    let mut parallel = plans.map(FixedGyroLoop::new);
+    let mut pair = FoldedPair::new(plans);
+    let delay = pair.output_delay();
+    let mut expected = std::collections::VecDeque::new();
+    for (k, &(adc, modes)) in inputs.iter().enumerate() {
+        let want = [0, 1].map(|g| parallel[g].step(adc[g], modes[g]));
+        let got = pair.step(adc, modes);
+        let dac = want.map(|w| w.dac);
+        let locked = [parallel[0].locked(), parallel[1].locked()];
+        if got.dac != dac || got.locked != locked || got.decimating != want[0].chain.is_some() {
+            return Some((k, format!("parallel {want:?} {locked:?}, pair {got:?}")));
+        }
+        if let (Some(a), Some(b)) = (want[0].chain, want[1].chain) {
+            expected.push_back((k + delay, [a, b]));
+        }
+        let due = expected.front().filter(|(at, _)| *at == k).map(|(_, c)| *c);
+        if due.is_some() {
+            expected.pop_front();
+        }
+        if got.chain != due {
+            return Some((k, format!("chain: expected {due:?}, pair {:?}", got.chain)));
+        }
+    }
+    None
+}
+
+/// The default plan's pair, through two closed-loop recordings (different seeds, one gyro's
+/// switch at a third, the other's at two thirds): every DAC code, lock flag and chain output.
+#[test]
+fn the_default_pair_folds_both_loops_bit_for_bit_through_lock_and_switches() {
+    let spec = Spec::paper_004();
+    let plan = Plan::new(&spec).unwrap();
+    let samples = 40_000;
+    let run = |seed, switch| {
+        record(
+            &plan,
+            &spec.resonator,
+            &spec.front_end,
+            seed,
+            10.0,
+            samples,
+            switch,
+        )
+        .unwrap()
+    };
+    let (a, b) = (run(7, samples / 3), run(8, 2 * samples / 3));
+    assert!(a.iter().any(|s| s.locked) && b.iter().any(|s| s.locked));
+    let inputs: Vec<_> = a
+        .iter()
+        .zip(&b)
+        .map(|(a, b)| ([a.adc, b.adc], [a.mode, b.mode]))
+        .collect();
+    assert_eq!(first_pair_difference([&plan, &plan], &inputs), None);
+}
+
+/// The default pair's schedule: every sample within the 120 clocks of a 200 kHz ADC at
+/// 24 MHz (two of them the fetch and decode), its deferred work well inside a decimation.
+#[test]
+fn the_default_pair_fits_a_sample_at_24_mhz() {
+    let plan = Plan::new(&Spec::paper_004()).unwrap();
+    let schedule = Schedule::pair(&plan).unwrap();
+    println!("{schedule}");
+    assert!(schedule.len() <= PAIR_SAMPLE_WORDS, "{schedule}");
+    assert!(
+        schedule.deferred.len() < plan.cic.decimation as usize / 10,
+        "{schedule}"
+    );
 }
 
 /// The fields fill the 64-bit word, and a word's bits are its fields at their offsets (the
@@ -199,9 +311,14 @@ fn a_control_word_packs_its_fields_at_their_offsets() {
         write: Some(Write {
             address: 5,
             data: WriteData::Cic,
+            decimating: true,
         }),
         quantize: Quantize::LockA,
+        quantize_gyro: 1,
         ..Control::default()
     };
-    assert_eq!(control.encode(), 1 << 42 | 5 << 43 | 5 << 50 | 15 << 53);
+    assert_eq!(
+        control.encode(),
+        1 << 42 | 5 << 43 | 5 << 50 | 15 << 53 | 1 << 62 | 1 << 63
+    );
 }
