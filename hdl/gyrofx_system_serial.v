@@ -6,9 +6,9 @@
 
 /*
  * gyrofx_system_serial — the whole mode-reversal gyro at the ADC rate, folded: gyro A's and B's
- *   folded loops (gyrofx_gyro_loop_serial) feeding the time-multiplexed chain
- *   (gyrofx_top_serial), whose sequencer commands the loops' modes, wired as gyrofx_system
- *   wires gyrofx_gyro_loop and gyrofx_top (architecture = "serial").
+ *   loops on one folded datapath (gyrofx_gyro_pair_serial) feeding the time-multiplexed chain
+ *   (gyrofx_top_serial's sequencer and engine), whose sequencer commands the loops' modes,
+ *   wired as gyrofx_system wires gyrofx_gyro_loop and gyrofx_top (architecture = "serial").
  *
  * Purpose: gyrofx_system on a small FPGA, bit-exact with it except that the chain's results
  *   show CHAIN_DELAY_SAMPLES ADC samples later (gyrofx_job::golden::System::of;
@@ -23,13 +23,16 @@
  *   outputs rate_out, out_valid (a one-clock pulse), bias_a, bias_b, estimated load what the
  *   chain made of them.
  *
- * Why the delay: a folded loop takes SCHEDULE_LEN + 2 clocks an ADC sample; the serial chain
- *   takes its program's clocks (gyrofx_top_serial's SETTLE + 1, over a thousand) a chain
- *   sample and runs beside the loops over many ADC samples. Its sequencer's modes change the
- *   clock after it takes a sample, in time for the next ADC sample, as in gyrofx_system; its
- *   results come later, within some later ADC sample that depends on the ce cadence. The
- *   system publishes them a fixed number of ADC samples later instead,
- *   CHAIN_DELAY_SAMPLES = ceil((chain clocks + margin) / (SCHEDULE_LEN + 3))
+ * Why the delay: the folded pair takes up to SCHEDULE_LEN + 2 clocks an ADC sample and makes
+ *   a decimation's rates SCHEDULE_SEGMENTS ADC samples after the sample that decimates; the
+ *   serial chain takes its program's clocks (gyrofx_top_serial's SETTLE + 1, over a thousand)
+ *   a chain sample and runs beside the loops over many ADC samples. Its sequencer takes the
+ *   sample at the end of the decimating ADC sample, so that its modes change in time for the
+ *   next one, as in gyrofx_system; its engine starts when the rates are made, on the
+ *   sequencer's flags as of the take, and its results come later, within some later ADC
+ *   sample that depends on the ce cadence. The system publishes them a fixed number of ADC
+ *   samples later instead, CHAIN_DELAY_SAMPLES = SCHEDULE_SEGMENTS
+ *   + ceil((chain clocks + margin) / (SCHEDULE_LEN + 3))
  *   (gyrofx_job::pipeline::system_chain_delay), so that every output is a function of the
  *   samples whatever the cadence: the engine holds its results until then. The chain must
  *   finish between chain samples: CHAIN_DELAY_SAMPLES <= CIC_DECIMATION (gyrofx refuses a
@@ -45,8 +48,8 @@
  * Parameters: the chain's as gyrofx_top_serial's (its program and coefficient ROMs are the
  *   system chain's), IN_F the loops' output fraction bits; the loops' as gyrofx_system's
  *   (shared ones once, ROUNDING, SATURATE, LATENCY as LOOP_*, per gyro with the prefix A_ or
- *   B_), plus the folded loops' schedule (both gyros' loops have the same formats, so one
- *   schedule ROM); CHAIN_DELAY_SAMPLES.
+ *   B_), plus the folded pair's schedule (both gyros' loops have the same formats);
+ *   CHAIN_DELAY_SAMPLES.
  */
 module gyrofx_system_serial #(
     // chain: sequencer
@@ -204,15 +207,16 @@ module gyrofx_system_serial #(
     parameter signed [63:0] B_LOCK_Q_R = 64'shb70271b,
     parameter signed [63:0] B_LOCK_A_N = 64'sh68db574,
     parameter signed [63:0] B_LOCK_A_R = 64'sh68db574,
-    // loops: the folded schedule (one for both gyros): image, words, words of a sample that
-    // does not decimate, RAM words
-    parameter SCHEDULE_FILE = "gyro_loop_schedule.mem",
-    parameter integer SCHEDULE_LEN = 114,
-    parameter integer SCHEDULE_REGULAR = 54,
-    parameter integer RAM_WORDS = 28,
+    // loops: the folded pair's schedule (gyrofx_gyro_pair_serial): image, words of the
+    // longest sample, of the regular part, deferred segments, RAM words
+    parameter SCHEDULE_FILE = "gyro_pair_schedule.mem",
+    parameter integer SCHEDULE_LEN = 117,
+    parameter integer SCHEDULE_REGULAR = 103,
+    parameter integer SCHEDULE_SEGMENTS = 13,
+    parameter integer RAM_WORDS = 64,
     // ADC samples from the one whose rates the chain takes to the one that publishes its
     // outputs (1..CIC_DECIMATION; gyrofx_job::pipeline::system_chain_delay)
-    parameter integer CHAIN_DELAY_SAMPLES = 14
+    parameter integer CHAIN_DELAY_SAMPLES = 26
 ) (
     input  wire                           clk,
     input  wire                           rst,
@@ -262,6 +266,18 @@ initial begin
             CHAIN_DELAY_SAMPLES, CIC_DECIMATION);
         $finish;
     end
+    if (ROM_DEPTH < 1 || ROM_DEPTH > (1 << SEL_W)) begin
+        $display("%m: ROM_DEPTH (%0d) must be 1..2^SEL_W (%0d)", ROM_DEPTH, 1 << SEL_W);
+        $finish;
+    end
+    // The folded pair gives both gyros one datapath: one set of formats.
+    if (A_PLL_KP_W != B_PLL_KP_W || A_PLL_KP_F != B_PLL_KP_F || A_PLL_KI_W != B_PLL_KI_W
+            || A_PLL_KI_F != B_PLL_KI_F || A_AGC_KP_W != B_AGC_KP_W || A_AGC_KP_F != B_AGC_KP_F
+            || A_AGC_KI_W != B_AGC_KI_W || A_AGC_KI_F != B_AGC_KI_F || A_COEF_W != B_COEF_W
+            || A_COEF_F != B_COEF_F) begin
+        $display("%m: gyro A's and B's loops must share their gains' and 1/SF coefficients' formats (one folded datapath)");
+        $finish;
+    end
 end
 
 // enable and bw_sel as of the ADC sample in flight: the loops' decimated output comes
@@ -284,109 +300,149 @@ wire loop_mode_a = enable ? mode_a : 1'b1;
 wire loop_mode_b = enable ? mode_b : 1'b1;
 wire signed [IN_W-1:0] rate_a;
 wire signed [IN_W-1:0] rate_b;
-wire loop_valid;
+wire decimating;
+wire rates_valid;
 
 /* verilator lint_off PINCONNECTEMPTY */
-gyrofx_gyro_loop_serial #(
-        .NCO_PHASE_W(NCO_PHASE_W), .NCO_ADDR_W(NCO_ADDR_W), .NCO_SIN_W(NCO_SIN_W),
-        .NCO_ERROR_FEEDBACK(NCO_ERROR_FEEDBACK),
-        .DEMOD_ADC_W(DEMOD_ADC_W), .DEMOD_ADC_F(DEMOD_ADC_F), .DEMOD_REF_W(DEMOD_REF_W),
-        .DEMOD_REF_F(DEMOD_REF_F), .DEMOD_PROD_W(DEMOD_PROD_W), .DEMOD_PROD_F(DEMOD_PROD_F),
-        .DEMOD_STATE_W(DEMOD_STATE_W), .DEMOD_STATE_F(DEMOD_STATE_F),
-        .DEMOD_OUT_W(DEMOD_OUT_W), .DEMOD_OUT_F(DEMOD_OUT_F), .DEMOD_SHIFT(DEMOD_SHIFT),
-        .PLL_ERR_W(PLL_ERR_W), .PLL_ERR_F(PLL_ERR_F), .PLL_KP_W(A_PLL_KP_W),
-        .PLL_KP_F(A_PLL_KP_F), .PLL_KI_W(A_PLL_KI_W), .PLL_KI_F(A_PLL_KI_F),
-        .PLL_INT_W(PLL_INT_W), .PLL_INT_F(PLL_INT_F), .PLL_OUT_W(PLL_OUT_W),
-        .PLL_OUT_F(PLL_OUT_F), .PLL_KP(A_PLL_KP), .PLL_KI(A_PLL_KI),
-        .PLL_INT_MIN(A_PLL_INT_MIN), .PLL_INT_MAX(A_PLL_INT_MAX), .AGC_ERR_W(AGC_ERR_W),
-        .AGC_ERR_F(AGC_ERR_F), .AGC_KP_W(A_AGC_KP_W), .AGC_KP_F(A_AGC_KP_F),
-        .AGC_KI_W(A_AGC_KI_W), .AGC_KI_F(A_AGC_KI_F), .AGC_INT_W(AGC_INT_W),
-        .AGC_INT_F(AGC_INT_F), .AGC_OUT_W(AGC_OUT_W), .AGC_OUT_F(AGC_OUT_F), .AGC_KP(A_AGC_KP),
-        .AGC_KI(A_AGC_KI), .AGC_INT_MIN(A_AGC_INT_MIN), .AGC_INT_MAX(A_AGC_INT_MAX),
-        .CIC_IN_W(CIC_IN_W), .CIC_IN_F(CIC_IN_F), .CIC_STAGES(CIC_STAGES),
-        .CIC_DECIMATION(CIC_DECIMATION), .CIC_DELAY(CIC_DELAY), .CIC_SHIFT(CIC_SHIFT),
-        .CIC_MID_W(CIC_MID_W), .CIC_MID_F(CIC_MID_F), .CIC_TAPS(CIC_TAPS),
-        .CIC_COEF_W(CIC_COEF_W), .CIC_COEF_F(CIC_COEF_F), .CIC_OUT_W(CIC_OUT_W),
-        .CIC_OUT_F(CIC_OUT_F), .DAC_W(DAC_W), .DAC_F(DAC_F), .OUT_W(IN_W), .OUT_F(IN_F),
-        .COEF_W(A_COEF_W), .COEF_F(A_COEF_F), .LATENCY(LOOP_LATENCY), .LOCK_SHIFT(LOCK_SHIFT),
-        .LOCK_HOLD(LOCK_HOLD), .SETPOINT_N(A_SETPOINT_N), .SETPOINT_R(A_SETPOINT_R),
-        .FREQ_WORD_N(A_FREQ_WORD_N), .FREQ_WORD_R(A_FREQ_WORD_R),
-        .PLL_PRESET_N(A_PLL_PRESET_N), .PLL_PRESET_R(A_PLL_PRESET_R),
-        .DAC_OFFSET_N(A_DAC_OFFSET_N), .DAC_OFFSET_R(A_DAC_OFFSET_R),
-        .SENSE_OFFSET_N(A_SENSE_OFFSET_N), .SENSE_OFFSET_R(A_SENSE_OFFSET_R),
-        .RATE_COEF_N(A_RATE_COEF_N), .RATE_COEF_R(A_RATE_COEF_R), .QUAD_COEF_N(A_QUAD_COEF_N),
-        .QUAD_COEF_R(A_QUAD_COEF_R), .LOCK_Q_N(A_LOCK_Q_N), .LOCK_Q_R(A_LOCK_Q_R),
-        .LOCK_A_N(A_LOCK_A_N), .LOCK_A_R(A_LOCK_A_R), .ROUNDING(LOOP_ROUNDING),
-        .SATURATE(LOOP_SATURATE), .NCO_ROM_FILE(NCO_ROM_FILE), .CIC_ROM_FILE(CIC_ROM_FILE),
-        .SCHEDULE_FILE(SCHEDULE_FILE), .SCHEDULE_LEN(SCHEDULE_LEN),
-        .SCHEDULE_REGULAR(SCHEDULE_REGULAR), .RAM_WORDS(RAM_WORDS)
-) loop_a (
-    .clk(clk), .rst(rst), .ce(ce), .mode(loop_mode_a), .adc_x(adc_a_x), .adc_y(adc_a_y),
-    .dac_x(dac_a_x), .dac_y(dac_a_y), .rate(rate_a), .quadrature(), .out_valid(loop_valid),
-    .locked(locked_a)
-);
-
-// B decimates by the same factor from the same reset, on the same schedule: its out_valid is A's.
-gyrofx_gyro_loop_serial #(
-        .NCO_PHASE_W(NCO_PHASE_W), .NCO_ADDR_W(NCO_ADDR_W), .NCO_SIN_W(NCO_SIN_W),
-        .NCO_ERROR_FEEDBACK(NCO_ERROR_FEEDBACK),
-        .DEMOD_ADC_W(DEMOD_ADC_W), .DEMOD_ADC_F(DEMOD_ADC_F), .DEMOD_REF_W(DEMOD_REF_W),
-        .DEMOD_REF_F(DEMOD_REF_F), .DEMOD_PROD_W(DEMOD_PROD_W), .DEMOD_PROD_F(DEMOD_PROD_F),
-        .DEMOD_STATE_W(DEMOD_STATE_W), .DEMOD_STATE_F(DEMOD_STATE_F),
-        .DEMOD_OUT_W(DEMOD_OUT_W), .DEMOD_OUT_F(DEMOD_OUT_F), .DEMOD_SHIFT(DEMOD_SHIFT),
-        .PLL_ERR_W(PLL_ERR_W), .PLL_ERR_F(PLL_ERR_F), .PLL_KP_W(B_PLL_KP_W),
-        .PLL_KP_F(B_PLL_KP_F), .PLL_KI_W(B_PLL_KI_W), .PLL_KI_F(B_PLL_KI_F),
-        .PLL_INT_W(PLL_INT_W), .PLL_INT_F(PLL_INT_F), .PLL_OUT_W(PLL_OUT_W),
-        .PLL_OUT_F(PLL_OUT_F), .PLL_KP(B_PLL_KP), .PLL_KI(B_PLL_KI),
-        .PLL_INT_MIN(B_PLL_INT_MIN), .PLL_INT_MAX(B_PLL_INT_MAX), .AGC_ERR_W(AGC_ERR_W),
-        .AGC_ERR_F(AGC_ERR_F), .AGC_KP_W(B_AGC_KP_W), .AGC_KP_F(B_AGC_KP_F),
-        .AGC_KI_W(B_AGC_KI_W), .AGC_KI_F(B_AGC_KI_F), .AGC_INT_W(AGC_INT_W),
-        .AGC_INT_F(AGC_INT_F), .AGC_OUT_W(AGC_OUT_W), .AGC_OUT_F(AGC_OUT_F), .AGC_KP(B_AGC_KP),
-        .AGC_KI(B_AGC_KI), .AGC_INT_MIN(B_AGC_INT_MIN), .AGC_INT_MAX(B_AGC_INT_MAX),
-        .CIC_IN_W(CIC_IN_W), .CIC_IN_F(CIC_IN_F), .CIC_STAGES(CIC_STAGES),
-        .CIC_DECIMATION(CIC_DECIMATION), .CIC_DELAY(CIC_DELAY), .CIC_SHIFT(CIC_SHIFT),
-        .CIC_MID_W(CIC_MID_W), .CIC_MID_F(CIC_MID_F), .CIC_TAPS(CIC_TAPS),
-        .CIC_COEF_W(CIC_COEF_W), .CIC_COEF_F(CIC_COEF_F), .CIC_OUT_W(CIC_OUT_W),
-        .CIC_OUT_F(CIC_OUT_F), .DAC_W(DAC_W), .DAC_F(DAC_F), .OUT_W(IN_W), .OUT_F(IN_F),
-        .COEF_W(B_COEF_W), .COEF_F(B_COEF_F), .LATENCY(LOOP_LATENCY), .LOCK_SHIFT(LOCK_SHIFT),
-        .LOCK_HOLD(LOCK_HOLD), .SETPOINT_N(B_SETPOINT_N), .SETPOINT_R(B_SETPOINT_R),
-        .FREQ_WORD_N(B_FREQ_WORD_N), .FREQ_WORD_R(B_FREQ_WORD_R),
-        .PLL_PRESET_N(B_PLL_PRESET_N), .PLL_PRESET_R(B_PLL_PRESET_R),
-        .DAC_OFFSET_N(B_DAC_OFFSET_N), .DAC_OFFSET_R(B_DAC_OFFSET_R),
-        .SENSE_OFFSET_N(B_SENSE_OFFSET_N), .SENSE_OFFSET_R(B_SENSE_OFFSET_R),
-        .RATE_COEF_N(B_RATE_COEF_N), .RATE_COEF_R(B_RATE_COEF_R), .QUAD_COEF_N(B_QUAD_COEF_N),
-        .QUAD_COEF_R(B_QUAD_COEF_R), .LOCK_Q_N(B_LOCK_Q_N), .LOCK_Q_R(B_LOCK_Q_R),
-        .LOCK_A_N(B_LOCK_A_N), .LOCK_A_R(B_LOCK_A_R), .ROUNDING(LOOP_ROUNDING),
-        .SATURATE(LOOP_SATURATE), .NCO_ROM_FILE(NCO_ROM_FILE), .CIC_ROM_FILE(CIC_ROM_FILE),
-        .SCHEDULE_FILE(SCHEDULE_FILE), .SCHEDULE_LEN(SCHEDULE_LEN),
-        .SCHEDULE_REGULAR(SCHEDULE_REGULAR), .RAM_WORDS(RAM_WORDS)
-) loop_b (
-    .clk(clk), .rst(rst), .ce(ce), .mode(loop_mode_b), .adc_x(adc_b_x), .adc_y(adc_b_y),
-    .dac_x(dac_b_x), .dac_y(dac_b_y), .rate(rate_b), .quadrature(), .out_valid(),
-    .locked(locked_b)
+gyrofx_gyro_pair_serial #(
+    .NCO_PHASE_W(NCO_PHASE_W), .NCO_ADDR_W(NCO_ADDR_W), .NCO_SIN_W(NCO_SIN_W),
+    .NCO_ERROR_FEEDBACK(NCO_ERROR_FEEDBACK),
+    .DEMOD_ADC_W(DEMOD_ADC_W), .DEMOD_ADC_F(DEMOD_ADC_F), .DEMOD_REF_W(DEMOD_REF_W),
+    .DEMOD_REF_F(DEMOD_REF_F), .DEMOD_PROD_W(DEMOD_PROD_W), .DEMOD_PROD_F(DEMOD_PROD_F),
+    .DEMOD_STATE_W(DEMOD_STATE_W), .DEMOD_STATE_F(DEMOD_STATE_F),
+    .DEMOD_OUT_W(DEMOD_OUT_W), .DEMOD_OUT_F(DEMOD_OUT_F), .DEMOD_SHIFT(DEMOD_SHIFT),
+    .PLL_ERR_W(PLL_ERR_W), .PLL_ERR_F(PLL_ERR_F), .PLL_KP_W(A_PLL_KP_W), .PLL_KP_F(A_PLL_KP_F),
+    .PLL_KI_W(A_PLL_KI_W), .PLL_KI_F(A_PLL_KI_F), .PLL_INT_W(PLL_INT_W), .PLL_INT_F(PLL_INT_F),
+    .PLL_OUT_W(PLL_OUT_W), .PLL_OUT_F(PLL_OUT_F), .AGC_ERR_W(AGC_ERR_W), .AGC_ERR_F(AGC_ERR_F),
+    .AGC_KP_W(A_AGC_KP_W), .AGC_KP_F(A_AGC_KP_F), .AGC_KI_W(A_AGC_KI_W), .AGC_KI_F(A_AGC_KI_F),
+    .AGC_INT_W(AGC_INT_W), .AGC_INT_F(AGC_INT_F), .AGC_OUT_W(AGC_OUT_W), .AGC_OUT_F(AGC_OUT_F),
+    .CIC_IN_W(CIC_IN_W), .CIC_IN_F(CIC_IN_F), .CIC_STAGES(CIC_STAGES),
+    .CIC_DECIMATION(CIC_DECIMATION), .CIC_DELAY(CIC_DELAY), .CIC_SHIFT(CIC_SHIFT),
+    .CIC_MID_W(CIC_MID_W), .CIC_MID_F(CIC_MID_F), .CIC_TAPS(CIC_TAPS),
+    .CIC_COEF_W(CIC_COEF_W), .CIC_COEF_F(CIC_COEF_F), .CIC_OUT_W(CIC_OUT_W),
+    .CIC_OUT_F(CIC_OUT_F), .DAC_W(DAC_W), .DAC_F(DAC_F), .OUT_W(IN_W), .OUT_F(IN_F),
+    .COEF_W(A_COEF_W), .COEF_F(A_COEF_F), .LATENCY(LOOP_LATENCY), .LOCK_SHIFT(LOCK_SHIFT),
+    .LOCK_HOLD(LOCK_HOLD),
+    .A_PLL_KP(A_PLL_KP), .A_PLL_KI(A_PLL_KI), .A_PLL_INT_MIN(A_PLL_INT_MIN),
+    .A_PLL_INT_MAX(A_PLL_INT_MAX), .A_AGC_KP(A_AGC_KP), .A_AGC_KI(A_AGC_KI),
+    .A_AGC_INT_MIN(A_AGC_INT_MIN), .A_AGC_INT_MAX(A_AGC_INT_MAX),
+    .A_SETPOINT_N(A_SETPOINT_N), .A_SETPOINT_R(A_SETPOINT_R),
+    .A_FREQ_WORD_N(A_FREQ_WORD_N), .A_FREQ_WORD_R(A_FREQ_WORD_R),
+    .A_PLL_PRESET_N(A_PLL_PRESET_N), .A_PLL_PRESET_R(A_PLL_PRESET_R),
+    .A_DAC_OFFSET_N(A_DAC_OFFSET_N), .A_DAC_OFFSET_R(A_DAC_OFFSET_R),
+    .A_SENSE_OFFSET_N(A_SENSE_OFFSET_N), .A_SENSE_OFFSET_R(A_SENSE_OFFSET_R),
+    .A_RATE_COEF_N(A_RATE_COEF_N), .A_RATE_COEF_R(A_RATE_COEF_R),
+    .A_QUAD_COEF_N(A_QUAD_COEF_N), .A_QUAD_COEF_R(A_QUAD_COEF_R),
+    .A_LOCK_Q_N(A_LOCK_Q_N), .A_LOCK_Q_R(A_LOCK_Q_R), .A_LOCK_A_N(A_LOCK_A_N),
+    .A_LOCK_A_R(A_LOCK_A_R),
+    .B_PLL_KP(B_PLL_KP), .B_PLL_KI(B_PLL_KI), .B_PLL_INT_MIN(B_PLL_INT_MIN),
+    .B_PLL_INT_MAX(B_PLL_INT_MAX), .B_AGC_KP(B_AGC_KP), .B_AGC_KI(B_AGC_KI),
+    .B_AGC_INT_MIN(B_AGC_INT_MIN), .B_AGC_INT_MAX(B_AGC_INT_MAX),
+    .B_SETPOINT_N(B_SETPOINT_N), .B_SETPOINT_R(B_SETPOINT_R),
+    .B_FREQ_WORD_N(B_FREQ_WORD_N), .B_FREQ_WORD_R(B_FREQ_WORD_R),
+    .B_PLL_PRESET_N(B_PLL_PRESET_N), .B_PLL_PRESET_R(B_PLL_PRESET_R),
+    .B_DAC_OFFSET_N(B_DAC_OFFSET_N), .B_DAC_OFFSET_R(B_DAC_OFFSET_R),
+    .B_SENSE_OFFSET_N(B_SENSE_OFFSET_N), .B_SENSE_OFFSET_R(B_SENSE_OFFSET_R),
+    .B_RATE_COEF_N(B_RATE_COEF_N), .B_RATE_COEF_R(B_RATE_COEF_R),
+    .B_QUAD_COEF_N(B_QUAD_COEF_N), .B_QUAD_COEF_R(B_QUAD_COEF_R),
+    .B_LOCK_Q_N(B_LOCK_Q_N), .B_LOCK_Q_R(B_LOCK_Q_R), .B_LOCK_A_N(B_LOCK_A_N),
+    .B_LOCK_A_R(B_LOCK_A_R),
+    .ROUNDING(LOOP_ROUNDING), .SATURATE(LOOP_SATURATE), .NCO_ROM_FILE(NCO_ROM_FILE),
+    .CIC_ROM_FILE(CIC_ROM_FILE), .SCHEDULE_FILE(SCHEDULE_FILE), .SCHEDULE_LEN(SCHEDULE_LEN),
+    .SCHEDULE_REGULAR(SCHEDULE_REGULAR), .SCHEDULE_SEGMENTS(SCHEDULE_SEGMENTS),
+    .RAM_WORDS(RAM_WORDS)
+) loops (
+    .clk(clk), .rst(rst), .ce(ce), .mode_a(loop_mode_a), .mode_b(loop_mode_b),
+    .adc_a_x(adc_a_x), .adc_a_y(adc_a_y), .adc_b_x(adc_b_x), .adc_b_y(adc_b_y),
+    .dac_a_x(dac_a_x), .dac_a_y(dac_a_y), .dac_b_x(dac_b_x), .dac_b_y(dac_b_y),
+    .locked_a(locked_a), .locked_b(locked_b), .decimating(decimating),
+    .rate_a(rate_a), .quadrature_a(), .rate_b(rate_b), .quadrature_b(),
+    .out_valid(rates_valid)
 );
 /* verilator lint_on PINCONNECTEMPTY */
 
-// The chain takes the loops' rates at their output clock; its modes change the clock after.
-wire chain_ce = loop_valid && enable_reg;
+// The chain: its sequencer takes the sample at the end of the decimating ADC sample (its modes
+// change the clock after, in time for the next ADC sample, as in gyrofx_system); the engine
+// (gyrofx_top_serial's, one shared multiplier) starts when the loops' deferred work has made
+// that sample's rates, SCHEDULE_SEGMENTS ADC samples later, on the sequencer's flags and the
+// bw_sel as of the take.
+wire take = decimating && enable_reg;
+wire blank_a;
+wire blank_b;
+wire [INTERVAL_W-1:0] interval_a;
+wire [INTERVAL_W-1:0] interval_b;
+wire done_a;
+wire done_b;
+wire window_done;
+
+gyrofx_sequencer #(
+    .INTERVAL_LENGTH(INTERVAL_LENGTH), .INTERVALS(INTERVALS), .PATTERN(PATTERN),
+    .BLANK(BLANK), .STAGGER(STAGGER), .PHASE_W(PHASE_W), .INTERVAL_W(INTERVAL_W)
+) sequencer (
+    .clk(clk), .rst(rst), .ce(take),
+    .mode_a(mode_a), .mode_b(mode_b), .blank_a(blank_a), .blank_b(blank_b),
+    .interval_a(interval_a), .interval_b(interval_b), .done_a(done_a), .done_b(done_b),
+    .window_done(window_done)
+);
+
+// The sequencer's description of the taken sample, held for the engine, and whether a take
+// waits for its rates.
+reg taken_reg = 1'b0;
+reg [SEL_W-1:0] taken_bw_sel_reg = {SEL_W{1'b0}};
+reg taken_mode_a_reg = 1'b1;
+reg taken_mode_b_reg = 1'b1;
+reg taken_blank_a_reg = 1'b0;
+reg taken_blank_b_reg = 1'b0;
+reg [INTERVAL_W-1:0] taken_interval_a_reg = {INTERVAL_W{1'b0}};
+reg [INTERVAL_W-1:0] taken_interval_b_reg = {INTERVAL_W{1'b0}};
+reg taken_done_a_reg = 1'b0;
+reg taken_done_b_reg = 1'b0;
+reg taken_window_done_reg = 1'b0;
+always @(posedge clk) begin
+    if (take) begin
+        taken_reg <= 1'b1;
+        taken_bw_sel_reg <= bw_sel_reg;
+        taken_mode_a_reg <= mode_a;
+        taken_mode_b_reg <= mode_b;
+        taken_blank_a_reg <= blank_a;
+        taken_blank_b_reg <= blank_b;
+        taken_interval_a_reg <= interval_a;
+        taken_interval_b_reg <= interval_b;
+        taken_done_a_reg <= done_a;
+        taken_done_b_reg <= done_b;
+        taken_window_done_reg <= window_done;
+    end else if (rates_valid) begin
+        taken_reg <= 1'b0;
+    end
+    if (rst) begin
+        taken_reg <= 1'b0;
+    end
+end
+
+wire chain_ce = rates_valid && taken_reg;
 wire signed [OUT_W-1:0] chain_rate;
 wire chain_valid;
 wire signed [BIAS_W-1:0] chain_bias_a;
 wire signed [BIAS_W-1:0] chain_bias_b;
 wire chain_estimated;
+/* verilator lint_off UNUSEDSIGNAL */
+wire chain_busy;
+/* verilator lint_on UNUSEDSIGNAL */
 
-gyrofx_top_serial #(
-    .INTERVAL_LENGTH(INTERVAL_LENGTH), .INTERVALS(INTERVALS), .PATTERN(PATTERN), .BLANK(BLANK),
-    .STAGGER(STAGGER), .PHASE_W(PHASE_W), .INTERVAL_W(INTERVAL_W), .IN_W(IN_W), .OUT_W(OUT_W),
-    .BIAS_W(BIAS_W), .SEL_W(SEL_W), .ROM_DEPTH(ROM_DEPTH), .ACC_W(ACC_W), .ADDR_W(ADDR_W),
-    .COEF_ADDR_W(COEF_ADDR_W), .RAM_DEPTH(RAM_DEPTH), .COEF_DEPTH(COEF_DEPTH),
-    .PROGRAM_DEPTH(PROGRAM_DEPTH), .RAM_INDEX_SHIFT(RAM_INDEX_SHIFT),
-    .COEF_INDEX_SHIFT(COEF_INDEX_SHIFT), .ROUNDING(ROUNDING), .PROGRAM_FILE(PROGRAM_FILE),
-    .COEFFICIENT_FILE(COEFFICIENT_FILE)
-) chain (
-    .clk(clk), .rst(rst), .ce(chain_ce), .bw_sel(bw_sel_reg), .y_a(rate_a), .y_b(rate_b),
-    .mode_a(mode_a), .mode_b(mode_b), .rate_out(chain_rate), .out_valid(chain_valid),
-    .bias_a(chain_bias_a), .bias_b(chain_bias_b), .estimated(chain_estimated)
+gyrofx_serial_engine #(
+    .IN_W(IN_W), .OUT_W(OUT_W), .BIAS_W(BIAS_W), .SEL_W(SEL_W), .INTERVAL_W(INTERVAL_W),
+    .ACC_W(ACC_W), .ADDR_W(ADDR_W), .COEF_ADDR_W(COEF_ADDR_W), .RAM_DEPTH(RAM_DEPTH),
+    .COEF_DEPTH(COEF_DEPTH), .PROGRAM_DEPTH(PROGRAM_DEPTH),
+    .RAM_INDEX_SHIFT(RAM_INDEX_SHIFT), .COEF_INDEX_SHIFT(COEF_INDEX_SHIFT),
+    .ROUNDING(ROUNDING), .PROGRAM_FILE(PROGRAM_FILE), .COEFFICIENT_FILE(COEFFICIENT_FILE)
+) engine (
+    .clk(clk), .rst(rst), .ce(chain_ce), .bw_sel(taken_bw_sel_reg), .y_a(rate_a), .y_b(rate_b),
+    .mode_a(taken_mode_a_reg), .mode_b(taken_mode_b_reg), .blank_a(taken_blank_a_reg),
+    .blank_b(taken_blank_b_reg), .done_a(taken_done_a_reg), .done_b(taken_done_b_reg),
+    .window_done(taken_window_done_reg), .interval_a(taken_interval_a_reg),
+    .interval_b(taken_interval_b_reg), .rate_out(chain_rate), .out_valid(chain_valid),
+    .bias_a(chain_bias_a), .bias_b(chain_bias_b), .estimated(chain_estimated),
+    .busy(chain_busy)
 );
 
 // Clocks since ce, up to the output clock (OUTPUT_COUNT; 0: none in flight).
@@ -396,6 +452,7 @@ wire output_clock = count_reg == OUTPUT_COUNT;
 // engine has pulsed out_valid since it took it (not when both gyros were blanked).
 reg [DELAY_W-1:0] pending_reg = {DELAY_W{1'b0}};
 reg chain_valid_reg = 1'b0;
+reg take_pending_reg = 1'b0;
 wire publish = output_clock && pending_reg == LAST;
 
 reg out_valid_reg = 1'b0;
@@ -412,10 +469,15 @@ always @(posedge clk) begin
     end else begin
         count_reg <= {COUNT_W{1'b0}};
     end
-    // A take at the output clock starts the count down; DELAY output clocks later, publish.
+    // A take (in this sample, before its output clock) starts the count down at the output
+    // clock; DELAY output clocks later, publish.
+    if (take) begin
+        take_pending_reg <= 1'b1;
+    end
     if (output_clock) begin
-        if (chain_ce) begin
+        if (take_pending_reg || take) begin
             pending_reg <= DELAY;
+            take_pending_reg <= 1'b0;
         end else if (pending_reg != {DELAY_W{1'b0}}) begin
             pending_reg <= pending_reg - 1'b1;
         end
@@ -436,6 +498,7 @@ always @(posedge clk) begin
     if (rst) begin
         count_reg <= {COUNT_W{1'b0}};
         pending_reg <= {DELAY_W{1'b0}};
+        take_pending_reg <= 1'b0;
         chain_valid_reg <= 1'b0;
         out_valid_reg <= 1'b0;
         rate_out_reg <= {OUT_W{1'b0}};

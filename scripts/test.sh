@@ -119,6 +119,11 @@ verilator --lint-only -Wall --top-module gyrofx_gyro_loop hdl/gyrofx_gyro_loop.v
     hdl/gyrofx_demodulator.v hdl/gyrofx_pi.v hdl/gyrofx_cic.v hdl/gyrofx_quantize.v hdl/gyrofx_spacing_check.v
 verilator --lint-only -Wall --top-module gyrofx_gyro_loop_serial hdl/gyrofx_gyro_loop_serial.v \
     hdl/gyrofx_quantize.v hdl/gyrofx_spacing_check.v
+verilator --lint-only -Wall --top-module gyrofx_gyro_pair_serial hdl/gyrofx_gyro_pair_serial.v \
+    hdl/gyrofx_quantize.v hdl/gyrofx_spacing_check.v
+verilator --lint-only -Wall --top-module gyrofx_system_serial hdl/gyrofx_system_serial.v \
+    hdl/gyrofx_gyro_pair_serial.v hdl/gyrofx_serial_engine.v hdl/gyrofx_sequencer.v \
+    hdl/gyrofx_quantize.v hdl/gyrofx_spacing_check.v
 verilator --lint-only -Wall --top-module gyrofx_system hdl/*.v
 verilator --lint-only -Wall --top-module gyrofx_top_serial hdl/gyrofx_top_serial.v \
     hdl/gyrofx_serial_engine.v hdl/gyrofx_sequencer.v

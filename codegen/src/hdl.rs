@@ -2,7 +2,7 @@
 //! in compile order (a unit before its users), and the sources one module needs.
 
 /// The reference RTL, embedded so that every package is self-contained.
-pub const RTL_SOURCES: [(&str, &str); 19] = [
+pub const RTL_SOURCES: [(&str, &str); 20] = [
     (
         "gyrofx_quantize.v",
         include_str!("../../hdl/gyrofx_quantize.v"),
@@ -55,6 +55,10 @@ pub const RTL_SOURCES: [(&str, &str); 19] = [
     (
         "gyrofx_gyro_loop_serial.v",
         include_str!("../../hdl/gyrofx_gyro_loop_serial.v"),
+    ),
+    (
+        "gyrofx_gyro_pair_serial.v",
+        include_str!("../../hdl/gyrofx_gyro_pair_serial.v"),
     ),
     ("gyrofx_system.v", include_str!("../../hdl/gyrofx_system.v")),
     (

@@ -257,15 +257,46 @@ impl Rom {
     /// The folded gyro loop's schedule (`gyrofx_gyro_loop_serial`): one control word per clock
     /// after a sample's `ce`, the fields of `gyrofx_model::gyro_loop::folded::Control`.
     pub fn gyro_loop_schedule(schedule: &gyro_loop::folded::Schedule) -> Rom {
-        // MSB first, as a ROM word packs its fields.
-        let layout: Vec<(&str, u32)> = gyro_loop::folded::FIELDS.iter().rev().copied().collect();
-        Rom {
-            name: "gyro_loop_schedule".into(),
-            description: format!(
+        Rom::folded_schedule(
+            schedule,
+            "gyro_loop_schedule",
+            "clock",
+            format!(
                 "folded gyro-loop schedule: {} control words from 0, one a clock ({} every sample, all in a decimating one)",
                 schedule.len(),
                 schedule.regular
             ),
+        )
+    }
+
+    /// The folded pair's schedule (`gyrofx_gyro_pair_serial`): both gyros' regular part, then
+    /// each deferred segment padded to the longest sample's words.
+    pub fn gyro_pair_schedule(schedule: &gyro_loop::folded::Schedule) -> Rom {
+        Rom::folded_schedule(
+            schedule,
+            "gyro_pair_schedule",
+            "word",
+            format!(
+                "folded two-gyro schedule: {} regular control words every sample, then {} deferred segments of {} words, one in each of the samples after a decimating one",
+                schedule.regular,
+                schedule.deferred.len(),
+                schedule.len() - schedule.regular
+            ),
+        )
+    }
+
+    fn folded_schedule(
+        schedule: &gyro_loop::folded::Schedule,
+        name: &str,
+        note: &str,
+        description: String,
+    ) -> Rom {
+        // MSB first, as a ROM word packs its fields.
+        let layout: Vec<(&str, u32)> = gyro_loop::folded::FIELDS.iter().rev().copied().collect();
+        let words = schedule.rom_words();
+        Rom {
+            name: name.into(),
+            description,
             fields: layout
                 .iter()
                 .map(|&(name, width)| Field {
@@ -277,16 +308,14 @@ impl Rom {
                     },
                 })
                 .collect(),
-            codes: schedule
-                .controls
+            codes: words
                 .iter()
                 .map(|c| c.fields().iter().rev().map(|v| i128::from(*v)).collect())
                 .collect(),
-            notes: schedule
-                .controls
+            notes: words
                 .iter()
                 .enumerate()
-                .map(|(t, c)| format!("clock {t}: {c}"))
+                .map(|(t, c)| format!("{note} {t}: {c}"))
                 .collect(),
         }
     }

@@ -43,6 +43,9 @@ pub struct Job {
     /// The system's chain ([`Job::system_chain`]) compiled for the `gyrofx_top_serial` inside
     /// `gyrofx_system_serial`, with `architecture = "serial"` on a resonator plant.
     pub system_serial: Option<gyrofx_model::serial::Program>,
+    /// Both gyros' loops on one folded datapath (`gyrofx_gyro_pair_serial`, inside
+    /// `gyrofx_system_serial`), with `architecture = "serial"` on a resonator plant.
+    pub pair_schedule: Option<gyrofx_model::gyro_loop::folded::Schedule>,
 }
 
 /// Designs one filter per bandwidth of `settings` at `fs_hz` for the noise model (°/√h, °/h/√h).
@@ -107,6 +110,10 @@ impl Job {
                 Some(chain) => Some(compile_serial(chain)?),
                 None => None,
             };
+            job.pair_schedule = match &job.system_chain {
+                Some(_) => Some(schedule_pair(&job.gyro_loops)?),
+                None => None,
+            };
             job.config.architecture = "serial".into();
             job.settings.architecture = crate::config::Architecture::Serial;
         }
@@ -142,13 +149,17 @@ impl Job {
             Some(_) => Some(crate::system::chain_plan(&settings.estimator, &chain.kf)?),
             None => None,
         };
-        let (serial, loop_schedule, system_serial) = match settings.architecture {
-            crate::config::Architecture::Parallel => (None, None, None),
+        let (serial, loop_schedule, system_serial, pair_schedule) = match settings.architecture {
+            crate::config::Architecture::Parallel => (None, None, None, None),
             crate::config::Architecture::Serial => (
                 Some(compile_serial(&chain)?),
                 Some(schedule_loop(&gyro_loops)?),
                 match &system_chain {
                     Some(chain) => Some(compile_serial(chain)?),
+                    None => None,
+                },
+                match &system_chain {
+                    Some(_) => Some(schedule_pair(&gyro_loops)?),
                     None => None,
                 },
             ),
@@ -165,6 +176,7 @@ impl Job {
             serial,
             loop_schedule,
             system_serial,
+            pair_schedule,
         })
     }
 
@@ -290,6 +302,31 @@ fn schedule_loop(loops: &[GyroLoop; 2]) -> Result<gyrofx_model::gyro_loop::folde
         field: "architecture".into(),
         value: "\"serial\"".into(),
         allowed: e.to_string(),
+    })
+}
+
+/// Both gyros' folded loops on one datapath (the system's); a pair it cannot fold is a config
+/// error on `loop.decimation` (the deferred work must end before the next decimation) or
+/// `architecture`.
+fn schedule_pair(loops: &[GyroLoop; 2]) -> Result<gyrofx_model::gyro_loop::folded::Schedule> {
+    use gyrofx_model::gyro_loop::folded::{Schedule, ScheduleError};
+    Schedule::pair(&loops[0].plan).map_err(|e| match e {
+        ScheduleError::Decimation {
+            segments,
+            decimation,
+        } => Error::Config {
+            field: "loop.decimation (with architecture = \"serial\")".into(),
+            value: decimation.to_string(),
+            allowed: format!(
+                "at least {}: the folded system's loops defer each decimation's compensators into the next {segments} samples",
+                segments + 1
+            ),
+        },
+        other => Error::Config {
+            field: "architecture".into(),
+            value: "\"serial\"".into(),
+            allowed: other.to_string(),
+        },
     })
 }
 

@@ -82,9 +82,9 @@ const PARALLEL_SYSTEM: Pipeline = Pipeline::new(
 /// chain takes their rates then and its sequencer's modes change), every ADC sample; the
 /// chain's results come [`system_chain_delay`] samples later, at that same clock.
 pub fn system(job: &Job) -> Pipeline {
-    match &job.loop_schedule {
-        Some(_) => {
-            let latency = gyro_loop(job).latency_clocks + 1;
+    match &job.pair_schedule {
+        Some(pair) => {
+            let latency = pair.len() as u32 + 3;
             Pipeline::new(latency, latency)
         }
         None => PARALLEL_SYSTEM,
@@ -104,12 +104,13 @@ pub const CHAIN_MARGIN_CLOCKS: u32 = 1;
 /// K-th sample after, K = ⌈(S + [`CHAIN_MARGIN_CLOCKS`]) / m⌉, reads finished results whatever
 /// the `ce` cadence (the samples are at least m clocks apart).
 pub fn system_chain_delay(job: &Job) -> u32 {
-    match &job.system_serial {
-        Some(program) => {
+    match (&job.system_serial, &job.pair_schedule) {
+        (Some(program), Some(pair)) => {
             let chain = program.settle_clocks() + 1;
-            (chain + CHAIN_MARGIN_CLOCKS).div_ceil(system(job).min_clocks_per_sample)
+            let deferred = pair.deferred.len() as u32;
+            deferred + (chain + CHAIN_MARGIN_CLOCKS).div_ceil(system(job).min_clocks_per_sample)
         }
-        None => 0,
+        _ => 0,
     }
 }
 

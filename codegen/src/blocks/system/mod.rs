@@ -53,6 +53,9 @@ pub const SERIAL_COEFFICIENT_ROM: &str = "system_serial_coefficients";
 
 /// The module with `architecture = "serial"`.
 pub const SERIAL_MODULE: &str = "gyrofx_system_serial";
+/// Name of the folded pair's schedule ROM (`gyrofx_gyro_pair_serial` inside
+/// `gyrofx_system_serial`).
+pub const PAIR_SCHEDULE_ROM: &str = "gyro_pair_schedule";
 
 /// Estimator windows after the start-up.
 pub const WINDOWS: usize = 2;
@@ -143,6 +146,41 @@ pub fn loop_params(loops: [&LoopPlan; 2], sine_file: &str, taps_file: &str) -> R
     Ok(shared)
 }
 
+/// `gyrofx_gyro_pair_serial`'s schedule parameters for `schedule` (a pair's), its image
+/// `schedule_file`.
+pub fn pair_schedule_params(
+    schedule: &gyrofx_model::gyro_loop::folded::Schedule,
+    schedule_file: &str,
+) -> [Param; 5] {
+    [
+        Param::string(
+            "SCHEDULE_FILE",
+            schedule_file,
+            "the folded pair's schedule ROM image (control words)",
+        ),
+        Param::integer(
+            "SCHEDULE_LEN",
+            schedule.len() as i64,
+            "control words of the longest sample",
+        ),
+        Param::integer(
+            "SCHEDULE_REGULAR",
+            schedule.regular as i64,
+            "control words of every sample (both gyros' regular parts)",
+        ),
+        Param::integer(
+            "SCHEDULE_SEGMENTS",
+            schedule.deferred.len() as i64,
+            "deferred segments: samples from a decimating one to its rates",
+        ),
+        Param::integer(
+            "RAM_WORDS",
+            schedule.ram_words() as i64,
+            "RAM words: both loops' states",
+        ),
+    ]
+}
+
 /// Refuses loops whose folded schedules differ: `gyrofx_system_serial` gives both one
 /// schedule ROM (`SCHEDULE_FILE`), gyro A's.
 ///
@@ -215,7 +253,9 @@ impl RtlBlock for System {
                     rom.description
                 );
             }
-            return vec![code, limbs];
+            let mut roms = vec![code, limbs];
+            roms.extend(job.pair_schedule.as_ref().map(Rom::gyro_pair_schedule));
+            return roms;
         }
         match &job.system_chain {
             Some(plan) => {
@@ -272,7 +312,7 @@ impl RtlBlock for System {
         block.cocotb_test = Some(include_str!("cocotb_test.py"));
         block.pipeline = pipeline::system(job);
         block.extra = vec!["loop_rate_a_dps", "loop_rate_b_dps"];
-        if let (Some(program), Some(schedule)) = (&job.system_serial, &job.loop_schedule) {
+        if let (Some(program), Some(schedule)) = (&job.system_serial, &job.pair_schedule) {
             let code = roms.entry(SERIAL_PROGRAM_ROM);
             let limbs = roms.entry(SERIAL_COEFFICIENT_ROM);
             block.module = SERIAL_MODULE;
@@ -295,7 +335,7 @@ impl RtlBlock for System {
             );
             let sine = roms.entry(gyro_loop::SINE_ROM);
             let taps = roms.entry(gyro_loop::TAPS_ROM);
-            let rom = roms.entry(gyro_loop::SCHEDULE_ROM);
+            let rom = roms.entry(PAIR_SCHEDULE_ROM);
             block.params.extend(
                 loop_params(
                     [&job.gyro_loops[0].plan, &job.gyro_loops[1].plan],
@@ -304,9 +344,7 @@ impl RtlBlock for System {
                 )
                 .expect("checked_job checked that the loops share what the RTL shares"),
             );
-            block
-                .params
-                .extend(gyro_loop::schedule_params(schedule, &rom.0));
+            block.params.extend(pair_schedule_params(schedule, &rom.0));
             block.params.push(Param::integer(
                 "CHAIN_DELAY_SAMPLES",
                 pipeline::system_chain_delay(job).into(),
