@@ -493,22 +493,40 @@ initial begin
     end
 end
 
-// rom_field: 1 drive sin, 2 drive cos, 3 transmit cos, 4 sense sin, 5 sense cos.
-wire [1:0] nco_index = rom_field == 3'd3 ? 2'd1 : (rom_field >= 3'd4 ? 2'd2 : 2'd0);
-wire [2:0] residue_index = rom_gyro_field ? {1'b0, nco_index} + 3'd3 : {1'b0, nco_index};
-wire cosine = rom_field == 3'd2 || rom_field == 3'd3 || rom_field == 3'd5;
-wire rom_mode = rom_gyro_field ? mode_b_reg : mode_a_reg;
-wire [NCO_PHASE_W-1:0] dac_offset = rom_gyro_field
-    ? (rom_mode ? B_DAC_OFFSET_N : B_DAC_OFFSET_R) : (rom_mode ? A_DAC_OFFSET_N : A_DAC_OFFSET_R);
-wire [NCO_PHASE_W-1:0] sense_offset = rom_gyro_field
-    ? (rom_mode ? B_SENSE_OFFSET_N : B_SENSE_OFFSET_R)
-    : (rom_mode ? A_SENSE_OFFSET_N : A_SENSE_OFFSET_R);
-wire [NCO_PHASE_W-1:0] nco_offset =
-    nco_index == 2'd0 ? {NCO_PHASE_W{1'b0}} : nco_index == 2'd1 ? dac_offset : sense_offset;
-wire signed [R_W-1:0] residue = residue_reg[residue_index];
+// The read's reference decoded from the fetched word a clock before it acts (rom field: 1 drive
+// sin, 2 drive cos, 3 transmit cos, 4 sense sin, 5 sense cos), so that a clock runs the phase's
+// adders and the ROM's address, not the field's decoding: the reference's offset (its gyro's
+// and mode's), which of the six truncation errors (one-hot: gyro A's drive, transmit, sense,
+// then gyro B's) and whether it is a cosine.
+wire [2:0] rom_field_next = fetched_reg[2:0];
+wire rom_gyro_next = fetched_reg[57];
+wire rom_mode_next = rom_gyro_next ? mode_b_reg : mode_a_reg;
+wire [1:0] nco_index_next = rom_field_next == 3'd3 ? 2'd1 : (rom_field_next >= 3'd4 ? 2'd2 : 2'd0);
+reg [NCO_PHASE_W-1:0] nco_offset_reg = {NCO_PHASE_W{1'b0}};
+reg [5:0] residue_select_reg = 6'd0;
+reg cosine_reg = 1'b0;
+always @(posedge clk) begin
+    nco_offset_reg <= nco_index_next == 2'd1
+        ? (rom_gyro_next ? (rom_mode_next ? B_DAC_OFFSET_N : B_DAC_OFFSET_R)
+                         : (rom_mode_next ? A_DAC_OFFSET_N : A_DAC_OFFSET_R))
+        : nco_index_next == 2'd2
+        ? (rom_gyro_next ? (rom_mode_next ? B_SENSE_OFFSET_N : B_SENSE_OFFSET_R)
+                         : (rom_mode_next ? A_SENSE_OFFSET_N : A_SENSE_OFFSET_R))
+        : {NCO_PHASE_W{1'b0}};
+    residue_select_reg <= {rom_gyro_next && nco_index_next == 2'd2,
+        rom_gyro_next && nco_index_next == 2'd1, rom_gyro_next && nco_index_next == 2'd0,
+        !rom_gyro_next && nco_index_next == 2'd2, !rom_gyro_next && nco_index_next == 2'd1,
+        !rom_gyro_next && nco_index_next == 2'd0};
+    cosine_reg <= rom_field_next == 3'd2 || rom_field_next == 3'd3 || rom_field_next == 3'd5;
+end
+wire cosine = cosine_reg;
+wire signed [R_W-1:0] residue =
+      ({R_W{residue_select_reg[0]}} & residue_reg[0]) | ({R_W{residue_select_reg[1]}} & residue_reg[1])
+    | ({R_W{residue_select_reg[2]}} & residue_reg[2]) | ({R_W{residue_select_reg[3]}} & residue_reg[3])
+    | ({R_W{residue_select_reg[4]}} & residue_reg[4]) | ({R_W{residue_select_reg[5]}} & residue_reg[5]);
 wire [NCO_PHASE_W-1:0] residue_extended = {{(NCO_PHASE_W - R_W){residue[R_W-1]}}, residue};
 wire [NCO_PHASE_W-1:0] nco_acc = rom_gyro_field ? nco_acc_b_reg : nco_acc_a_reg;
-wire [NCO_PHASE_W-1:0] phase_exact = nco_acc + nco_offset;
+wire [NCO_PHASE_W-1:0] phase_exact = nco_acc + nco_offset_reg;
 wire [NCO_PHASE_W-1:0] phase = NCO_ERROR_FEEDBACK != 0 ? phase_exact + residue_extended
                                                        : phase_exact;
 localparam [R_W-1:0] ONES = {R_W{1'b1}};
@@ -987,14 +1005,31 @@ wire signed [PLL_RND_W-1:0] pll_floor = {acc_reg[PLL_UPD_W-1], acc_reg[PLL_UPD_W
 wire pll_increment = pll_rounded[0] ^ pll_floor[0];
 wire signed [AGC_RND_W-1:0] agc_floor = {acc_reg[AGC_UPD_W-1], acc_reg[AGC_UPD_W-1:AGC_DROP]};
 wire agc_increment = agc_rounded[0] ^ agc_floor[0];
-wire pll_below_a = pll_floor < A_PLL_LOW_LESS || (pll_floor == A_PLL_LOW_LESS && !pll_increment);
-wire pll_above_a = pll_floor > A_PLL_HIGH || (pll_floor == A_PLL_HIGH && pll_increment);
-wire pll_below_b = pll_floor < B_PLL_LOW_LESS || (pll_floor == B_PLL_LOW_LESS && !pll_increment);
-wire pll_above_b = pll_floor > B_PLL_HIGH || (pll_floor == B_PLL_HIGH && pll_increment);
-wire agc_below_a = agc_floor < A_AGC_LOW_LESS || (agc_floor == A_AGC_LOW_LESS && !agc_increment);
-wire agc_above_a = agc_floor > A_AGC_HIGH || (agc_floor == A_AGC_HIGH && agc_increment);
-wire agc_below_b = agc_floor < B_AGC_LOW_LESS || (agc_floor == B_AGC_LOW_LESS && !agc_increment);
-wire agc_above_b = agc_floor > B_AGC_HIGH || (agc_floor == B_AGC_HIGH && agc_increment);
+// Each comparison with a limit in two halves side by side, the upper signed and the lower
+// unsigned (less: the upper less, or equal and the lower less), so that no carry chain runs
+// the whole width: eight of them, and a gyro's choice after, would not meet 24 MHz otherwise.
+localparam integer PLL_H = PLL_RND_W / 2;
+localparam integer AGC_H = AGC_RND_W / 2;
+`define GYROFX_LESS(value, limit, w, h) (($signed(value[w-1:h]) < $signed(limit[w-1:h])) || (value[w-1:h] == limit[w-1:h] && value[h-1:0] < limit[h-1:0]))
+`define GYROFX_MORE(value, limit, w, h) (($signed(value[w-1:h]) > $signed(limit[w-1:h])) || (value[w-1:h] == limit[w-1:h] && value[h-1:0] > limit[h-1:0]))
+wire pll_below_a = `GYROFX_LESS(pll_floor, A_PLL_LOW_LESS, PLL_RND_W, PLL_H)
+    || (pll_floor == A_PLL_LOW_LESS && !pll_increment);
+wire pll_above_a = `GYROFX_MORE(pll_floor, A_PLL_HIGH, PLL_RND_W, PLL_H)
+    || (pll_floor == A_PLL_HIGH && pll_increment);
+wire pll_below_b = `GYROFX_LESS(pll_floor, B_PLL_LOW_LESS, PLL_RND_W, PLL_H)
+    || (pll_floor == B_PLL_LOW_LESS && !pll_increment);
+wire pll_above_b = `GYROFX_MORE(pll_floor, B_PLL_HIGH, PLL_RND_W, PLL_H)
+    || (pll_floor == B_PLL_HIGH && pll_increment);
+wire agc_below_a = `GYROFX_LESS(agc_floor, A_AGC_LOW_LESS, AGC_RND_W, AGC_H)
+    || (agc_floor == A_AGC_LOW_LESS && !agc_increment);
+wire agc_above_a = `GYROFX_MORE(agc_floor, A_AGC_HIGH, AGC_RND_W, AGC_H)
+    || (agc_floor == A_AGC_HIGH && agc_increment);
+wire agc_below_b = `GYROFX_LESS(agc_floor, B_AGC_LOW_LESS, AGC_RND_W, AGC_H)
+    || (agc_floor == B_AGC_LOW_LESS && !agc_increment);
+wire agc_above_b = `GYROFX_MORE(agc_floor, B_AGC_HIGH, AGC_RND_W, AGC_H)
+    || (agc_floor == B_AGC_HIGH && agc_increment);
+`undef GYROFX_LESS
+`undef GYROFX_MORE
 // v_reg's next value at either PI's point: the point's rounded update and limits chosen first
 // (the point and its gyro are known early), the comparisons last.
 wire pll_point = quantize_field == 4'd5;
@@ -1282,7 +1317,11 @@ always @(posedge clk) begin
     if (rom_en) begin
         ref_negative_reg <= t[T_W-1];
         if (cosine && NCO_ERROR_FEEDBACK != 0) begin
-            residue_reg[residue_index] <= phase[R_W-1:0] ^ HALF_BIN;
+            for (r = 0; r < 6; r = r + 1) begin
+                if (residue_select_reg[r]) begin
+                    residue_reg[r] <= phase[R_W-1:0] ^ HALF_BIN;
+                end
+            end
         end
     end
     if (executing_reg && advance_field) begin

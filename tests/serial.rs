@@ -351,14 +351,14 @@ fn the_serial_variants_fed_one_clock_too_soon_stop_the_simulation() {
     }
 }
 
-/// `architecture = "serial"` makes the system `gyrofx_system_serial`: both folded loops feeding
-/// the serial chain. Its vectors (the parallel system's closed run, the chain's outputs
+/// `architecture = "serial"` makes the system `gyrofx_system_serial`: both gyros' loops on one
+/// folded datapath (`gyrofx_gyro_pair_serial`) feeding the serial chain. Its vectors (the parallel system's closed run, the chain's outputs
 /// `chain_delay_samples` lines later) pass bit-exact in Verilator and against the C model
 /// through DPI-C; Verilator runs them again with the last one's `estimated` flipped and fails at
 /// that sample only; Icarus, Verilator and GHDL fail at a flipped bit early on. GHDL's run of
 /// every sample (4.5 min of CPU, the longest of the suite) runs with `GYROFX_SLOW_TESTS=1`
-/// (offline; CI's budget): the VHDL loops run whole in the folded loop's test, and the system's
-/// VHDL adds the wiring and the publication delay.
+/// (offline; CI's budget): the pair's VHDL is the system's alone, so its run up to sample 700
+/// is the VHDL pair's CI check.
 #[test]
 fn the_folded_system_passes_the_system_vectors_and_a_flipped_bit_fails() {
     let dir = tempfile::tempdir().unwrap();
@@ -367,23 +367,29 @@ fn the_folded_system_passes_the_system_vectors_and_a_flipped_bit_fails() {
     let system = &m["system"];
     assert_eq!(system["architecture"], "serial");
     assert_eq!(system["module"], "gyrofx_system_serial");
-    // Every output the clock after the folded loops' (the chain's modes change then), every
-    // ADC sample; the chain's results the fewest samples later that cover its program.
-    let loop_clocks = m["gyro_loop"]["latency_clocks"].as_u64().unwrap();
-    assert_eq!(system["latency_clocks"].as_u64().unwrap(), loop_clocks + 1);
+    // Both loops on one folded datapath, every sample within 120 clocks (a 200 kHz ADC at
+    // 24 MHz); every output the clock after the pair's longest sample (fetch and decode, then
+    // the outputs), every ADC sample; the chain's results after the pair's deferred segments
+    // and the fewest samples that cover its program.
+    let pair = &system["folded_loops"];
+    assert_eq!(pair["module"], "gyrofx_gyro_pair_serial");
+    let pair_clocks = pair["longest_sample_words"].as_u64().unwrap() + 3;
+    assert!(pair_clocks <= 120, "{pair}");
+    assert_eq!(system["latency_clocks"].as_u64().unwrap(), pair_clocks);
     assert_eq!(
         system["min_clocks_per_sample"].as_u64().unwrap(),
-        loop_clocks + 1
+        pair_clocks
     );
     let chain = system["serial_chain"]["latency_clocks"].as_u64().unwrap();
     let delay = system["chain_delay_samples"].as_u64().unwrap();
-    assert_eq!(delay, (chain + 1).div_ceil(loop_clocks + 1));
+    let segments = pair["deferred_segments"].as_u64().unwrap();
+    assert_eq!(delay, segments + (chain + 1).div_ceil(pair_clocks));
     let folder = std::path::Path::new(&out).join("system");
     for file in [
         "tb_gyrofx_system_serial.v",
         "tb_gyrofx_system_serial.vhd",
         "system_serial_program.mem",
-        "gyro_loop_schedule.mem",
+        "gyro_pair_schedule.mem",
     ] {
         assert!(folder.join(file).exists(), "{file}");
     }

@@ -413,6 +413,13 @@ impl RtlBlock for System {
                     "ram_words": program.ram_words,
                     "coefficient_words": program.coefficients.len(),
                 })),
+                "folded_loops": job.pair_schedule.as_ref().map(|pair| json!({
+                    "module": "gyrofx_gyro_pair_serial",
+                    "regular_words": pair.regular,
+                    "longest_sample_words": pair.len(),
+                    "deferred_segments": pair.deferred.len(),
+                    "ram_words": pair.ram_words(),
+                })),
                 "schedule": {
                     "interval_length": schedule.interval_length,
                     "intervals": schedule.intervals,

@@ -1283,9 +1283,14 @@ impl Schedule {
     }
 
     /// The segments after the regular part, in the order samples run them: the decimating
-    /// sample's, then the deferred ones.
+    /// sample's (one gyro's; the pair's decimating sample runs only the regular part), then
+    /// the deferred ones.
     pub fn segments(&self) -> impl Iterator<Item = &[Control]> {
-        std::iter::once(&self.controls[self.regular..]).chain(self.deferred.iter().map(|d| &d[..]))
+        let decimating = &self.controls[self.regular..];
+        (!decimating.is_empty())
+            .then_some(decimating)
+            .into_iter()
+            .chain(self.deferred.iter().map(|d| &d[..]))
     }
 
     /// The schedule ROM's words: the regular part, then each segment ([`Schedule::segments`])

@@ -322,3 +322,24 @@ fn a_control_word_packs_its_fields_at_their_offsets() {
         1 << 42 | 5 << 43 | 5 << 50 | 15 << 53 | 1 << 62 | 1 << 63
     );
 }
+
+/// The schedule ROM's layout: the regular part, then each segment at
+/// `regular + k·(len − regular)` (the RTL's addresses); one gyro's ROM is its controls.
+#[test]
+fn the_rom_holds_the_regular_part_then_each_segment_at_its_base() {
+    let plan = Plan::new(&Spec::paper_004()).unwrap();
+    let one = Schedule::new(&plan).unwrap();
+    assert_eq!(one.rom_words(), one.controls);
+    let pair = Schedule::pair(&plan).unwrap();
+    let words = pair.rom_words();
+    let segment = pair.len() - pair.regular;
+    assert_eq!(words.len(), pair.regular + pair.deferred.len() * segment);
+    assert_eq!(words[..pair.regular], pair.controls[..]);
+    for (k, d) in pair.deferred.iter().enumerate() {
+        let base = pair.regular + k * segment;
+        assert_eq!(words[base..base + d.len()], d[..], "segment {k}");
+        assert!(words[base + d.len()..base + segment]
+            .iter()
+            .all(|w| *w == Control::default()));
+    }
+}
