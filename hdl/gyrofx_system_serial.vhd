@@ -1,9 +1,9 @@
 -- Language: VHDL-2008
 
 -- gyrofx_system_serial — the whole mode-reversal gyro at the ADC rate, folded: gyro A's and
--- B's folded loops (gyrofx_gyro_loop_serial) feeding the time-multiplexed chain
--- (gyrofx_top_serial), whose sequencer commands the loops' modes, wired as gyrofx_system wires
--- gyrofx_gyro_loop and gyrofx_top (architecture = "serial").
+-- B's loops on one folded datapath (gyrofx_gyro_pair_serial) feeding the time-multiplexed
+-- chain (gyrofx_top_serial's sequencer and engine), whose sequencer commands the loops' modes,
+-- wired as gyrofx_system wires gyrofx_gyro_loop and gyrofx_top (architecture = "serial").
 --
 -- Purpose: the VHDL twin of gyrofx_system_serial.v (same generics, ports and timing):
 --   gyrofx_system on a small FPGA, bit-exact with it except that the chain's results show
@@ -19,21 +19,31 @@
 --   outputs rate_out, out_valid (a one-clock pulse), bias_a, bias_b, estimated load what the
 --   chain made of them.
 --
--- Why the delay: a folded loop takes SCHEDULE_LEN + 2 clocks an ADC sample; the serial chain
---   takes its program's clocks (over a thousand) a chain sample and runs beside the loops
---   over many ADC samples. Its sequencer's modes change the clock after it takes a sample, in
---   time for the next ADC sample; its results come within some later ADC sample that depends
---   on the ce cadence. The system publishes them a fixed number of ADC samples later instead,
---   CHAIN_DELAY_SAMPLES = ceil((chain clocks + margin) / (SCHEDULE_LEN + 3))
+-- Why the delay: the folded pair takes up to SCHEDULE_LEN + 2 clocks an ADC sample and makes
+--   a decimation's rates SCHEDULE_SEGMENTS ADC samples after the sample that decimates; the
+--   serial chain takes its program's clocks (over a thousand) a chain sample and runs beside
+--   the loops over many ADC samples. Its sequencer takes the sample at the end of the
+--   decimating ADC sample, so that its modes change in time for the next one, as in
+--   gyrofx_system; its engine starts when the rates are made, on the sequencer's flags as of
+--   the take, and its results come within some later ADC sample that depends on the ce
+--   cadence. The system publishes them a fixed number of ADC samples later instead,
+--   CHAIN_DELAY_SAMPLES = SCHEDULE_SEGMENTS + ceil((chain clocks + margin) / (SCHEDULE_LEN + 3))
 --   (gyrofx_job::pipeline::system_chain_delay), whatever the cadence; the engine holds its
 --   results until then. CHAIN_DELAY_SAMPLES <= CIC_DECIMATION: the chain finishes between
 --   chain samples.
 --
 -- Timing: ce at most every SCHEDULE_LEN + 3 clocks. Every output shows SCHEDULE_LEN + 3
---   clocks after ce: dac_*, locked_* load with the loops' and hold until the next sample's;
---   mode_a, mode_b and the published chain outputs load at the loops' output clock,
---   SCHEDULE_LEN + 2 clocks after ce, and hold otherwise (out_valid for one clock). A clock
---   with rst high clears every register and the pending publication.
+--   clocks after ce: dac_*, locked_* load with the loops' (by SCHEDULE_LEN + 2 clocks) and
+--   hold until the next sample's; mode_a, mode_b (the modes of the next sample) and the
+--   published chain outputs load at the loops' output clock, SCHEDULE_LEN + 2 clocks after
+--   ce, and hold otherwise (out_valid for one clock). A clock with rst high clears every
+--   register and the pending publication.
+--
+-- Generics: the chain's as gyrofx_top_serial's (its program and coefficient ROMs are the
+--   system chain's), IN_F the loops' output fraction bits; the loops' as gyrofx_system's
+--   (shared ones once, ROUNDING, SATURATE, LATENCY as LOOP_*, per gyro with the prefix A_ or
+--   B_), plus the folded pair's schedule (both gyros' loops have the same formats);
+--   CHAIN_DELAY_SAMPLES.
 
 library ieee;
 use ieee.std_logic_1164.all;
@@ -196,15 +206,16 @@ entity gyrofx_system_serial is
         B_LOCK_Q_R : std_logic_vector := 64x"b70271b";
         B_LOCK_A_N : std_logic_vector := 64x"68db574";
         B_LOCK_A_R : std_logic_vector := 64x"68db574";
-        -- loops: the folded schedule (one for both gyros): image, words, words of a sample
-        -- that does not decimate, RAM words
-        SCHEDULE_FILE : string := "gyro_loop_schedule.mem";
-        SCHEDULE_LEN : positive := 114;
-        SCHEDULE_REGULAR : positive := 54;
-        RAM_WORDS : positive := 28;
+        -- loops: the folded pair's schedule (gyrofx_gyro_pair_serial): image, words of the
+        -- longest sample, of the regular part, deferred segments, RAM words
+        SCHEDULE_FILE : string := "gyro_pair_schedule.mem";
+        SCHEDULE_LEN : positive := 117;
+        SCHEDULE_REGULAR : positive := 103;
+        SCHEDULE_SEGMENTS : positive := 13;
+        RAM_WORDS : positive := 64;
         -- ADC samples from the one whose rates the chain takes to the one that publishes its
         -- outputs (1..CIC_DECIMATION; gyrofx_job::pipeline::system_chain_delay)
-        CHAIN_DELAY_SAMPLES : positive := 14
+        CHAIN_DELAY_SAMPLES : positive := 26
     );
     port (
         clk       : in  std_logic;
@@ -247,7 +258,31 @@ architecture rtl of gyrofx_system_serial is
     signal loop_mode_b : std_logic;
     signal rate_a : signed(IN_W - 1 downto 0);
     signal rate_b : signed(IN_W - 1 downto 0);
-    signal loop_valid : std_logic;
+    signal decimating : std_logic;
+    signal rates_valid : std_logic;
+
+    -- The chain's sequencer: its take and its description of the sample taken.
+    signal take : std_logic;
+    signal blank_a : std_logic;
+    signal blank_b : std_logic;
+    signal interval_a : unsigned(INTERVAL_W - 1 downto 0);
+    signal interval_b : unsigned(INTERVAL_W - 1 downto 0);
+    signal done_a : std_logic;
+    signal done_b : std_logic;
+    signal window_done : std_logic;
+    -- That description, held for the engine, and whether a take waits for its rates.
+    signal taken_reg : std_logic := '0';
+    signal taken_bw_sel_reg : unsigned(SEL_W - 1 downto 0) := (others => '0');
+    signal taken_mode_a_reg : std_logic := '1';
+    signal taken_mode_b_reg : std_logic := '1';
+    signal taken_blank_a_reg : std_logic := '0';
+    signal taken_blank_b_reg : std_logic := '0';
+    signal taken_interval_a_reg : unsigned(INTERVAL_W - 1 downto 0) := (others => '0');
+    signal taken_interval_b_reg : unsigned(INTERVAL_W - 1 downto 0) := (others => '0');
+    signal taken_done_a_reg : std_logic := '0';
+    signal taken_done_b_reg : std_logic := '0';
+    signal taken_window_done_reg : std_logic := '0';
+
     signal chain_ce : std_logic;
     signal chain_rate : signed(OUT_W - 1 downto 0);
     signal chain_valid : std_logic;
@@ -258,10 +293,12 @@ architecture rtl of gyrofx_system_serial is
     -- Clocks since ce, up to the output clock (0: none in flight).
     signal count_reg : natural range 0 to LOOP_CLOCKS := 0;
     signal output_clock : std_logic;
-    -- Output clocks until the chain's last take is published (0: none pending), and whether
-    -- the engine has pulsed out_valid since it took it (not when both gyros were blanked).
+    -- Output clocks until the chain's last take is published (0: none pending), whether the
+    -- engine has pulsed out_valid since it took it (not when both gyros were blanked), and
+    -- whether a take of this sample waits for its output clock.
     signal pending_reg : natural range 0 to CHAIN_DELAY_SAMPLES := 0;
     signal chain_valid_reg : std_logic := '0';
+    signal take_pending_reg : std_logic := '0';
     signal publish : std_logic;
 
     signal out_valid_reg : std_logic := '0';
@@ -276,6 +313,18 @@ begin
         report "gyrofx_system_serial: CHAIN_DELAY_SAMPLES (" & integer'image(CHAIN_DELAY_SAMPLES)
             & ") must be 1..CIC_DECIMATION (" & integer'image(CIC_DECIMATION)
             & "): the chain finishes between chain samples"
+        severity failure;
+    assert ROM_DEPTH <= 2 ** SEL_W
+        report "gyrofx_system_serial: ROM_DEPTH (" & integer'image(ROM_DEPTH)
+            & ") must be 1..2^SEL_W (" & integer'image(2 ** SEL_W) & ")"
+        severity failure;
+    -- The folded pair gives both gyros one datapath: one set of formats.
+    assert A_PLL_KP_W = B_PLL_KP_W and A_PLL_KP_F = B_PLL_KP_F and A_PLL_KI_W = B_PLL_KI_W
+        and A_PLL_KI_F = B_PLL_KI_F and A_AGC_KP_W = B_AGC_KP_W and A_AGC_KP_F = B_AGC_KP_F
+        and A_AGC_KI_W = B_AGC_KI_W and A_AGC_KI_F = B_AGC_KI_F and A_COEF_W = B_COEF_W
+        and A_COEF_F = B_COEF_F
+        report "gyrofx_system_serial: gyro A's and B's loops must share their gains' and 1/SF "
+            & "coefficients' formats (one folded datapath)"
         severity failure;
 
     process (clk)
@@ -295,7 +344,7 @@ begin
     loop_mode_a <= chain_mode_a when enable = '1' else '1';
     loop_mode_b <= chain_mode_b when enable = '1' else '1';
 
-    loop_a : entity work.gyrofx_gyro_loop_serial
+    loops : entity work.gyrofx_gyro_pair_serial
         generic map (
             NCO_PHASE_W => NCO_PHASE_W, NCO_ADDR_W => NCO_ADDR_W, NCO_SIN_W => NCO_SIN_W,
             NCO_ERROR_FEEDBACK => NCO_ERROR_FEEDBACK,
@@ -307,103 +356,120 @@ begin
             PLL_ERR_F => PLL_ERR_F, PLL_KP_W => A_PLL_KP_W, PLL_KP_F => A_PLL_KP_F,
             PLL_KI_W => A_PLL_KI_W, PLL_KI_F => A_PLL_KI_F, PLL_INT_W => PLL_INT_W,
             PLL_INT_F => PLL_INT_F, PLL_OUT_W => PLL_OUT_W, PLL_OUT_F => PLL_OUT_F,
-            PLL_KP => A_PLL_KP, PLL_KI => A_PLL_KI, PLL_INT_MIN => A_PLL_INT_MIN,
-            PLL_INT_MAX => A_PLL_INT_MAX, AGC_ERR_W => AGC_ERR_W, AGC_ERR_F => AGC_ERR_F,
-            AGC_KP_W => A_AGC_KP_W, AGC_KP_F => A_AGC_KP_F, AGC_KI_W => A_AGC_KI_W,
-            AGC_KI_F => A_AGC_KI_F, AGC_INT_W => AGC_INT_W, AGC_INT_F => AGC_INT_F,
-            AGC_OUT_W => AGC_OUT_W, AGC_OUT_F => AGC_OUT_F, AGC_KP => A_AGC_KP,
-            AGC_KI => A_AGC_KI, AGC_INT_MIN => A_AGC_INT_MIN, AGC_INT_MAX => A_AGC_INT_MAX,
+            AGC_ERR_W => AGC_ERR_W, AGC_ERR_F => AGC_ERR_F, AGC_KP_W => A_AGC_KP_W,
+            AGC_KP_F => A_AGC_KP_F, AGC_KI_W => A_AGC_KI_W, AGC_KI_F => A_AGC_KI_F,
+            AGC_INT_W => AGC_INT_W, AGC_INT_F => AGC_INT_F, AGC_OUT_W => AGC_OUT_W,
+            AGC_OUT_F => AGC_OUT_F,
             CIC_IN_W => CIC_IN_W, CIC_IN_F => CIC_IN_F, CIC_STAGES => CIC_STAGES,
             CIC_DECIMATION => CIC_DECIMATION, CIC_DELAY => CIC_DELAY, CIC_SHIFT => CIC_SHIFT,
             CIC_MID_W => CIC_MID_W, CIC_MID_F => CIC_MID_F, CIC_TAPS => CIC_TAPS,
             CIC_COEF_W => CIC_COEF_W, CIC_COEF_F => CIC_COEF_F, CIC_OUT_W => CIC_OUT_W,
             CIC_OUT_F => CIC_OUT_F, DAC_W => DAC_W, DAC_F => DAC_F, OUT_W => IN_W,
             OUT_F => IN_F, COEF_W => A_COEF_W, COEF_F => A_COEF_F, LATENCY => LOOP_LATENCY,
-            LOCK_SHIFT => LOCK_SHIFT, LOCK_HOLD => LOCK_HOLD, SETPOINT_N => A_SETPOINT_N,
-            SETPOINT_R => A_SETPOINT_R, FREQ_WORD_N => A_FREQ_WORD_N,
-            FREQ_WORD_R => A_FREQ_WORD_R, PLL_PRESET_N => A_PLL_PRESET_N,
-            PLL_PRESET_R => A_PLL_PRESET_R, DAC_OFFSET_N => A_DAC_OFFSET_N,
-            DAC_OFFSET_R => A_DAC_OFFSET_R, SENSE_OFFSET_N => A_SENSE_OFFSET_N,
-            SENSE_OFFSET_R => A_SENSE_OFFSET_R, RATE_COEF_N => A_RATE_COEF_N,
-            RATE_COEF_R => A_RATE_COEF_R, QUAD_COEF_N => A_QUAD_COEF_N,
-            QUAD_COEF_R => A_QUAD_COEF_R, LOCK_Q_N => A_LOCK_Q_N, LOCK_Q_R => A_LOCK_Q_R,
-            LOCK_A_N => A_LOCK_A_N, LOCK_A_R => A_LOCK_A_R, ROUNDING => LOOP_ROUNDING,
-            SATURATE => LOOP_SATURATE, NCO_ROM_FILE => NCO_ROM_FILE,
-            CIC_ROM_FILE => CIC_ROM_FILE,
-            SCHEDULE_FILE => SCHEDULE_FILE, SCHEDULE_LEN => SCHEDULE_LEN,
-            SCHEDULE_REGULAR => SCHEDULE_REGULAR, RAM_WORDS => RAM_WORDS
+            LOCK_SHIFT => LOCK_SHIFT, LOCK_HOLD => LOCK_HOLD,
+            A_PLL_KP => A_PLL_KP, A_PLL_KI => A_PLL_KI, A_PLL_INT_MIN => A_PLL_INT_MIN,
+            A_PLL_INT_MAX => A_PLL_INT_MAX, A_AGC_KP => A_AGC_KP, A_AGC_KI => A_AGC_KI,
+            A_AGC_INT_MIN => A_AGC_INT_MIN, A_AGC_INT_MAX => A_AGC_INT_MAX,
+            A_SETPOINT_N => A_SETPOINT_N, A_SETPOINT_R => A_SETPOINT_R,
+            A_FREQ_WORD_N => A_FREQ_WORD_N, A_FREQ_WORD_R => A_FREQ_WORD_R,
+            A_PLL_PRESET_N => A_PLL_PRESET_N, A_PLL_PRESET_R => A_PLL_PRESET_R,
+            A_DAC_OFFSET_N => A_DAC_OFFSET_N, A_DAC_OFFSET_R => A_DAC_OFFSET_R,
+            A_SENSE_OFFSET_N => A_SENSE_OFFSET_N, A_SENSE_OFFSET_R => A_SENSE_OFFSET_R,
+            A_RATE_COEF_N => A_RATE_COEF_N, A_RATE_COEF_R => A_RATE_COEF_R,
+            A_QUAD_COEF_N => A_QUAD_COEF_N, A_QUAD_COEF_R => A_QUAD_COEF_R,
+            A_LOCK_Q_N => A_LOCK_Q_N, A_LOCK_Q_R => A_LOCK_Q_R, A_LOCK_A_N => A_LOCK_A_N,
+            A_LOCK_A_R => A_LOCK_A_R,
+            B_PLL_KP => B_PLL_KP, B_PLL_KI => B_PLL_KI, B_PLL_INT_MIN => B_PLL_INT_MIN,
+            B_PLL_INT_MAX => B_PLL_INT_MAX, B_AGC_KP => B_AGC_KP, B_AGC_KI => B_AGC_KI,
+            B_AGC_INT_MIN => B_AGC_INT_MIN, B_AGC_INT_MAX => B_AGC_INT_MAX,
+            B_SETPOINT_N => B_SETPOINT_N, B_SETPOINT_R => B_SETPOINT_R,
+            B_FREQ_WORD_N => B_FREQ_WORD_N, B_FREQ_WORD_R => B_FREQ_WORD_R,
+            B_PLL_PRESET_N => B_PLL_PRESET_N, B_PLL_PRESET_R => B_PLL_PRESET_R,
+            B_DAC_OFFSET_N => B_DAC_OFFSET_N, B_DAC_OFFSET_R => B_DAC_OFFSET_R,
+            B_SENSE_OFFSET_N => B_SENSE_OFFSET_N, B_SENSE_OFFSET_R => B_SENSE_OFFSET_R,
+            B_RATE_COEF_N => B_RATE_COEF_N, B_RATE_COEF_R => B_RATE_COEF_R,
+            B_QUAD_COEF_N => B_QUAD_COEF_N, B_QUAD_COEF_R => B_QUAD_COEF_R,
+            B_LOCK_Q_N => B_LOCK_Q_N, B_LOCK_Q_R => B_LOCK_Q_R, B_LOCK_A_N => B_LOCK_A_N,
+            B_LOCK_A_R => B_LOCK_A_R,
+            ROUNDING => LOOP_ROUNDING, SATURATE => LOOP_SATURATE, NCO_ROM_FILE => NCO_ROM_FILE,
+            CIC_ROM_FILE => CIC_ROM_FILE, SCHEDULE_FILE => SCHEDULE_FILE,
+            SCHEDULE_LEN => SCHEDULE_LEN, SCHEDULE_REGULAR => SCHEDULE_REGULAR,
+            SCHEDULE_SEGMENTS => SCHEDULE_SEGMENTS, RAM_WORDS => RAM_WORDS
         )
         port map (
-            clk => clk, rst => rst, ce => ce, mode => loop_mode_a, adc_x => adc_a_x,
-            adc_y => adc_a_y, dac_x => dac_a_x, dac_y => dac_a_y, rate => rate_a,
-            quadrature => open, out_valid => loop_valid, locked => locked_a
+            clk => clk, rst => rst, ce => ce, mode_a => loop_mode_a, mode_b => loop_mode_b,
+            adc_a_x => adc_a_x, adc_a_y => adc_a_y, adc_b_x => adc_b_x, adc_b_y => adc_b_y,
+            dac_a_x => dac_a_x, dac_a_y => dac_a_y, dac_b_x => dac_b_x, dac_b_y => dac_b_y,
+            locked_a => locked_a, locked_b => locked_b, decimating => decimating,
+            rate_a => rate_a, quadrature_a => open, rate_b => rate_b, quadrature_b => open,
+            out_valid => rates_valid
         );
 
-    -- B decimates by the same factor from the same reset, on the same schedule: its out_valid is
-    -- A's.
-    loop_b : entity work.gyrofx_gyro_loop_serial
-        generic map (
-            NCO_PHASE_W => NCO_PHASE_W, NCO_ADDR_W => NCO_ADDR_W, NCO_SIN_W => NCO_SIN_W,
-            NCO_ERROR_FEEDBACK => NCO_ERROR_FEEDBACK,
-            DEMOD_ADC_W => DEMOD_ADC_W, DEMOD_ADC_F => DEMOD_ADC_F, DEMOD_REF_W => DEMOD_REF_W,
-            DEMOD_REF_F => DEMOD_REF_F, DEMOD_PROD_W => DEMOD_PROD_W,
-            DEMOD_PROD_F => DEMOD_PROD_F, DEMOD_STATE_W => DEMOD_STATE_W,
-            DEMOD_STATE_F => DEMOD_STATE_F, DEMOD_OUT_W => DEMOD_OUT_W,
-            DEMOD_OUT_F => DEMOD_OUT_F, DEMOD_SHIFT => DEMOD_SHIFT, PLL_ERR_W => PLL_ERR_W,
-            PLL_ERR_F => PLL_ERR_F, PLL_KP_W => B_PLL_KP_W, PLL_KP_F => B_PLL_KP_F,
-            PLL_KI_W => B_PLL_KI_W, PLL_KI_F => B_PLL_KI_F, PLL_INT_W => PLL_INT_W,
-            PLL_INT_F => PLL_INT_F, PLL_OUT_W => PLL_OUT_W, PLL_OUT_F => PLL_OUT_F,
-            PLL_KP => B_PLL_KP, PLL_KI => B_PLL_KI, PLL_INT_MIN => B_PLL_INT_MIN,
-            PLL_INT_MAX => B_PLL_INT_MAX, AGC_ERR_W => AGC_ERR_W, AGC_ERR_F => AGC_ERR_F,
-            AGC_KP_W => B_AGC_KP_W, AGC_KP_F => B_AGC_KP_F, AGC_KI_W => B_AGC_KI_W,
-            AGC_KI_F => B_AGC_KI_F, AGC_INT_W => AGC_INT_W, AGC_INT_F => AGC_INT_F,
-            AGC_OUT_W => AGC_OUT_W, AGC_OUT_F => AGC_OUT_F, AGC_KP => B_AGC_KP,
-            AGC_KI => B_AGC_KI, AGC_INT_MIN => B_AGC_INT_MIN, AGC_INT_MAX => B_AGC_INT_MAX,
-            CIC_IN_W => CIC_IN_W, CIC_IN_F => CIC_IN_F, CIC_STAGES => CIC_STAGES,
-            CIC_DECIMATION => CIC_DECIMATION, CIC_DELAY => CIC_DELAY, CIC_SHIFT => CIC_SHIFT,
-            CIC_MID_W => CIC_MID_W, CIC_MID_F => CIC_MID_F, CIC_TAPS => CIC_TAPS,
-            CIC_COEF_W => CIC_COEF_W, CIC_COEF_F => CIC_COEF_F, CIC_OUT_W => CIC_OUT_W,
-            CIC_OUT_F => CIC_OUT_F, DAC_W => DAC_W, DAC_F => DAC_F, OUT_W => IN_W,
-            OUT_F => IN_F, COEF_W => B_COEF_W, COEF_F => B_COEF_F, LATENCY => LOOP_LATENCY,
-            LOCK_SHIFT => LOCK_SHIFT, LOCK_HOLD => LOCK_HOLD, SETPOINT_N => B_SETPOINT_N,
-            SETPOINT_R => B_SETPOINT_R, FREQ_WORD_N => B_FREQ_WORD_N,
-            FREQ_WORD_R => B_FREQ_WORD_R, PLL_PRESET_N => B_PLL_PRESET_N,
-            PLL_PRESET_R => B_PLL_PRESET_R, DAC_OFFSET_N => B_DAC_OFFSET_N,
-            DAC_OFFSET_R => B_DAC_OFFSET_R, SENSE_OFFSET_N => B_SENSE_OFFSET_N,
-            SENSE_OFFSET_R => B_SENSE_OFFSET_R, RATE_COEF_N => B_RATE_COEF_N,
-            RATE_COEF_R => B_RATE_COEF_R, QUAD_COEF_N => B_QUAD_COEF_N,
-            QUAD_COEF_R => B_QUAD_COEF_R, LOCK_Q_N => B_LOCK_Q_N, LOCK_Q_R => B_LOCK_Q_R,
-            LOCK_A_N => B_LOCK_A_N, LOCK_A_R => B_LOCK_A_R, ROUNDING => LOOP_ROUNDING,
-            SATURATE => LOOP_SATURATE, NCO_ROM_FILE => NCO_ROM_FILE,
-            CIC_ROM_FILE => CIC_ROM_FILE,
-            SCHEDULE_FILE => SCHEDULE_FILE, SCHEDULE_LEN => SCHEDULE_LEN,
-            SCHEDULE_REGULAR => SCHEDULE_REGULAR, RAM_WORDS => RAM_WORDS
-        )
-        port map (
-            clk => clk, rst => rst, ce => ce, mode => loop_mode_b, adc_x => adc_b_x,
-            adc_y => adc_b_y, dac_x => dac_b_x, dac_y => dac_b_y, rate => rate_b,
-            quadrature => open, out_valid => open, locked => locked_b
-        );
+    -- The chain: its sequencer takes the sample at the end of the decimating ADC sample (its
+    -- modes change the clock after, in time for the next ADC sample, as in gyrofx_system);
+    -- the engine (gyrofx_top_serial's, one shared multiplier) starts when the loops' deferred
+    -- work has made that sample's rates, SCHEDULE_SEGMENTS ADC samples later, on the
+    -- sequencer's flags and the bw_sel as of the take.
+    take <= decimating and enable_reg;
 
-    -- The chain takes the loops' rates at their output clock; its modes change the clock after.
-    chain_ce <= loop_valid and enable_reg;
-
-    chain : entity work.gyrofx_top_serial
+    sequencer : entity work.gyrofx_sequencer
         generic map (
             INTERVAL_LENGTH => INTERVAL_LENGTH, INTERVALS => INTERVALS, PATTERN => PATTERN,
-            BLANK => BLANK, STAGGER => STAGGER, PHASE_W => PHASE_W, INTERVAL_W => INTERVAL_W,
-            IN_W => IN_W, OUT_W => OUT_W, BIAS_W => BIAS_W, SEL_W => SEL_W,
-            ROM_DEPTH => ROM_DEPTH, ACC_W => ACC_W, ADDR_W => ADDR_W, COEF_ADDR_W => COEF_ADDR_W,
-            RAM_DEPTH => RAM_DEPTH, COEF_DEPTH => COEF_DEPTH, PROGRAM_DEPTH => PROGRAM_DEPTH,
-            RAM_INDEX_SHIFT => RAM_INDEX_SHIFT, COEF_INDEX_SHIFT => COEF_INDEX_SHIFT,
-            ROUNDING => ROUNDING, PROGRAM_FILE => PROGRAM_FILE,
-            COEFFICIENT_FILE => COEFFICIENT_FILE
+            BLANK => BLANK, STAGGER => STAGGER, PHASE_W => PHASE_W, INTERVAL_W => INTERVAL_W
         )
         port map (
-            clk => clk, rst => rst, ce => chain_ce, bw_sel => bw_sel_reg, y_a => rate_a,
-            y_b => rate_b, mode_a => chain_mode_a, mode_b => chain_mode_b,
-            rate_out => chain_rate, out_valid => chain_valid, bias_a => chain_bias_a,
-            bias_b => chain_bias_b, estimated => chain_estimated
+            clk => clk, rst => rst, ce => take,
+            mode_a => chain_mode_a, mode_b => chain_mode_b, blank_a => blank_a,
+            blank_b => blank_b, interval_a => interval_a, interval_b => interval_b,
+            done_a => done_a, done_b => done_b, window_done => window_done
+        );
+
+    -- The sequencer's description of the taken sample, held for the engine, and whether a
+    -- take waits for its rates.
+    process (clk)
+    begin
+        if rising_edge(clk) then
+            if take = '1' then
+                taken_reg <= '1';
+                taken_bw_sel_reg <= bw_sel_reg;
+                taken_mode_a_reg <= chain_mode_a;
+                taken_mode_b_reg <= chain_mode_b;
+                taken_blank_a_reg <= blank_a;
+                taken_blank_b_reg <= blank_b;
+                taken_interval_a_reg <= interval_a;
+                taken_interval_b_reg <= interval_b;
+                taken_done_a_reg <= done_a;
+                taken_done_b_reg <= done_b;
+                taken_window_done_reg <= window_done;
+            elsif rates_valid = '1' then
+                taken_reg <= '0';
+            end if;
+            if rst = '1' then
+                taken_reg <= '0';
+            end if;
+        end if;
+    end process;
+
+    chain_ce <= rates_valid and taken_reg;
+
+    engine : entity work.gyrofx_serial_engine
+        generic map (
+            IN_W => IN_W, OUT_W => OUT_W, BIAS_W => BIAS_W, SEL_W => SEL_W,
+            INTERVAL_W => INTERVAL_W, ACC_W => ACC_W, ADDR_W => ADDR_W,
+            COEF_ADDR_W => COEF_ADDR_W, RAM_DEPTH => RAM_DEPTH, COEF_DEPTH => COEF_DEPTH,
+            PROGRAM_DEPTH => PROGRAM_DEPTH, RAM_INDEX_SHIFT => RAM_INDEX_SHIFT,
+            COEF_INDEX_SHIFT => COEF_INDEX_SHIFT, ROUNDING => ROUNDING,
+            PROGRAM_FILE => PROGRAM_FILE, COEFFICIENT_FILE => COEFFICIENT_FILE
+        )
+        port map (
+            clk => clk, rst => rst, ce => chain_ce, bw_sel => taken_bw_sel_reg, y_a => rate_a,
+            y_b => rate_b, mode_a => taken_mode_a_reg, mode_b => taken_mode_b_reg,
+            blank_a => taken_blank_a_reg, blank_b => taken_blank_b_reg,
+            done_a => taken_done_a_reg, done_b => taken_done_b_reg,
+            window_done => taken_window_done_reg, interval_a => taken_interval_a_reg,
+            interval_b => taken_interval_b_reg, rate_out => chain_rate,
+            out_valid => chain_valid, bias_a => chain_bias_a, bias_b => chain_bias_b,
+            estimated => chain_estimated, busy => open
         );
 
     output_clock <= '1' when count_reg = LOOP_CLOCKS else '0';
@@ -419,11 +485,15 @@ begin
             else
                 count_reg <= 0;
             end if;
-            -- A take at the output clock starts the count down; CHAIN_DELAY_SAMPLES output
-            -- clocks later, publish.
+            -- A take (in this sample, before its output clock) starts the count down at the
+            -- output clock; CHAIN_DELAY_SAMPLES output clocks later, publish.
+            if take = '1' then
+                take_pending_reg <= '1';
+            end if;
             if output_clock = '1' then
-                if chain_ce = '1' then
+                if take_pending_reg = '1' or take = '1' then
                     pending_reg <= CHAIN_DELAY_SAMPLES;
+                    take_pending_reg <= '0';
                 elsif pending_reg /= 0 then
                     pending_reg <= pending_reg - 1;
                 end if;
@@ -444,6 +514,7 @@ begin
             if rst = '1' then
                 count_reg <= 0;
                 pending_reg <= 0;
+                take_pending_reg <= '0';
                 chain_valid_reg <= '0';
                 out_valid_reg <= '0';
                 rate_out_reg <= (others => '0');

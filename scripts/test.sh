@@ -133,9 +133,9 @@ ghdl -a --std=08 -Werror -Wunused -Wbinding -Wbody -Wspecs --workdir="$ghdl_work
     hdl/gyrofx_mem_pkg.vhd hdl/gyrofx_quantize.vhd hdl/gyrofx_spacing_check.vhd hdl/gyrofx_kf.vhd hdl/gyrofx_sequencer.vhd \
     hdl/gyrofx_bias_estimator.vhd hdl/gyrofx_calibration.vhd hdl/gyrofx_top.vhd \
     hdl/gyrofx_mean_filter.vhd hdl/gyrofx_mean_filter_serial.vhd hdl/gyrofx_nco.vhd hdl/gyrofx_demodulator.vhd hdl/gyrofx_pi.vhd \
-    hdl/gyrofx_cic.vhd hdl/gyrofx_gyro_loop.vhd hdl/gyrofx_gyro_loop_serial.vhd hdl/gyrofx_system.vhd \
-    hdl/gyrofx_serial_engine.vhd \
-    hdl/gyrofx_top_serial.vhd hdl/gyrofx_testbench_pkg.vhd
+    hdl/gyrofx_cic.vhd hdl/gyrofx_gyro_loop.vhd hdl/gyrofx_gyro_loop_serial.vhd hdl/gyrofx_gyro_pair_serial.vhd \
+    hdl/gyrofx_system.vhd hdl/gyrofx_serial_engine.vhd \
+    hdl/gyrofx_top_serial.vhd hdl/gyrofx_system_serial.vhd hdl/gyrofx_testbench_pkg.vhd
 rm -rf "$ghdl_work"
 # Every Verilator build compiles Verilator's runtime (verilated.cpp and two more: 8.7 of a
 # small testbench's 11 CPU-s) with the same flags: through ccache (verilated.mk's OBJCACHE),

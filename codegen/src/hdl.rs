@@ -136,7 +136,7 @@ pub fn vhdl_sources_of(module: &str) -> Vec<&'static (&'static str, &'static str
 
 /// The reference RTL in VHDL-2008, in compile order (packages first), and the package the VHDL
 /// testbenches share (last: simulation only).
-pub const VHDL_SOURCES: [(&str, &str); 21] = [
+pub const VHDL_SOURCES: [(&str, &str); 22] = [
     (
         "gyrofx_mem_pkg.vhd",
         include_str!("../../hdl/gyrofx_mem_pkg.vhd"),
@@ -185,6 +185,10 @@ pub const VHDL_SOURCES: [(&str, &str); 21] = [
     (
         "gyrofx_gyro_loop_serial.vhd",
         include_str!("../../hdl/gyrofx_gyro_loop_serial.vhd"),
+    ),
+    (
+        "gyrofx_gyro_pair_serial.vhd",
+        include_str!("../../hdl/gyrofx_gyro_pair_serial.vhd"),
     ),
     (
         "gyrofx_system.vhd",
@@ -285,6 +289,7 @@ mod tests {
         let system = names("gyrofx_system");
         let left_out = [
             "gyrofx_gyro_loop_serial.vhd",
+            "gyrofx_gyro_pair_serial.vhd",
             "gyrofx_mean_filter.vhd",
             "gyrofx_mean_filter_serial.vhd",
             "gyrofx_serial_engine.vhd",
@@ -297,11 +302,11 @@ mod tests {
             .filter(|n| !left_out.contains(n))
             .collect();
         assert_eq!(system, expected);
-        // The folded system: both folded loops and the serial chain, not the parallel ones.
+        // The folded system: the folded pair and the serial chain's sequencer and engine, not
+        // the parallel loops and chain, nor the one-gyro folded loop and gyrofx_top_serial.
         let folded = names("gyrofx_system_serial");
         for file in [
-            "gyrofx_gyro_loop_serial.vhd",
-            "gyrofx_top_serial.vhd",
+            "gyrofx_gyro_pair_serial.vhd",
             "gyrofx_serial_engine.vhd",
             "gyrofx_sequencer.vhd",
             "gyrofx_spacing_check.vhd",
@@ -310,7 +315,9 @@ mod tests {
         }
         for file in [
             "gyrofx_gyro_loop.vhd",
+            "gyrofx_gyro_loop_serial.vhd",
             "gyrofx_top.vhd",
+            "gyrofx_top_serial.vhd",
             "gyrofx_system.vhd",
         ] {
             assert!(!folded.contains(&file), "{file}: {folded:?}");
