@@ -40,10 +40,12 @@
  *
  * Timing: ce at most every SCHEDULE_LEN + 3 clocks. Every output shows SCHEDULE_LEN + 3
  *   clocks after ce: dac_*, locked_* load with the loops' (by SCHEDULE_LEN + 2 clocks) and
- *   hold until the next sample's; mode_a, mode_b (the modes of the next sample) and the
- *   published chain outputs load at the loops' output clock, SCHEDULE_LEN + 2 clocks after
- *   ce, and hold otherwise (out_valid for one clock). A clock with rst high clears every
- *   register and the pending publication.
+ *   hold until the next sample's; mode_a, mode_b (the modes of the next sample) change the
+ *   clock after the sequencer's take, at the end of a decimating sample's regular part
+ *   (SCHEDULE_REGULAR + 3 clocks after ce), and hold otherwise; the published chain outputs
+ *   load at the loops' output clock, SCHEDULE_LEN + 2 clocks after ce, and hold otherwise
+ *   (out_valid for one clock). A clock with rst high clears every register and the pending
+ *   publication.
  *
  * Parameters: the chain's as gyrofx_top_serial's (its program and coefficient ROMs are the
  *   system chain's), IN_F the loops' output fraction bits; the loops' as gyrofx_system's

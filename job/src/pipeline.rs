@@ -78,9 +78,9 @@ const PARALLEL_SYSTEM: Pipeline = Pipeline::new(
 );
 
 /// The system as `job` builds it: `gyrofx_system` (the loop's four stages, then the chain's),
-/// or `gyrofx_system_serial`, whose outputs all show the clock after the folded loops' (the
-/// chain takes their rates then and its sequencer's modes change), every ADC sample; the
-/// chain's results come [`system_chain_delay`] samples later, at that same clock.
+/// or `gyrofx_system_serial`, whose outputs all show the clock after the folded pair's longest
+/// sample (its words, each acting two clocks after its fetch), every ADC sample; the chain's
+/// results come [`system_chain_delay`] samples later, at that same clock.
 pub fn system(job: &Job) -> Pipeline {
     match &job.pair_schedule {
         Some(pair) => {
@@ -99,10 +99,11 @@ pub const CHAIN_MARGIN_CLOCKS: u32 = 1;
 /// `out_valid`, `bias_a`, `bias_b`, `estimated`) after the sample whose loop outputs the chain
 /// took (its `CHAIN_DELAY_SAMPLES`); 0 for `gyrofx_system`, which shows them in that sample.
 ///
-/// The serial chain needs `gyrofx_top_serial`'s latency S (clocks) for a sample, while a new ADC
-/// sample may come every `system(job).min_clocks_per_sample` = m clocks: publishing at the
-/// K-th sample after, K = ⌈(S + [`CHAIN_MARGIN_CLOCKS`]) / m⌉, reads finished results whatever
-/// the `ce` cadence (the samples are at least m clocks apart).
+/// The folded pair makes a decimation's rates D samples after the sample that decimates (its
+/// deferred segments), and the serial chain then needs `gyrofx_top_serial`'s latency S
+/// (clocks), while a new ADC sample may come every `system(job).min_clocks_per_sample` = m
+/// clocks: publishing at the K-th sample after, K = D + ⌈(S + [`CHAIN_MARGIN_CLOCKS`]) / m⌉,
+/// reads finished results whatever the `ce` cadence (the samples are at least m clocks apart).
 pub fn system_chain_delay(job: &Job) -> u32 {
     match (&job.system_serial, &job.pair_schedule) {
         (Some(program), Some(pair)) => {
@@ -188,14 +189,16 @@ mod tests {
         assert_eq!(system_chain_delay(&parallel), 0);
         let job = serial();
         let timing = system(&job);
+        let pair = job.pair_schedule.as_ref().unwrap();
         assert_eq!(
             timing.latency_clocks,
-            gyro_loop(&job).latency_clocks + 1,
-            "the modes change the clock after the loops' outputs"
+            pair.len() as u32 + 3,
+            "the outputs the clock after the pair's longest sample's (fetch, decode, words)"
         );
         assert_eq!(timing.min_clocks_per_sample, timing.latency_clocks);
         let chain = job.system_serial.as_ref().unwrap().settle_clocks() + 1;
-        let k = system_chain_delay(&job);
+        // The engine starts when the pair's deferred segments have made the rates.
+        let k = system_chain_delay(&job) - pair.deferred.len() as u32;
         assert!(k * timing.min_clocks_per_sample >= chain + CHAIN_MARGIN_CLOCKS);
         assert!((k - 1) * timing.min_clocks_per_sample < chain + CHAIN_MARGIN_CLOCKS);
         assert!(check_system(&job).is_ok());
