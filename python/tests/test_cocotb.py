@@ -86,16 +86,19 @@ def test_the_serial_blocks_pass_it_and_a_flipped_bit_fails_it(tmp_path):
     assert f", min_clocks_per_sample={spacing})\n" in (folder / "cocotb" / "test_gyro_loop.py").read_text()
     assert_passes(make(folder, "cocotb-gyro_loop", GYROFX_COCOTB_SAMPLES="300"))
     assert_fails(make(folder, "cocotb-gyro_loop", GYROFX_COCOTB_SAMPLES="300", GYROFX_COCOTB_FLIP_EXPECTED="40"), 1)
-    # The folded system: every output after the loops' schedule and a clock, the chain's
+    # The folded system: both gyros' loops on one folded datapath, every output the clock after
+    # its longest sample (within 120 clocks: a 200 kHz ADC at 24 MHz), the chain's
     # chain_delay_samples later, as the Python System (the test's model) has them. Its run is
-    # an estimator window whatever GYROFX_COCOTB_SAMPLES (14 300 samples of 117 clocks, about
+    # an estimator window whatever GYROFX_COCOTB_SAMPLES (14 300 samples of 120 clocks, about
     # 100 s of CPU): run only with GYROFX_SLOW_TESTS=1 (offline; CI's budget), and no
     # flipped-bit run, the scoreboards are those test_one_flipped_expected_bit_fails_it proves on
     # the parallel system.
     system = manifest["system"]
     assert system["module"] == "gyrofx_system_serial"
+    pair = system["folded_loops"]
+    assert pair["module"] == "gyrofx_gyro_pair_serial"
     spacing = system["min_clocks_per_sample"]
-    assert system["latency_clocks"] == spacing == loop["min_clocks_per_sample"] + 1
+    assert system["latency_clocks"] == spacing == pair["longest_sample_words"] + 3 <= 120
     assert f"TIMING = tb.Timing(latency_clocks={spacing}, min_clocks_per_sample={spacing})\n" in (
         folder / "cocotb" / "test_system.py"
     ).read_text()
