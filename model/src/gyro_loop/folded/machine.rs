@@ -459,12 +459,18 @@ impl Machine {
         let mut done = false;
         if let Some(k) = segment {
             let words = if pair {
-                self.schedule.deferred[k].clone()
+                self.schedule.deferred[k].len()
             } else {
-                self.schedule.controls[regular..].to_vec()
+                self.schedule.controls.len() - regular
             };
-            for control in &words {
-                self.clock(control);
+            for t in 0..words {
+                // Copied word by word: the segment is not cloned every sample.
+                let control = if pair {
+                    self.schedule.deferred[k][t]
+                } else {
+                    self.schedule.controls[regular + t]
+                };
+                self.clock(&control);
             }
             done = !pair || k + 1 == self.schedule.deferred.len();
             self.pending = (!done).then_some(k + 1);

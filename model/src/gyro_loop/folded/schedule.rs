@@ -628,6 +628,21 @@ fn lock(words: &Words) -> Template {
     t
 }
 
+/// The combs on the accumulator's value from clock 1 on: `w_j = w_(j−1) − (w_(j−1) one
+/// decimation ago)`, each comb reading its word, subtracting it on the next clock and writing
+/// the new value there. Returns the clock of the last comb's sum (1 with no comb).
+fn comb_chain(t: &mut Template, combs: &[u8]) -> u32 {
+    let mut op = 1;
+    for (j, &word) in combs.iter().enumerate() {
+        let read_clock = 1 + j as u32;
+        t.read(read_clock, word, ReadGate::Seen, 1);
+        op = read_clock + 1;
+        t.accumulate(op, AccX::Keep, AccY::NegRead);
+        t.write(op, word, WriteData::AccCic);
+    }
+    op
+}
+
 /// CIC `channel`'s decimation: the combs, the compensator, the `1/SF` product.
 fn cic(channel: usize, widths: &Widths, words: &Words, taps: usize) -> Template {
     let name = ["CIC I", "CIC Q"][channel];
@@ -640,17 +655,8 @@ fn cic(channel: usize, widths: &Widths, words: &Words, taps: usize) -> Template 
         0,
     );
     t.accumulate(1, AccX::Read, AccY::Zero);
-    // w_j = w_(j−1) − (w_(j−1) one decimation ago): each comb reads its word, subtracts it
-    // on the next clock and writes the new value there.
-    let mut read_clock = 1;
-    let mut op = 1;
-    for &word in &words.combs[channel] {
-        t.read(read_clock, word, ReadGate::Seen, 1);
-        op = read_clock + 1;
-        t.accumulate(op, AccX::Keep, AccY::NegRead);
-        t.write(op, word, WriteData::AccCic);
-        read_clock += 1;
-    }
+    let op = comb_chain(&mut t, &words.combs[channel]);
+    let read_clock = op;
     let cic_ready = op + 1;
     t.quantize(cic_ready, Quantize::Cic);
     // The compensator: taps T−1 .. 1 from the delay line (read in that order, so that each
@@ -718,14 +724,7 @@ fn combs(channel: usize, words: &Words) -> Template {
     let fresh = words.fresh.expect("a pair's words have fresh words")[channel];
     t.read(0, fresh, ReadGate::None, 0);
     t.accumulate(1, AccX::Read, AccY::Zero);
-    let mut op = 1;
-    for (j, &word) in words.combs[channel].iter().enumerate() {
-        let read_clock = 1 + j as u32;
-        t.read(read_clock, word, ReadGate::Seen, 1);
-        op = read_clock + 1;
-        t.accumulate(op, AccX::Keep, AccY::NegRead);
-        t.write(op, word, WriteData::AccCic);
-    }
+    let op = comb_chain(&mut t, &words.combs[channel]);
     t.quantize(op + 1, Quantize::Cic);
     t.write(op + 2, fresh, WriteData::Cic);
     t
@@ -934,7 +933,8 @@ impl Schedule {
         let regular = regular.max(line.controls.len());
         line.controls.resize(regular, Control::default());
         let segment = (PAIR_SAMPLE_WORDS.saturating_sub(regular) as u32).max(MIN_SEGMENT);
-        let pieces: Vec<Template> = banks
+        // Each piece with its CIC (gyro, channel): one CIC's pieces follow one another.
+        let pieces: Vec<((usize, usize), Template)> = banks
             .iter()
             .enumerate()
             .flat_map(|(g, bank)| {
@@ -942,7 +942,7 @@ impl Schedule {
                 (0..2).flat_map(move |channel| {
                     deferred_pieces(channel, widths, bank, taps, segment)
                         .into_iter()
-                        .map(move |t| t.for_gyro(g as u8))
+                        .map(move |t| ((g, channel), t.for_gyro(g as u8)))
                 })
             })
             .collect();
@@ -977,17 +977,17 @@ const MIN_SEGMENT: u32 = 12;
 /// after its end, when it reads what that piece made: the same channel's), else in a new one.
 /// Returns each segment's words (from `regular`) and the pieces' placements.
 fn pack(
-    pieces: &[Template],
+    pieces: &[((usize, usize), Template)],
     regular: u32,
     segment: u32,
 ) -> Result<(Vec<Vec<Control>>, Vec<Placement>), ScheduleError> {
     let limit = regular + segment;
     let mut segments: Vec<Timeline> = vec![Timeline::default()];
     let mut previous: Option<(u32, u32)> = None;
-    for (i, piece) in pieces.iter().enumerate() {
+    for (i, (cic, piece)) in pieces.iter().enumerate() {
         // Pieces of one channel follow one another (they share its RAM words and registers);
         // the first piece of a channel reads nothing of the one before.
-        let same_channel = i > 0 && piece_channel(&pieces[i - 1]) == piece_channel(piece);
+        let same_channel = i > 0 && pieces[i - 1].0 == *cic;
         let earliest = match previous {
             Some((start, end)) => {
                 if same_channel {
@@ -1019,11 +1019,6 @@ fn pack(
         words.push(s.controls[regular as usize..].to_vec());
     }
     Ok((words, placements))
-}
-
-/// Which (gyro, channel) a deferred piece works on.
-fn piece_channel(piece: &Template) -> (u8, bool) {
-    (piece.gyro, piece.name.ends_with('Q'))
 }
 
 /// The compensator taps of `plan`, or why it has no folded schedule.
