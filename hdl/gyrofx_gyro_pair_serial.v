@@ -29,8 +29,12 @@
  *   SCHEDULE_LEN - SCHEDULE_REGULAR words, one in each of the next samples, after the regular
  *   part. The schedule ROM holds the regular part, then the segments.
  *
- * Pipeline: ce takes the sample (inputs, modes, switch clears); a word acts two clocks after
- *   it is fetched. dac_*, locked_* load at the schedule's DAC and lock words; decimating
+ * Pipeline: ce takes the sample (modes, switch clears); a word acts two clocks after it is
+ *   fetched. The ADC codes are not captured: the schedule reads adc_* while the sample's
+ *   regular part runs, so they must hold from ce until SCHEDULE_REGULAR + 2 clocks after it
+ *   (as an ADC interface's data register does until its next conversion; the system's
+ *   testbenches hold them until the next ce). Registers of their own would be 96 flip-flops
+ *   that share no logic cell with a LUT: what kept the whole system from one UP5K. dac_*, locked_* load at the schedule's DAC and lock words; decimating
  *   pulses for one clock after the last word of a decimating sample, out_valid after the last
  *   word of the sample whose segment completes the four decimated outputs (SCHEDULE_SEGMENTS
  *   samples later), with rate_a, quadrature_a, rate_b, quadrature_b loaded (the 1/SF of the
@@ -468,10 +472,6 @@ reg switching_b_reg = 1'b0;
 // The mode of the last decimating sample (its 1/SF coefficients, applied samples later).
 reg decimation_mode_a_reg = 1'b1;
 reg decimation_mode_b_reg = 1'b1;
-reg signed [DEMOD_ADC_W-1:0] adc_a_x_reg = {DEMOD_ADC_W{1'b0}};
-reg signed [DEMOD_ADC_W-1:0] adc_a_y_reg = {DEMOD_ADC_W{1'b0}};
-reg signed [DEMOD_ADC_W-1:0] adc_b_x_reg = {DEMOD_ADC_W{1'b0}};
-reg signed [DEMOD_ADC_W-1:0] adc_b_y_reg = {DEMOD_ADC_W{1'b0}};
 wire switching_a = mode_a != mode_a_reg || start_reg;
 wire switching_b = mode_b != mode_b_reg || start_reg;
 
@@ -480,16 +480,26 @@ reg [NCO_PHASE_W-1:0] nco_acc_a_reg = {NCO_PHASE_W{1'b0}};
 reg [NCO_PHASE_W-1:0] nco_acc_b_reg = {NCO_PHASE_W{1'b0}};
 reg [NCO_PHASE_W-1:0] freq_a_reg = {NCO_PHASE_W{1'b0}};
 reg [NCO_PHASE_W-1:0] freq_b_reg = {NCO_PHASE_W{1'b0}};
-// residues 0..2 gyro A's (drive, transmit, sense), 3..5 gyro B's
-reg signed [R_W-1:0] residue_reg [0:5];
+// The six truncation errors in a block RAM, word {gyro, reference} (reference 0 drive,
+// 1 transmit, 2 sense): as registers they were 120 flip-flops that share no logic cell with a
+// LUT. A word written since rst is valid (residue_valid_reg), else it reads as 0, as rst
+// cleared the registers. A cosine writes its reference's word; the schedule never reads that
+// word in the next clock (gyrofx_model::gyro_loop::folded's tests hold it), so the read needs
+// no bypass.
+(* no_rw_check *)
+reg [R_W-1:0] residue_ram [0:7];
+reg [R_W-1:0] residue_q;
+reg [5:0] residue_valid_reg = 6'd0;
+reg residue_read_valid_reg = 1'b0;
+reg [2:0] residue_address_reg = 3'd0;
 reg [NCO_SIN_W-1:0] nco_rom [0:(1 << NCO_ADDR_W)-1];
 reg [NCO_SIN_W-1:0] ref_magnitude_reg = {NCO_SIN_W{1'b0}};
 reg ref_negative_reg = 1'b0;
 integer r;
 initial begin
     $readmemh(NCO_ROM_FILE, nco_rom);
-    for (r = 0; r < 6; r = r + 1) begin
-        residue_reg[r] = {R_W{1'b0}};
+    for (r = 0; r < 8; r = r + 1) begin
+        residue_ram[r] = {R_W{1'b0}};
     end
 end
 
@@ -505,6 +515,11 @@ wire [1:0] nco_index_next = rom_field_next == 3'd3 ? 2'd1 : (rom_field_next >= 3
 reg [NCO_PHASE_W-1:0] nco_offset_reg = {NCO_PHASE_W{1'b0}};
 reg [5:0] residue_select_reg = 6'd0;
 reg cosine_reg = 1'b0;
+wire [5:0] residue_select_next = {rom_gyro_next && nco_index_next == 2'd2,
+    rom_gyro_next && nco_index_next == 2'd1, rom_gyro_next && nco_index_next == 2'd0,
+    !rom_gyro_next && nco_index_next == 2'd2, !rom_gyro_next && nco_index_next == 2'd1,
+    !rom_gyro_next && nco_index_next == 2'd0};
+wire [2:0] residue_address_next = {rom_gyro_next, nco_index_next};
 always @(posedge clk) begin
     nco_offset_reg <= nco_index_next == 2'd1
         ? (rom_gyro_next ? (rom_mode_next ? B_DAC_OFFSET_N : B_DAC_OFFSET_R)
@@ -513,17 +528,14 @@ always @(posedge clk) begin
         ? (rom_gyro_next ? (rom_mode_next ? B_SENSE_OFFSET_N : B_SENSE_OFFSET_R)
                          : (rom_mode_next ? A_SENSE_OFFSET_N : A_SENSE_OFFSET_R))
         : {NCO_PHASE_W{1'b0}};
-    residue_select_reg <= {rom_gyro_next && nco_index_next == 2'd2,
-        rom_gyro_next && nco_index_next == 2'd1, rom_gyro_next && nco_index_next == 2'd0,
-        !rom_gyro_next && nco_index_next == 2'd2, !rom_gyro_next && nco_index_next == 2'd1,
-        !rom_gyro_next && nco_index_next == 2'd0};
+    residue_select_reg <= residue_select_next;
+    residue_address_reg <= residue_address_next;
+    residue_q <= residue_ram[residue_address_next];
+    residue_read_valid_reg <= |(residue_select_next & residue_valid_reg);
     cosine_reg <= rom_field_next == 3'd2 || rom_field_next == 3'd3 || rom_field_next == 3'd5;
 end
 wire cosine = cosine_reg;
-wire signed [R_W-1:0] residue =
-      ({R_W{residue_select_reg[0]}} & residue_reg[0]) | ({R_W{residue_select_reg[1]}} & residue_reg[1])
-    | ({R_W{residue_select_reg[2]}} & residue_reg[2]) | ({R_W{residue_select_reg[3]}} & residue_reg[3])
-    | ({R_W{residue_select_reg[4]}} & residue_reg[4]) | ({R_W{residue_select_reg[5]}} & residue_reg[5]);
+wire signed [R_W-1:0] residue = {R_W{residue_read_valid_reg}} & residue_q;
 wire [NCO_PHASE_W-1:0] residue_extended = {{(NCO_PHASE_W - R_W){residue[R_W-1]}}, residue};
 wire [NCO_PHASE_W-1:0] nco_acc = rom_gyro_field ? nco_acc_b_reg : nco_acc_a_reg;
 wire [NCO_PHASE_W-1:0] phase_exact = nco_acc + nco_offset_reg;
@@ -659,16 +671,16 @@ end
 // gated to 0, the compensator's output). (The top bit, a guard bit, is never a limb's.)
 /* verilator lint_off UNUSEDSIGNAL */
 wire signed [A_EXT_W-1:0] a_value =
-      `GYROFX_A_OPERAND(a_select_reg[0], adc_a_x_reg, DEMOD_ADC_W)
-    | `GYROFX_A_OPERAND(a_select_reg[1], adc_a_y_reg, DEMOD_ADC_W)
+      `GYROFX_A_OPERAND(a_select_reg[0], adc_a_x, DEMOD_ADC_W)
+    | `GYROFX_A_OPERAND(a_select_reg[1], adc_a_y, DEMOD_ADC_W)
     | `GYROFX_A_OPERAND(a_select_reg[2], drive_q_a_reg, DEMOD_OUT_W)
     | `GYROFX_A_OPERAND(a_select_reg[3], amplitude_error_a_reg, AGC_ERR_W)
     | `GYROFX_A_OPERAND(a_select_reg[4], amplitude_a_reg, AGC_OUT_W)
     | `GYROFX_A_OPERAND(a_select_reg[5], c_reg, CIC_MID_W)
     | ({A_EXT_W{a_select_reg[6]}} & {{(A_EXT_W-CIC_MID_W){rd[CIC_MID_W-1]}}, rd[CIC_MID_W-1:0]})
     | `GYROFX_A_OPERAND(a_select_reg[7], cic_output_reg, CIC_OUT_W)
-    | `GYROFX_A_OPERAND(a_select_reg[8], adc_b_x_reg, DEMOD_ADC_W)
-    | `GYROFX_A_OPERAND(a_select_reg[9], adc_b_y_reg, DEMOD_ADC_W)
+    | `GYROFX_A_OPERAND(a_select_reg[8], adc_b_x, DEMOD_ADC_W)
+    | `GYROFX_A_OPERAND(a_select_reg[9], adc_b_y, DEMOD_ADC_W)
     | `GYROFX_A_OPERAND(a_select_reg[10], drive_q_b_reg, DEMOD_OUT_W)
     | `GYROFX_A_OPERAND(a_select_reg[11], amplitude_error_b_reg, AGC_ERR_W)
     | `GYROFX_A_OPERAND(a_select_reg[12], amplitude_b_reg, AGC_OUT_W);
@@ -1271,10 +1283,6 @@ always @(posedge clk) begin
         switching_a_reg <= switching_a;
         switching_b_reg <= switching_b;
         first_reg <= start_reg;
-        adc_a_x_reg <= adc_a_x;
-        adc_a_y_reg <= adc_a_y;
-        adc_b_x_reg <= adc_b_x;
-        adc_b_y_reg <= adc_b_y;
         decimate_reg <= decimates;
         count_reg <= decimates ? {CNT_W{1'b0}} : count_reg + 1'b1;
         if (decimates) begin
@@ -1317,11 +1325,8 @@ always @(posedge clk) begin
     if (rom_en) begin
         ref_negative_reg <= t[T_W-1];
         if (cosine && NCO_ERROR_FEEDBACK != 0) begin
-            for (r = 0; r < 6; r = r + 1) begin
-                if (residue_select_reg[r]) begin
-                    residue_reg[r] <= phase[R_W-1:0] ^ HALF_BIN;
-                end
-            end
+            residue_ram[residue_address_reg] <= phase[R_W-1:0] ^ HALF_BIN;
+            residue_valid_reg <= residue_valid_reg | residue_select_reg;
         end
     end
     if (executing_reg && advance_field) begin
@@ -1400,15 +1405,9 @@ always @(posedge clk) begin
         final_reg <= 1'b0;
         decimation_mode_a_reg <= 1'b1;
         decimation_mode_b_reg <= 1'b1;
-        adc_a_x_reg <= {DEMOD_ADC_W{1'b0}};
-        adc_a_y_reg <= {DEMOD_ADC_W{1'b0}};
-        adc_b_x_reg <= {DEMOD_ADC_W{1'b0}};
-        adc_b_y_reg <= {DEMOD_ADC_W{1'b0}};
         nco_acc_a_reg <= {NCO_PHASE_W{1'b0}};
         nco_acc_b_reg <= {NCO_PHASE_W{1'b0}};
-        for (r = 0; r < 6; r = r + 1) begin
-            residue_reg[r] <= {R_W{1'b0}};
-        end
+        residue_valid_reg <= 6'd0;
         read_zero_reg <= 1'b0;
         read_preset_reg <= 1'b0;
         acc_reg <= {ACC_W{1'b0}};

@@ -24,7 +24,7 @@
  *
  * Timing: each instruction takes 4 clocks (fetch, read RAM and coefficient,
  *   multiply, execute). On ce (when idle) the inputs and the sequencer's flags are
- *   captured and the sample program runs from address 0 to its End: the outputs
+ *   captured (the samples not when CAPTURE_SAMPLES = 0) and the sample program runs from address 0 to its End: the outputs
  *   show 4 * (sample program length) clocks after the ce clock, out_valid for one
  *   clock. ce while busy is ignored. rst (synchronous, wins over ce) clears the
  *   outputs at once and stops a running program; the first sample after it runs
@@ -55,7 +55,15 @@ module gyrofx_serial_engine #(
     parameter integer ROUNDING = 3,
     // ROM images for $readmemh
     parameter PROGRAM_FILE = "serial_program.mem",
-    parameter COEFFICIENT_FILE = "serial_coefficients.mem"
+    parameter COEFFICIENT_FILE = "serial_coefficients.mem",
+    // 1: y_a, y_b and the flags captured at ce. 0: y_a, y_b read from the ports while the
+    // program runs (the driver holds them from ce until out_valid; the flags are captured
+    // either way)
+    parameter integer CAPTURE_SAMPLES = 1,
+    // 1: rate_out, bias_a, bias_b, estimated load at End and hold until the next End. 0: they
+    // show the results as the program assembles them, final from End until the next
+    // sample's program writes them (a driver that publishes them later keeps its own copy)
+    parameter integer HOLD_RESULTS = 1
 ) (
     input  wire                     clk,
     input  wire                     rst,
@@ -106,6 +114,10 @@ end
 
 reg [WORD_W-1:0] program_rom [0:PROGRAM_DEPTH-1];
 reg [15:0] coefficient_rom [0:COEF_DEPTH-1];
+// Read and written at one address every instruction, but the word read in the clock that
+// writes it (phase 3) is never used (the next instruction reads again in its phase 1), so the
+// block RAM needs no read-first bypass.
+(* no_rw_check *)
 reg [15:0] ram [0:RAM_DEPTH-1];
 integer k;
 initial begin
@@ -139,7 +151,9 @@ reg signed [ACC_W-1:0] acc = {ACC_W{1'b0}};
 reg signed [15:0] a_word = 16'sd0;
 reg signed [15:0] b_word = 16'sd0;
 reg signed [15:0] input_word = 16'sd0;
-reg signed [31:0] product = 32'sd0;
+// No initial value, as the multiplier block's output register has none (yosys folds only such
+// a register into it): it loads every clock, three before it is first read.
+reg signed [31:0] product;
 reg half = 1'b0;
 reg sticky = 1'b0;
 reg negative = 1'b0;
@@ -189,18 +203,22 @@ generate
     end
 endgenerate
 
+// The samples the program reads: captured at ce, or the ports themselves.
+wire signed [LIMB*IN_LIMBS-1:0] y_a_sample = CAPTURE_SAMPLES != 0 ? y_a_reg : y_a_ext;
+wire signed [LIMB*IN_LIMBS-1:0] y_b_sample = CAPTURE_SAMPLES != 0 ? y_b_reg : y_b_ext;
+
 // Input limbs: y_a's, then y_b's (the top ones sign-extended).
 integer j;
 always @* begin
     input_word = 16'sd0;
     for (j = 0; j < IN_LIMBS; j = j + 1) begin
         if (address_field == j[ADDR_W-1:0]) begin
-            input_word = (j == IN_LIMBS - 1) ? {y_a_reg[LIMB*j+LIMB-1], y_a_reg[LIMB*j +: LIMB]}
-                                             : {1'b0, y_a_reg[LIMB*j +: LIMB]};
+            input_word = (j == IN_LIMBS - 1) ? {y_a_sample[LIMB*j+LIMB-1], y_a_sample[LIMB*j +: LIMB]}
+                                             : {1'b0, y_a_sample[LIMB*j +: LIMB]};
         end
         if (address_field == j[ADDR_W-1:0] + IN_LIMBS[ADDR_W-1:0]) begin
-            input_word = (j == IN_LIMBS - 1) ? {y_b_reg[LIMB*j+LIMB-1], y_b_reg[LIMB*j +: LIMB]}
-                                             : {1'b0, y_b_reg[LIMB*j +: LIMB]};
+            input_word = (j == IN_LIMBS - 1) ? {y_b_sample[LIMB*j+LIMB-1], y_b_sample[LIMB*j +: LIMB]}
+                                             : {1'b0, y_b_sample[LIMB*j +: LIMB]};
         end
     end
 end
@@ -242,7 +260,10 @@ end
 
 wire [LIMB-1:0] low = acc[LIMB-1:0];
 wire signed [ACC_W-1:0] shifted = acc >>> LIMB;
+// An accumulator narrower than 32 bits (a config's ACC_W) leaves the product's top bits unread.
+/* verilator lint_off UNUSEDSIGNAL */
 wire signed [PRODUCT_W-1:0] product_wide = product;
+/* verilator lint_on UNUSEDSIGNAL */
 wire signed [ACC_W-1:0] addend = (op == OP_ROUND) ? {{(ACC_W-1){1'b0}}, increment}
                                                   : product_wide[ACC_W-1:0];
 wire execute = running && phase == 2'd3;
@@ -375,11 +396,11 @@ always @(posedge clk) begin
     end
 end
 
-assign rate_out = rate_reg;
+assign rate_out = HOLD_RESULTS != 0 ? rate_reg : rate_shadow[OUT_W-1:0];
 assign out_valid = valid_reg;
-assign bias_a = bias_a_reg;
-assign bias_b = bias_b_reg;
-assign estimated = estimated_reg;
+assign bias_a = HOLD_RESULTS != 0 ? bias_a_reg : bias_a_shadow[BIAS_W-1:0];
+assign bias_b = HOLD_RESULTS != 0 ? bias_b_reg : bias_b_shadow[BIAS_W-1:0];
+assign estimated = HOLD_RESULTS != 0 ? estimated_reg : estimated_state;
 assign busy = running;
 
 endmodule

@@ -65,7 +65,14 @@ entity gyrofx_serial_engine is
         ROUNDING : natural := 3;
         -- ROM images (hex, one word per line)
         PROGRAM_FILE : string := "serial_program.mem";
-        COEFFICIENT_FILE : string := "serial_coefficients.mem"
+        COEFFICIENT_FILE : string := "serial_coefficients.mem";
+        -- 1: y_a, y_b and the flags captured at ce. 0: y_a, y_b read from the ports while
+        -- the program runs (the driver holds them from ce until out_valid)
+        CAPTURE_SAMPLES : natural := 1;
+        -- 1: rate_out, bias_a, bias_b, estimated load at End and hold until the next End. 0:
+        -- they show the results as the program assembles them, final from End until the next
+        -- sample's program writes them
+        HOLD_RESULTS : natural := 1
     );
     port (
         clk         : in  std_logic;
@@ -157,6 +164,9 @@ architecture rtl of gyrofx_serial_engine is
     -- The sample, captured at ce.
     signal y_a_reg : signed(LIMB * IN_LIMBS - 1 downto 0) := (others => '0');
     signal y_b_reg : signed(LIMB * IN_LIMBS - 1 downto 0) := (others => '0');
+    -- The samples the program reads: captured at ce, or the ports themselves.
+    signal y_a_sample : signed(LIMB * IN_LIMBS - 1 downto 0);
+    signal y_b_sample : signed(LIMB * IN_LIMBS - 1 downto 0);
     signal bw_sel_reg : unsigned(SEL_W - 1 downto 0) := (others => '0');
     signal interval_a_reg : unsigned(INTERVAL_W - 1 downto 0) := (others => '0');
     signal interval_b_reg : unsigned(INTERVAL_W - 1 downto 0) := (others => '0');
@@ -247,6 +257,9 @@ begin
     select_value <= resize(bw_sel_reg, COEF_ADDR_W) when by_bw_sel = '1' else (others => '0');
     coefficient_address <= coefficient_field + shift_left(select_value, COEF_INDEX_SHIFT);
 
+    y_a_sample <= y_a_reg when CAPTURE_SAMPLES /= 0 else resize(y_a, LIMB * IN_LIMBS);
+    y_b_sample <= y_b_reg when CAPTURE_SAMPLES /= 0 else resize(y_b, LIMB * IN_LIMBS);
+
     -- Input limbs: y_a's, then y_b's (the top ones sign-extended). A later match wins,
     -- as the Verilog's loop of assignments does.
     input_limbs : process (all)
@@ -258,8 +271,8 @@ begin
     begin
         word := (others => '0');
         for j in 0 to IN_LIMBS - 1 loop
-            limb_a := std_logic_vector(y_a_reg(LIMB * j + LIMB - 1 downto LIMB * j));
-            limb_b := std_logic_vector(y_b_reg(LIMB * j + LIMB - 1 downto LIMB * j));
+            limb_a := std_logic_vector(y_a_sample(LIMB * j + LIMB - 1 downto LIMB * j));
+            limb_b := std_logic_vector(y_b_sample(LIMB * j + LIMB - 1 downto LIMB * j));
             top_a := '0';
             top_b := '0';
             if j = IN_LIMBS - 1 then
@@ -493,11 +506,11 @@ begin
         end if;
     end process;
 
-    rate_out <= rate_reg;
+    rate_out <= rate_reg when HOLD_RESULTS /= 0 else signed(rate_shadow(OUT_W - 1 downto 0));
     out_valid <= valid_reg;
-    bias_a <= bias_a_reg;
-    bias_b <= bias_b_reg;
-    estimated <= estimated_reg;
+    bias_a <= bias_a_reg when HOLD_RESULTS /= 0 else signed(bias_a_shadow(BIAS_W - 1 downto 0));
+    bias_b <= bias_b_reg when HOLD_RESULTS /= 0 else signed(bias_b_shadow(BIAS_W - 1 downto 0));
+    estimated <= estimated_reg when HOLD_RESULTS /= 0 else estimated_state;
     busy <= running;
 
 end architecture;

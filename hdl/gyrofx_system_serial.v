@@ -34,11 +34,13 @@
  *   samples later instead, CHAIN_DELAY_SAMPLES = SCHEDULE_SEGMENTS
  *   + ceil((chain clocks + margin) / (SCHEDULE_LEN + 3))
  *   (gyrofx_job::pipeline::system_chain_delay), so that every output is a function of the
- *   samples whatever the cadence: the engine holds its results until then. The chain must
+ *   samples whatever the cadence: the engine's results hold until then. The chain must
  *   finish between chain samples: CHAIN_DELAY_SAMPLES <= CIC_DECIMATION (gyrofx refuses a
  *   config where it cannot).
  *
- * Timing: ce at most every SCHEDULE_LEN + 3 clocks. Every output shows SCHEDULE_LEN + 3
+ * Timing: ce at most every SCHEDULE_LEN + 3 clocks; adc_* hold from ce until the next ce
+ *   (the pair reads them while the sample runs, SCHEDULE_REGULAR + 2 clocks after ce at the
+ *   latest; the other inputs are taken at ce). Every output shows SCHEDULE_LEN + 3
  *   clocks after ce: dac_*, locked_* load with the loops' (by SCHEDULE_LEN + 2 clocks) and
  *   hold until the next sample's; mode_a, mode_b (the modes of the next sample) change the
  *   clock after the sequencer's take, at the end of a decimating sample's regular part
@@ -421,6 +423,12 @@ always @(posedge clk) begin
     end
 end
 
+// The engine reads the pair's rates from its outputs, which hold for a decimation, and leaves
+// its results where its program assembles them, which hold until the next chain sample's
+// program: both outlast the chain's run and the publication's delay (CHAIN_DELAY_SAMPLES <=
+// CIC_DECIMATION), so neither is copied (106 flip-flops that would share no logic cell with a
+// LUT). The rate is published only when the engine's program made one (chain_valid_reg), as
+// the engine's own output register would have held the last one otherwise.
 wire chain_ce = rates_valid && taken_reg;
 wire signed [OUT_W-1:0] chain_rate;
 wire chain_valid;
@@ -436,7 +444,8 @@ gyrofx_serial_engine #(
     .ACC_W(ACC_W), .ADDR_W(ADDR_W), .COEF_ADDR_W(COEF_ADDR_W), .RAM_DEPTH(RAM_DEPTH),
     .COEF_DEPTH(COEF_DEPTH), .PROGRAM_DEPTH(PROGRAM_DEPTH),
     .RAM_INDEX_SHIFT(RAM_INDEX_SHIFT), .COEF_INDEX_SHIFT(COEF_INDEX_SHIFT),
-    .ROUNDING(ROUNDING), .PROGRAM_FILE(PROGRAM_FILE), .COEFFICIENT_FILE(COEFFICIENT_FILE)
+    .ROUNDING(ROUNDING), .PROGRAM_FILE(PROGRAM_FILE), .COEFFICIENT_FILE(COEFFICIENT_FILE),
+    .CAPTURE_SAMPLES(0), .HOLD_RESULTS(0)
 ) engine (
     .clk(clk), .rst(rst), .ce(chain_ce), .bw_sel(taken_bw_sel_reg), .y_a(rate_a), .y_b(rate_b),
     .mode_a(taken_mode_a_reg), .mode_b(taken_mode_b_reg), .blank_a(taken_blank_a_reg),
@@ -491,8 +500,10 @@ always @(posedge clk) begin
         chain_valid_reg <= 1'b1;
     end
     out_valid_reg <= publish && chain_valid_reg;
-    if (publish) begin
+    if (publish && chain_valid_reg) begin
         rate_out_reg <= chain_rate;
+    end
+    if (publish) begin
         bias_a_reg <= chain_bias_a;
         bias_b_reg <= chain_bias_b;
         estimated_reg <= chain_estimated;

@@ -461,7 +461,11 @@ begin
             COEF_ADDR_W => COEF_ADDR_W, RAM_DEPTH => RAM_DEPTH, COEF_DEPTH => COEF_DEPTH,
             PROGRAM_DEPTH => PROGRAM_DEPTH, RAM_INDEX_SHIFT => RAM_INDEX_SHIFT,
             COEF_INDEX_SHIFT => COEF_INDEX_SHIFT, ROUNDING => ROUNDING,
-            PROGRAM_FILE => PROGRAM_FILE, COEFFICIENT_FILE => COEFFICIENT_FILE
+            PROGRAM_FILE => PROGRAM_FILE, COEFFICIENT_FILE => COEFFICIENT_FILE,
+            -- The rates hold at the pair's outputs for a decimation and the results where the
+            -- program assembles them until the next chain sample's program: both outlast the
+            -- chain and the publication's delay, so neither is copied (as the Verilog).
+            CAPTURE_SAMPLES => 0, HOLD_RESULTS => 0
         )
         port map (
             clk => clk, rst => rst, ce => chain_ce, bw_sel => taken_bw_sel_reg, y_a => rate_a,
@@ -507,8 +511,11 @@ begin
                 chain_valid_reg <= '1';
             end if;
             out_valid_reg <= publish and chain_valid_reg;
-            if publish = '1' then
+            -- The rate only when the engine's program made one.
+            if publish = '1' and chain_valid_reg = '1' then
                 rate_out_reg <= chain_rate;
+            end if;
+            if publish = '1' then
                 bias_a_reg <= chain_bias_a;
                 bias_b_reg <= chain_bias_b;
                 estimated_reg <= chain_estimated;

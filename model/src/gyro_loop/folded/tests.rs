@@ -205,7 +205,11 @@ proptest! {
         let plan = Plan::new(&spec);
         prop_assume!(plan.is_ok());
         let plan = plan.unwrap();
-        prop_assume!(Schedule::pair(&plan).is_ok());
+        let schedule = Schedule::pair(&plan);
+        prop_assume!(schedule.is_ok());
+        let schedule = schedule.unwrap();
+        let hazard = error_read_after_its_write(&schedule);
+        prop_assert!(hazard.is_none(), "{:?} in {}", hazard, schedule);
         let width = plan.demodulator.input.width;
         let code = |x: i64| sign_extend(i128::from(x), width) as i64;
         let mut modes = [Mode::Normal; 2];
@@ -286,6 +290,60 @@ fn the_default_pair_folds_both_loops_bit_for_bit_through_lock_and_switches() {
         .map(|(a, b)| ([a.adc, b.adc], [a.mode, b.mode]))
         .collect();
     assert_eq!(first_pair_difference([&plan, &plan], &inputs), None);
+}
+
+/// Where `schedule` reads an NCO reference's truncation error in the clock right after a
+/// cosine wrote it (`gyrofx_gyro_pair_serial` keeps the errors in a block RAM whose read that
+/// clock would return the old word): the clock and the two reads. Runs checked: the regular
+/// part, and the regular part followed by each deferred segment.
+fn error_read_after_its_write(schedule: &Schedule) -> Option<String> {
+    let reference = |c: &Control| -> Option<(u8, u8)> {
+        match c.rom {
+            RomRead::None => None,
+            RomRead::DriveSin | RomRead::DriveCos => Some((c.rom_gyro, 0)),
+            RomRead::TransmitCos => Some((c.rom_gyro, 1)),
+            RomRead::SenseSin | RomRead::SenseCos => Some((c.rom_gyro, 2)),
+        }
+    };
+    let writes = |c: &Control| {
+        matches!(
+            c.rom,
+            RomRead::DriveCos | RomRead::TransmitCos | RomRead::SenseCos
+        )
+    };
+    let regular = &schedule.controls[..schedule.regular];
+    let runs = std::iter::once(regular.to_vec()).chain(
+        schedule
+            .segments()
+            .map(|segment| [regular, segment].concat()),
+    );
+    for run in runs {
+        for (t, pair) in run.windows(2).enumerate() {
+            if writes(&pair[0]) && reference(&pair[1]) == reference(&pair[0]) {
+                return Some(format!(
+                    "clock {t}: {:?} of gyro {}, then {:?}",
+                    pair[0].rom, pair[0].rom_gyro, pair[1].rom
+                ));
+            }
+        }
+    }
+    None
+}
+
+/// A cosine's write of its truncation error and the next read of that error are never in
+/// adjacent clocks in the default pair; a schedule where they are is caught.
+#[test]
+fn the_pair_never_reads_a_truncation_error_the_clock_after_writing_it() {
+    let plan = Plan::new(&Spec::paper_004()).unwrap();
+    let mut schedule = Schedule::pair(&plan).unwrap();
+    assert_eq!(error_read_after_its_write(&schedule), None, "{schedule}");
+    let cosine = schedule.controls[..schedule.regular]
+        .iter()
+        .position(|c| c.rom == RomRead::TransmitCos)
+        .expect("a transmit cosine");
+    schedule.controls[cosine + 1].rom = RomRead::TransmitCos;
+    schedule.controls[cosine + 1].rom_gyro = schedule.controls[cosine].rom_gyro;
+    assert!(error_read_after_its_write(&schedule).is_some());
 }
 
 /// The default pair's schedule: every sample within the 120 clocks of a 200 kHz ADC at
