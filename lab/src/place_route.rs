@@ -39,16 +39,73 @@ pub struct PlaceRequest {
     pub jobs: usize,
 }
 
-/// The names of the blocks placed, in the package's order: each block that places itself
+/// The names of the designs placed, in the package's order: each block that places itself
 /// ([`gyrofx_codegen::blocks::RtlBlock::placement`]), its serial variant beside it
 /// (`top_serial`, `mean_filter_serial`, `gyro_loop_serial`); of the system only its serial
-/// variant (`system_serial`).
+/// variant (`system_serial`); then the whole system on one part ([`whole_system::NAME`]).
 pub fn placed_blocks() -> Vec<&'static str> {
-    blocks::placed_names()
+    let mut names = blocks::placed_names();
+    names.push(whole_system::NAME);
+    names
 }
 
 /// The harness module around a placed block.
 pub const HARNESS: &str = "gyrofx_place_route_harness";
+
+/// What one placement synthesizes: one block as its package configures it, or several wired
+/// in one top ([`whole_system`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Design {
+    /// Its name in the table and its folder: a [`placed_blocks`] name.
+    pub name: &'static str,
+    /// Its RTL module(s), for the table.
+    pub module: &'static str,
+    /// The module the harness instantiates, kept as a hierarchy of its own so that its
+    /// statistics are the design's alone.
+    pub top: String,
+    /// The Verilog files yosys reads (the harness's besides), in order.
+    pub sources: Vec<String>,
+    /// Every file of its folder but the harness: RTL, ROM images, configured wrappers.
+    pub files: Vec<(String, String)>,
+    /// Its inputs after `rst` and `ce` (name, width in bits).
+    pub inputs: Vec<(String, u32)>,
+    /// Its outputs (name, width in bits).
+    pub outputs: Vec<(String, u32)>,
+    /// Whether it has `clk`, `rst` and `ce` ports.
+    pub clocked: bool,
+    /// Clocks from one sample's `ce` to the next one's, at least.
+    pub clocks_per_sample: u32,
+}
+
+impl Design {
+    /// `block` as its package configures it ([`design::configured_module`]).
+    pub fn of_block(block: &Block) -> Design {
+        let mut sources: Vec<String> = design::sources(block.module)
+            .iter()
+            .map(|(n, _)| n.to_string())
+            .collect();
+        sources.push(design::CONFIGURED_FILE.into());
+        Design {
+            name: block.name,
+            module: block.module,
+            top: design::configured_name(block.module),
+            sources,
+            files: design::design_files(block),
+            inputs: block
+                .inputs
+                .iter()
+                .map(|s| (s.name.to_string(), s.format.width))
+                .collect(),
+            outputs: block
+                .outputs
+                .iter()
+                .map(|o| (o.signal.name.to_string(), o.signal.format.width))
+                .collect(),
+            clocked: block.clocked,
+            clocks_per_sample: block.clocks_per_sample(),
+        }
+    }
+}
 
 /// The folder of the place-and-route results in the synthesis package.
 pub const FOLDER: &str = "place_and_route";
@@ -403,28 +460,19 @@ pub struct Placement {
     pub nextpnr: Option<ToolVersion>,
 }
 
-/// The harness around `block`'s configured module ([`design::configured_module`]): its inputs
-/// (`rst`, `ce` first) are one shift register loaded from `serial_in`; its outputs are
-/// captured when `capture` is high and shifted out on `serial_out` otherwise. Every port bit
-/// thus reaches a pin, and nothing the block computes can be optimized away.
-pub fn harness(block: &Block) -> String {
-    let clocked = block.clocked;
+/// The harness around `design`'s top module ([`Design::top`]): its inputs (`rst`, `ce` first)
+/// are one shift register loaded from `serial_in`; its outputs are captured when `capture` is
+/// high and shifted out on `serial_out` otherwise. Every port bit thus reaches a pin, and
+/// nothing the design computes can be optimized away.
+pub fn harness(design: &Design) -> String {
+    let clocked = design.clocked;
     let mut inputs: Vec<(String, u32)> = Vec::new();
     if clocked {
         inputs.push(("rst".into(), 1));
         inputs.push(("ce".into(), 1));
     }
-    inputs.extend(
-        block
-            .inputs
-            .iter()
-            .map(|s| (s.name.to_string(), s.format.width)),
-    );
-    let outputs: Vec<(String, u32)> = block
-        .outputs
-        .iter()
-        .map(|o| (o.signal.name.to_string(), o.signal.format.width))
-        .collect();
+    inputs.extend(design.inputs.iter().cloned());
+    let outputs = &design.outputs;
     let declare = |kind: &str, (name, width): &(String, u32), init: bool| {
         let range = if *width > 1 {
             format!("[{}:0] ", width - 1)
@@ -455,7 +503,7 @@ pub fn harness(block: &Block) -> String {
     fill(
         HARNESS_TEMPLATE,
         &[
-            ("module", block.module),
+            ("module", design.module),
             ("in_bits", &in_bits.to_string()),
             ("out_bits", &out_bits.to_string()),
             ("harness", HARNESS),
@@ -476,8 +524,8 @@ pub fn harness(block: &Block) -> String {
             ("out_top", &(out_bits.max(2) - 1).to_string()),
             ("input_names", &names(&inputs)),
             ("shifted_inputs", &shift_source(&inputs)),
-            ("output_names", &names(&outputs)),
-            ("configured", &design::configured_name(block.module)),
+            ("output_names", &names(outputs)),
+            ("configured", &design.top),
             ("ports", &ports.join(",\n")),
         ],
     )
@@ -524,21 +572,16 @@ const RUN_SCRIPT: &str = include_str!("../templates/place_route/run.sh");
 
 /// The yosys script of `target` for `block`, run in the block's folder; it writes
 /// `<target>/stat.json` (and, for iCE40, `<target>/netlist.json` for nextpnr).
-fn yosys_script(block: &Block, target: Target) -> String {
-    let sources: Vec<&str> = design::sources(block.module)
-        .iter()
-        .map(|(n, _)| *n)
-        .collect();
-    let configured = design::configured_name(block.module);
+fn yosys_script(design: &Design, target: Target) -> String {
+    let configured = &design.top;
     let folder = target.name();
-    let sources = sources.join(" ");
+    let sources = design.sources.join(" ");
     match target {
         Target::Xilinx => fill(
             XILINX_SCRIPT,
             &[
                 ("sources", &sources),
-                ("config", design::CONFIGURED_FILE),
-                ("configured", &configured),
+                ("configured", configured),
                 ("folder", folder),
             ],
         ),
@@ -546,10 +589,9 @@ fn yosys_script(block: &Block, target: Target) -> String {
             ECP5_SCRIPT,
             &[
                 ("sources", &sources),
-                ("config", design::CONFIGURED_FILE),
                 ("harness_file", HARNESS_FILE),
                 ("harness", HARNESS),
-                ("configured", &configured),
+                ("configured", configured),
                 ("folder", folder),
             ],
         ),
@@ -557,10 +599,9 @@ fn yosys_script(block: &Block, target: Target) -> String {
             ICE40_SCRIPT,
             &[
                 ("sources", &sources),
-                ("config", design::CONFIGURED_FILE),
                 ("harness_file", HARNESS_FILE),
                 ("harness", HARNESS),
-                ("configured", &configured),
+                ("configured", configured),
                 (
                     "dsp",
                     if target == Target::Ice40Up5k {
@@ -865,16 +906,16 @@ fn count_cells(
 }
 
 impl Placement {
-    /// `block` on `tools`' target before anything is counted: fits, no figure.
-    fn new(block: &Block, tools: &Tools) -> Placement {
+    /// `design` on `tools`' target before anything is counted: fits, no figure.
+    fn new(design: &Design, tools: &Tools) -> Placement {
         let target = tools.target;
         let device = target.device();
         Placement {
             target,
             device: device.name,
             package: device.package,
-            block: block.name,
-            module: block.module,
+            block: design.name,
+            module: design.module,
             lut4: None,
             lut6: None,
             ff: 0,
@@ -887,9 +928,9 @@ impl Placement {
             fmax_mhz: None,
             fmax_goal_mhz: device.goal_mhz,
             critical_path: None,
-            clocks_per_sample: block.clocks_per_sample(),
+            clocks_per_sample: design.clocks_per_sample,
             max_sample_rate_hz: None,
-            folder: format!("{FOLDER}/{}/{}", block.name, target.name()),
+            folder: format!("{FOLDER}/{}/{}", design.name, target.name()),
             yosys: tools.yosys.clone(),
             nextpnr: tools.nextpnr.clone(),
         }
@@ -906,16 +947,16 @@ impl Placement {
     }
 }
 
-/// Places one block on one target (`tools`') in `dir` (the block's folder, holding its design
-/// files and harness).
-fn place(dir: &Path, block: &Block, tools: &Tools) -> Result<Placement> {
+/// Places one design on one target (`tools`') in `dir` (the design's folder, holding its files
+/// and harness).
+fn place(dir: &Path, design: &Design, tools: &Tools) -> Result<Placement> {
     let target = tools.target;
     let folder = dir.join(target.name());
     // Below `dir` only: after a signal has removed the work folder, this fails instead of
     // bringing it back to be left behind.
     output_folder::create_below(dir, &folder).map_err(|e| Error::io(&folder, e))?;
     for (name, text) in [
-        ("synth.ys", yosys_script(block, target)),
+        ("synth.ys", yosys_script(design, target)),
         ("run.sh", run_script(target)),
     ] {
         let path = folder.join(name);
@@ -932,24 +973,21 @@ fn place(dir: &Path, block: &Block, tools: &Tools) -> Result<Placement> {
     if !yosys.success {
         return Err(Error::Synthesis(format!(
             "{program} failed on {} for {}:\n{}\n{}",
-            block.name,
+            design.name,
             target.name(),
             log_tail(&dir.join(&yosys_log)),
             yosys.printed()
         )));
     }
-    let cells = module_cells(
-        &folder.join("stat.json"),
-        &design::configured_name(block.module),
-    )?;
-    let mut placement = Placement::new(block, tools);
+    let cells = module_cells(&folder.join("stat.json"), &design.top)?;
+    let mut placement = Placement::new(design, tools);
     let counts = count_cells(&mut placement, &cells);
     // A block that needs more than the device has cannot be placed: said without nextpnr.
     if refuse_over_capacity(&mut placement, &counts) {
         return Ok(placement);
     }
     if let Some(nextpnr) = target.nextpnr() {
-        route(dir, block, nextpnr, &mut placement)?;
+        route(dir, design.name, nextpnr, &mut placement)?;
     }
     Ok(placement)
 }
@@ -964,9 +1002,9 @@ fn logic_cell(target: Target) -> &'static str {
     }
 }
 
-/// Runs `nextpnr` on the block's netlist in `dir` and reads what it says into `placement`:
-/// whether it fits, its logic cells, Fmax and critical path.
-fn route(dir: &Path, block: &Block, nextpnr: Tool, placement: &mut Placement) -> Result<()> {
+/// Runs `nextpnr` on the netlist of the design `name` in `dir` and reads what it says into
+/// `placement`: whether it fits, its logic cells, Fmax and critical path.
+fn route(dir: &Path, name: &str, nextpnr: Tool, placement: &mut Placement) -> Result<()> {
     let target = placement.target;
     let device = target.device();
     let log = PathBuf::from(target.name()).join("nextpnr.log");
@@ -991,7 +1029,7 @@ fn route(dir: &Path, block: &Block, nextpnr: Tool, placement: &mut Placement) ->
             return Err(Error::Synthesis(format!(
                 "{} failed on {} for {}:\n{}\n{printed}",
                 nextpnr.program(),
-                block.name,
+                name,
                 target.name(),
                 log_tail(&dir.join(&log))
             )));
@@ -1057,17 +1095,16 @@ fn sample_rate(rate: f64) -> String {
     }
 }
 
-/// The blocks a [`PlaceRequest`] names, their design files written into the work folder and
-/// ready to be placed ([`Prepared::place`], one task at a time, in any order or side by side),
-/// then added to the package ([`Prepared::add_to`]).
+/// The designs a [`PlaceRequest`] names, their files written into the work folder and ready to
+/// be placed ([`Prepared::place`], one task at a time, in any order or side by side), then added
+/// to the package ([`Prepared::add_to`]).
 pub struct Prepared {
-    designs: Vec<Block>,
-    design_files: Vec<Vec<(String, String)>>,
+    designs: Vec<Design>,
     tools: Vec<Tools>,
     work: PathBuf,
 }
 
-/// One block on one target: indices into [`Prepared`]'s blocks and targets.
+/// One design on one target: indices into [`Prepared`]'s designs and targets.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Task {
     block: usize,
@@ -1075,8 +1112,8 @@ pub struct Task {
 }
 
 impl Prepared {
-    /// Writes the design files of the blocks `request` names (from [`placed_blocks`]) of `job`
-    /// below `work`, to be placed on the targets of `tools` ([`check_tools`] of the request's).
+    /// Writes the files of the designs `request` names (from [`placed_blocks`]) of `job` below
+    /// `work`, to be placed on the targets of `tools` ([`check_tools`] of the request's).
     ///
     /// # Errors
     /// A config the serial variant refuses, or an I/O error.
@@ -1088,40 +1125,48 @@ impl Prepared {
         tools: Vec<Tools>,
         work: &Path,
     ) -> Result<Prepared> {
-        let mut designs: Vec<Block> = Vec::new();
         let mut serial: Option<(Job, RomImages)> = None;
-        for name in &request.blocks {
+        let mut block_named = |name: &'static str| -> Result<Block> {
             let (registered, is_serial) =
                 blocks::placed(name).unwrap_or_else(|| panic!("{name} is not a placed block"));
-            if is_serial {
-                if serial.is_none() {
-                    let job = job.serial_variant()?;
-                    let roms = RomImages::new(&job, provenance);
-                    serial = Some((job, roms));
-                }
-                let (serial_job, serial_roms) = serial.as_ref().expect("set above");
-                let mut block = registered.block(serial_job, serial_roms);
-                block.name = name;
-                designs.push(block);
-            } else {
-                designs.push(registered.block(job, roms));
+            if !is_serial {
+                return Ok(registered.block(job, roms));
             }
+            if serial.is_none() {
+                let job = job.serial_variant()?;
+                let roms = RomImages::new(&job, provenance);
+                serial = Some((job, roms));
+            }
+            let (serial_job, serial_roms) = serial.as_ref().expect("set above");
+            let mut block = registered.block(serial_job, serial_roms);
+            block.name = name;
+            Ok(block)
+        };
+        let mut designs = Vec::new();
+        for name in &request.blocks {
+            designs.push(if *name == whole_system::NAME {
+                whole_system::design(
+                    &block_named(whole_system::SYSTEM)?,
+                    &block_named(whole_system::MEAN_FILTER)?,
+                )
+            } else {
+                Design::of_block(&block_named(name)?)
+            });
         }
-        let mut design_files = Vec::new();
-        for block in &designs {
-            let dir = work.join(FOLDER).join(block.name);
+        for design in &designs {
+            let dir = work.join(FOLDER).join(design.name);
             output_folder::create_below(work, &dir).map_err(|e| Error::io(&dir, e))?;
-            let mut files = design::design_files(block);
-            files.push((HARNESS_FILE.into(), harness(block)));
-            for (name, text) in &files {
+            for (name, text) in design
+                .files
+                .iter()
+                .chain([&(HARNESS_FILE.to_string(), harness(design))])
+            {
                 let path = dir.join(name);
                 std::fs::write(&path, text).map_err(|e| Error::io(&path, e))?;
             }
-            design_files.push(files);
         }
         Ok(Prepared {
             designs,
-            design_files,
             tools,
             work: work.to_path_buf(),
         })
@@ -1154,11 +1199,12 @@ impl Prepared {
     /// # Errors
     /// An I/O error reading them.
     pub fn add_to(&self, package: &mut Package) -> Result<()> {
-        for (block, files) in self.designs.iter().zip(&self.design_files) {
+        for block in &self.designs {
             let prefix = format!("{FOLDER}/{}", block.name);
-            for (name, text) in files {
+            for (name, text) in &block.files {
                 package.add(format!("{prefix}/{name}"), text.as_str());
             }
+            package.add(format!("{prefix}/{HARNESS_FILE}"), harness(block));
             for target in self.tools.iter().map(|t| t.target) {
                 let dir = self.work.join(FOLDER).join(block.name).join(target.name());
                 // yosys's log is left out (6 MB for the gyro loop): `run.sh` writes it again.
@@ -1267,6 +1313,8 @@ pub fn critical_paths(placements: &[Placement]) -> String {
         })
         .collect()
 }
+
+pub mod whole_system;
 
 #[cfg(test)]
 mod tests;

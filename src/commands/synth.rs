@@ -31,8 +31,10 @@ pub struct Args {
     target: Option<String>,
     /// The blocks placed with --target, comma-separated (default: all of sequencer,
     /// estimator, calibration, kf, top, top_serial, mean_filter, mean_filter_serial,
-    /// gyro_loop, gyro_loop_serial, system_serial; the _serial ones are the config's chain,
-    /// mean filter, gyro loop and whole system in the serial architecture).
+    /// gyro_loop, gyro_loop_serial, system_serial, whole_system_serial; the _serial ones are
+    /// the config's chain, mean filter, gyro loop and system in the serial architecture, and
+    /// whole_system_serial the serial system with the serial mean filter on its rate, in one
+    /// top).
     #[arg(long, value_name = "LIST", requires = "target")]
     blocks: Option<String>,
     /// yosys and nextpnr runs at a time with --target, the chain's and loop's flows among

@@ -23,11 +23,16 @@ fn block(clocked: bool) -> Block {
     block
 }
 
+/// [`block`] as `place` synthesizes it.
+fn design(clocked: bool) -> Design {
+    Design::of_block(&block(clocked))
+}
+
 /// Every input register takes the next one's bits and the last takes the pin: the inputs,
 /// read as one vector `{rst, ce, bw_sel, z}`, shift by one place each clock.
 #[test]
 fn the_harness_shifts_every_input_bit_and_captures_every_output() {
-    let text = harness(&block(true));
+    let text = harness(&design(true));
     assert!(
         text.contains("{rst, ce, bw_sel, z} <= {ce, bw_sel, z, serial_in};"),
         "{text}"
@@ -41,7 +46,7 @@ fn the_harness_shifts_every_input_bit_and_captures_every_output() {
     assert!(text.contains(".clk(clk)"), "{text}");
 
     // A combinational block has no clock, reset or enable to drive.
-    let text = harness(&block(false));
+    let text = harness(&design(false));
     assert!(
         text.contains("{bw_sel, z} <= {bw_sel[0], z, serial_in};"),
         "{text}"
@@ -281,9 +286,9 @@ fn the_tools_table_names_each_targets_programs_once() {
         nextpnr: None,
     };
     let placements = [
-        Placement::new(&block(true), &ecp5),
-        Placement::new(&block(false), &ecp5),
-        Placement::new(&block(true), &xilinx),
+        Placement::new(&design(true), &ecp5),
+        Placement::new(&design(false), &ecp5),
+        Placement::new(&design(true), &xilinx),
     ];
     let table = tools_table(&placements);
     let rows: Vec<&str> = table.lines().skip(2).collect();
@@ -334,7 +339,7 @@ fn ecp5_cells_are_counted_from_yosys_statistics() {
         &design::configured_name("gyrofx_kf"),
     )
     .unwrap();
-    let mut placement = Placement::new(&block(true), &ecp5_tools(Target::Ecp5_12f));
+    let mut placement = Placement::new(&design(true), &ecp5_tools(Target::Ecp5_12f));
     let counts = count_cells(&mut placement, &cells);
     assert_eq!(
         (
@@ -357,7 +362,7 @@ fn ecp5_cells_are_counted_from_yosys_statistics() {
 fn an_ecp5_part_refuses_a_block_larger_than_its_datasheet() {
     let refused = |target: Target, cells: &[(&str, u64)]| {
         let cells: Vec<(String, u64)> = cells.iter().map(|(k, n)| (k.to_string(), *n)).collect();
-        let mut placement = Placement::new(&block(true), &ecp5_tools(target));
+        let mut placement = Placement::new(&design(true), &ecp5_tools(target));
         let counts = count_cells(&mut placement, &cells);
         refuse_over_capacity(&mut placement, &counts).then(|| placement.limit.unwrap())
     };
@@ -392,7 +397,7 @@ fn an_ecp5_part_refuses_a_block_larger_than_its_datasheet() {
 fn an_ecp5_report_gives_logic_cells_fmax_and_a_clean_critical_path() {
     let text = std::fs::read_to_string(fixture("sequencer_ecp5-12f_report.json")).unwrap();
     let report: serde_json::Value = serde_json::from_str(&text).unwrap();
-    let mut placement = Placement::new(&block(true), &ecp5_tools(Target::Ecp5_12f));
+    let mut placement = Placement::new(&design(true), &ecp5_tools(Target::Ecp5_12f));
     read_report(&mut placement, &report);
     assert!(placement.fits, "{placement:?}");
     assert_eq!(placement.logic_cells, Some(94));
@@ -414,7 +419,7 @@ fn an_ecp5_report_gives_logic_cells_fmax_and_a_clean_critical_path() {
     // 12F refuses them, the 25F takes them.
     let mut crowded = report.clone();
     crowded["utilization"]["TRELLIS_COMB"]["used"] = 13_000.into();
-    let mut small = Placement::new(&block(true), &ecp5_tools(Target::Ecp5_12f));
+    let mut small = Placement::new(&design(true), &ecp5_tools(Target::Ecp5_12f));
     read_report(&mut small, &crowded);
     assert!(!small.fits && small.fmax_mhz.is_none());
     assert!(
@@ -424,7 +429,7 @@ fn an_ecp5_report_gives_logic_cells_fmax_and_a_clean_critical_path() {
             .is_some_and(|l| l.starts_with("13000 logic cells, the LFE5U-12F has 12288")),
         "{small:?}"
     );
-    let mut larger = Placement::new(&block(true), &ecp5_tools(Target::Ecp5_25f));
+    let mut larger = Placement::new(&design(true), &ecp5_tools(Target::Ecp5_25f));
     read_report(&mut larger, &crowded);
     assert!(larger.fits && larger.logic_cells == Some(13_000));
 }
