@@ -489,7 +489,7 @@ reg [NCO_PHASE_W-1:0] freq_b_reg = {NCO_PHASE_W{1'b0}};
 (* no_rw_check *)
 reg [R_W-1:0] residue_ram [0:7];
 reg [R_W-1:0] residue_q;
-reg [5:0] residue_valid_reg = 6'd0;
+reg [7:0] residue_valid_reg = 8'd0;
 reg residue_read_valid_reg = 1'b0;
 reg [2:0] residue_address_reg = 3'd0;
 reg [NCO_SIN_W-1:0] nco_rom [0:(1 << NCO_ADDR_W)-1];
@@ -506,19 +506,13 @@ end
 // The read's reference decoded from the fetched word a clock before it acts (rom field: 1 drive
 // sin, 2 drive cos, 3 transmit cos, 4 sense sin, 5 sense cos), so that a clock runs the phase's
 // adders and the ROM's address, not the field's decoding: the reference's offset (its gyro's
-// and mode's), which of the six truncation errors (one-hot: gyro A's drive, transmit, sense,
-// then gyro B's) and whether it is a cosine.
+// and mode's), the word of its truncation error and whether it is a cosine.
 wire [2:0] rom_field_next = fetched_reg[2:0];
 wire rom_gyro_next = fetched_reg[57];
 wire rom_mode_next = rom_gyro_next ? mode_b_reg : mode_a_reg;
 wire [1:0] nco_index_next = rom_field_next == 3'd3 ? 2'd1 : (rom_field_next >= 3'd4 ? 2'd2 : 2'd0);
 reg [NCO_PHASE_W-1:0] nco_offset_reg = {NCO_PHASE_W{1'b0}};
-reg [5:0] residue_select_reg = 6'd0;
 reg cosine_reg = 1'b0;
-wire [5:0] residue_select_next = {rom_gyro_next && nco_index_next == 2'd2,
-    rom_gyro_next && nco_index_next == 2'd1, rom_gyro_next && nco_index_next == 2'd0,
-    !rom_gyro_next && nco_index_next == 2'd2, !rom_gyro_next && nco_index_next == 2'd1,
-    !rom_gyro_next && nco_index_next == 2'd0};
 wire [2:0] residue_address_next = {rom_gyro_next, nco_index_next};
 always @(posedge clk) begin
     nco_offset_reg <= nco_index_next == 2'd1
@@ -528,10 +522,9 @@ always @(posedge clk) begin
         ? (rom_gyro_next ? (rom_mode_next ? B_SENSE_OFFSET_N : B_SENSE_OFFSET_R)
                          : (rom_mode_next ? A_SENSE_OFFSET_N : A_SENSE_OFFSET_R))
         : {NCO_PHASE_W{1'b0}};
-    residue_select_reg <= residue_select_next;
     residue_address_reg <= residue_address_next;
     residue_q <= residue_ram[residue_address_next];
-    residue_read_valid_reg <= |(residue_select_next & residue_valid_reg);
+    residue_read_valid_reg <= residue_valid_reg[residue_address_next];
     cosine_reg <= rom_field_next == 3'd2 || rom_field_next == 3'd3 || rom_field_next == 3'd5;
 end
 wire cosine = cosine_reg;
@@ -1326,7 +1319,7 @@ always @(posedge clk) begin
         ref_negative_reg <= t[T_W-1];
         if (cosine && NCO_ERROR_FEEDBACK != 0) begin
             residue_ram[residue_address_reg] <= phase[R_W-1:0] ^ HALF_BIN;
-            residue_valid_reg <= residue_valid_reg | residue_select_reg;
+            residue_valid_reg[residue_address_reg] <= 1'b1;
         end
     end
     if (executing_reg && advance_field) begin
@@ -1407,7 +1400,7 @@ always @(posedge clk) begin
         decimation_mode_b_reg <= 1'b1;
         nco_acc_a_reg <= {NCO_PHASE_W{1'b0}};
         nco_acc_b_reg <= {NCO_PHASE_W{1'b0}};
-        residue_valid_reg <= 6'd0;
+        residue_valid_reg <= 8'd0;
         read_zero_reg <= 1'b0;
         read_preset_reg <= 1'b0;
         acc_reg <= {ACC_W{1'b0}};

@@ -45,14 +45,14 @@ pub fn design(system: &Block, mean_filter: &Block) -> Design {
     let mut sources: Vec<String> = Vec::new();
     let mut files: Vec<(String, String)> = Vec::new();
     for part in &parts {
-        for source in &part.sources {
-            let source = if source == design::CONFIGURED_FILE {
-                configured_file(part)
-            } else {
-                source.clone()
-            };
-            if !sources.contains(&source) {
-                sources.push(source);
+        // The RTL both read once; the configured wrappers after it (below).
+        for source in part
+            .sources
+            .iter()
+            .filter(|s| *s != design::CONFIGURED_FILE)
+        {
+            if !sources.contains(source) {
+                sources.push(source.clone());
             }
         }
         for (name, text) in &part.files {
@@ -72,8 +72,7 @@ pub fn design(system: &Block, mean_filter: &Block) -> Design {
             }
         }
     }
-    // The configured wrappers last among the sources, then the top.
-    sources.retain(|s| !s.ends_with("_configured.v"));
+    // The configured wrappers, then the top.
     sources.extend(parts.iter().map(configured_file));
     sources.push(TOP_FILE.into());
     let [system_part, mean_filter_part] = parts;
@@ -255,54 +254,69 @@ mod design_tests {
     use gyrofx_job::config::Config;
     use gyrofx_job::job::Job;
 
-    /// The whole system's folder holds both blocks' configured wrappers apart and a top that
-    /// drives the mean filter from the system's published rate; its top, read with every
-    /// source, passes Verilator's lint with every warning (what yosys then synthesizes). An
-    /// unconnected port or a missing source fails it.
+    /// The whole system's folder holds both blocks' configured wrappers apart, each source
+    /// once, and a top that drives the mean filter from the system's published rate, aligned
+    /// to the mean filter's input format when the KF's output has another; its top, read with
+    /// every source, passes Verilator's lint with every warning (what yosys then synthesizes).
+    /// An unconnected port, a width mismatch or a missing source fails it.
     #[test]
     fn the_whole_system_wires_the_mean_filter_to_the_published_rate_and_lints_clean() {
-        let job = Job::new(Config::embedded()).unwrap();
         let provenance = Provenance {
             version: "test".into(),
             command: "test".into(),
             config_sha256: "0".repeat(64),
         };
-        let roms = RomImages::new(&job, &provenance);
-        let work = tempfile::tempdir().unwrap();
-        let request = PlaceRequest {
-            targets: vec![],
-            blocks: vec![NAME],
-            jobs: 1,
-        };
-        let prepared =
-            Prepared::new(&job, &roms, &provenance, &request, vec![], work.path()).unwrap();
-        let design = &prepared.designs[0];
-        assert_eq!(design.top, TOP);
-        assert!(design.sources.ends_with(&[
-            "system_serial_configured.v".to_string(),
-            "mean_filter_serial_configured.v".to_string(),
-            TOP_FILE.to_string()
-        ]));
-        let top = &design.files.iter().find(|(n, _)| n == TOP_FILE).unwrap().1;
-        assert!(top.contains(".ce(out_valid),\n    .x(rate_out),"), "{top}");
-        assert!(harness(design).contains("gyrofx_whole_system_serial dut ("));
-        let dir = work.path().join(FOLDER).join(NAME);
-        let lint = std::process::Command::new("verilator")
-            .args([
-                "--lint-only",
-                "-Wall",
-                "-Wno-DECLFILENAME",
-                "--top-module",
-                TOP,
-            ])
-            .args(&design.sources)
-            .current_dir(&dir)
-            .output()
-            .expect("verilator runs (scripts/test.sh installs it)");
-        assert!(
-            lint.status.success(),
-            "{}",
-            String::from_utf8_lossy(&lint.stderr)
-        );
+        // The default (the rate is s24.14, the mean filter's input too), and a KF output two
+        // bits wider with two more fraction bits (the mean filter drops them).
+        for (overlay, x) in [
+            ("", "rate_out"),
+            ("[kf]\noutput_format = \"s26.16\"\n", "{rate_out[25:2]}"),
+        ] {
+            let job = Job::new(Config::from_toml(overlay, "test").unwrap()).unwrap();
+            let roms = RomImages::new(&job, &provenance);
+            let work = tempfile::tempdir().unwrap();
+            let request = PlaceRequest {
+                targets: vec![],
+                blocks: vec![NAME],
+                jobs: 1,
+            };
+            let prepared =
+                Prepared::new(&job, &roms, &provenance, &request, vec![], work.path()).unwrap();
+            let design = &prepared.designs[0];
+            assert_eq!(design.top, TOP);
+            assert!(design.sources.ends_with(&[
+                "system_serial_configured.v".to_string(),
+                "mean_filter_serial_configured.v".to_string(),
+                TOP_FILE.to_string()
+            ]));
+            let mut once = design.sources.clone();
+            once.sort();
+            once.dedup();
+            assert_eq!(once.len(), design.sources.len(), "{:?}", design.sources);
+            let top = &design.files.iter().find(|(n, _)| n == TOP_FILE).unwrap().1;
+            assert!(
+                top.contains(&format!(".ce(out_valid),\n    .x({x}),")),
+                "{overlay}: {top}"
+            );
+            assert!(harness(design).contains("gyrofx_whole_system_serial dut ("));
+            let dir = work.path().join(FOLDER).join(NAME);
+            let lint = std::process::Command::new("verilator")
+                .args([
+                    "--lint-only",
+                    "-Wall",
+                    "-Wno-DECLFILENAME",
+                    "--top-module",
+                    TOP,
+                ])
+                .args(&design.sources)
+                .current_dir(&dir)
+                .output()
+                .expect("verilator runs (scripts/test.sh installs it)");
+            assert!(
+                lint.status.success(),
+                "{overlay}: {}",
+                String::from_utf8_lossy(&lint.stderr)
+            );
+        }
     }
 }
