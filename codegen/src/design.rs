@@ -83,11 +83,7 @@ mod tests {
     /// system's own chain program under the serial engine's default names.
     #[test]
     fn the_design_carries_each_submodules_images_under_its_default_names() {
-        let provenance = Provenance {
-            version: "test".into(),
-            command: "test".into(),
-            config_sha256: "0".repeat(64),
-        };
+        let provenance = Provenance::placeholder();
         let file = |files: &[(String, String)], name: &str| -> String {
             files
                 .iter()

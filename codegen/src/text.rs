@@ -16,6 +16,16 @@ pub struct Provenance {
 }
 
 impl Provenance {
+    /// A provenance whose fields say nothing (version and command `test`, a config hash of
+    /// zeros): for text built where its generated-by line does not matter, as in tests.
+    pub fn placeholder() -> Self {
+        Self {
+            version: "test".into(),
+            command: "test".into(),
+            config_sha256: "0".repeat(64),
+        }
+    }
+
     /// The generated-by line, after `comment` (e.g. `//` or `#`).
     pub fn line(&self, comment: &str) -> String {
         format!(

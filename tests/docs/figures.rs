@@ -283,11 +283,7 @@ fn the_pipeline_clocks_the_guide_quotes_are_the_codes() {
     );
 
     // The table's clocks/sample column: each placed block's, per target, every placed block.
-    let provenance = Provenance {
-        version: "test".into(),
-        command: "test".into(),
-        config_sha256: "0".repeat(64),
-    };
+    let provenance = Provenance::placeholder();
     let roms = RomImages::new(&job, &provenance);
     let serial_roms = RomImages::new(&serial, &provenance);
     let page = std::fs::read_to_string(guide().join(place)).unwrap();

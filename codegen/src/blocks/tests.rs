@@ -16,11 +16,7 @@ fn run_embedded(edit: impl FnOnce(&mut Config)) -> (Job, Run) {
     config.samples = 4000;
     edit(&mut config);
     let job = Job::new(config).unwrap();
-    let provenance = Provenance {
-        version: "test".into(),
-        command: "test".into(),
-        config_sha256: "0".repeat(64),
-    };
+    let provenance = Provenance::placeholder();
     let progress = Progress::default();
     let roms = RomImages::new(&job, &provenance);
     let builders = vector_builders(&job, &roms, None).unwrap();
@@ -44,11 +40,7 @@ fn named<'a>(run: &'a Run, name: &str) -> &'a crate::block::Block {
 #[test]
 fn streamed_vector_files_equal_the_kept_rows() {
     let (job, kept) = run_embedded(|config| config.plant.model = "rate".into());
-    let provenance = Provenance {
-        version: "test".into(),
-        command: "test".into(),
-        config_sha256: "0".repeat(64),
-    };
+    let provenance = Provenance::placeholder();
     let roms = RomImages::new(&job, &provenance);
     for (csv, selected) in [(true, None), (false, Some(vec!["kf".to_string()]))] {
         let root = tempfile::tempdir().unwrap();
@@ -264,11 +256,7 @@ fn with_default_blocks(check: impl FnOnce(&[crate::block::Block], &crate::text::
     let mut config = gyrofx_job::config::Config::embedded();
     config.samples = 100;
     let job = Job::new(config).unwrap();
-    let provenance = crate::text::Provenance {
-        version: "test".into(),
-        command: "test".into(),
-        config_sha256: "0".repeat(64),
-    };
+    let provenance = crate::text::Provenance::placeholder();
     let roms = RomImages::new(&job, &provenance);
     let blocks: Vec<_> = super::of(&job).map(|b| b.block(&job, &roms)).collect();
     check(&blocks, &provenance);
