@@ -207,5 +207,7 @@ stubtest_folder="$(mktemp -d)"
 (cd "$stubtest_folder" && "$python_venv/bin/python" -m mypy.stubtest gyrofx)
 rm -rf "$stubtest_folder"
 # One pytest worker per core (pytest-xdist): each cocotb run is one single-threaded simulator.
+# The ten longest tests are listed at the end (pytest's --durations), as nextest's log times
+# each of its tests: where CI's minutes go.
 GYROFX_CLI="$PWD/target/debug/gyrofx" GYROFX_WHEEL="$(ls python/target/wheels/gyrofx-*.whl)" \
-    "$python_venv/bin/python" -m pytest -q -n auto python/tests
+    "$python_venv/bin/python" -m pytest -q -n auto --durations=10 python/tests
