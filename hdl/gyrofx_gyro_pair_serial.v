@@ -589,6 +589,10 @@ wire accumulate_mode_next = accumulate_gyro_next ? mode_b_reg : mode_a_reg;
 /* verilator lint_off UNUSEDSIGNAL */
 reg [8:0] x_select_reg = 9'd0;
 reg [11:0] y_select_reg = 12'd0;
+// The y selects again, for the adder's high half: one register driving all ACC_W bits of the
+// y operand's AND-OR was the UP5K's critical path (its fan-out routed ahead of the carry chain);
+// keep stops yosys merging the copy back.
+(* keep *) reg [11:0] y_select_high_reg = 12'd0;
 /* verilator lint_on UNUSEDSIGNAL */
 // A constant of two gyros and two modes: one select per (gyro, mode), A normal, A reverse,
 // B normal, B reverse.
@@ -616,17 +620,20 @@ endfunction
 // the mode drives x and a is 1, or senses it and a is 2.
 wire a_adc = a_field_next == 4'd1 || a_field_next == 4'd2;
 wire a_x = (a_field_next == 4'd1) == issue_mode_next;
+wire [11:0] y_select_next = {y_field == 4'd9 && accumulate_gyro_next,
+    y_field == 4'd8 && accumulate_gyro_next,
+    y_field == 4'd9 && !accumulate_gyro_next, y_field == 4'd8 && !accumulate_gyro_next,
+    y_field == 4'd7 && !zero_next,
+    y_field == 4'd6, y_field == 4'd5, y_field == 4'd4, y_field == 4'd3,
+    y_field == 4'd2 && !zero_next, y_field == 4'd1, 1'b0};
 always @(posedge clk) begin
     x_select_reg <= {1'b0, x_field == 4'd7 && !zero_next, x_field == 4'd6 || x_field == 4'd8,
         x_field == 4'd5 && !zero_next && !preset_next, 1'b0, x_field == 4'd3 && !zero_next,
         x_field == 4'd2 && !zero_next, 1'b0, x_field == 4'd0};
     setpoint_select_reg <= gyro_mode(x_setpoint, accumulate_gyro_next, accumulate_mode_next);
     preset_select_reg <= gyro_mode(x_preset, accumulate_gyro_next, accumulate_mode_next);
-    y_select_reg <= {y_field == 4'd9 && accumulate_gyro_next, y_field == 4'd8 && accumulate_gyro_next,
-        y_field == 4'd9 && !accumulate_gyro_next, y_field == 4'd8 && !accumulate_gyro_next,
-        y_field == 4'd7 && !zero_next,
-        y_field == 4'd6, y_field == 4'd5, y_field == 4'd4, y_field == 4'd3,
-        y_field == 4'd2 && !zero_next, y_field == 4'd1, 1'b0};
+    y_select_reg <= y_select_next;
+    y_select_high_reg <= y_select_next;
     y_carry_reg <= ((y_field == 4'd2 || y_field == 4'd7) && !zero_next) || y_field == 4'd4;
     a_select_reg <= {
         a_field_next == 4'd5 && issue_gyro_next, a_field_next == 4'd4 && issue_gyro_next,
@@ -874,7 +881,10 @@ wire signed [ACC_W-1:0] x_value =
     | ({ACC_W{x_select_reg[7]}} & shifted(rd_acc, AGC_READ_SHIFT));
 
 // y, a negated one inverted (x + ~y + 1: the carry in adds the 1).
-wire signed [ACC_W-1:0] y_value =
+// Each half of the adder takes its y from its own copy of the selects; each copy's other
+// half is left unused.
+/* verilator lint_off UNUSEDSIGNAL */
+wire signed [ACC_W-1:0] y_value_low =
       ({ACC_W{y_select_reg[1]}} & pp_reg)
     | ({ACC_W{y_select_reg[2]}} & ~rd_acc)
     | ({ACC_W{y_select_reg[3]}} & (p_acc <<< DEMOD_ALIGN))
@@ -886,6 +896,20 @@ wire signed [ACC_W-1:0] y_value =
     | ({ACC_W{y_select_reg[9]}} & error_a_acc)
     | ({ACC_W{y_select_reg[10]}} & drive_q_b_acc)
     | ({ACC_W{y_select_reg[11]}} & error_b_acc);
+wire signed [ACC_W-1:0] y_value_high =
+      ({ACC_W{y_select_high_reg[1]}} & pp_reg)
+    | ({ACC_W{y_select_high_reg[2]}} & ~rd_acc)
+    | ({ACC_W{y_select_high_reg[3]}} & (p_acc <<< DEMOD_ALIGN))
+    | ({ACC_W{y_select_high_reg[4]}} & ~output_acc)
+    | ({ACC_W{y_select_high_reg[5]}} & output_acc)
+    | ({ACC_W{y_select_high_reg[6]}} & previous_rd_acc)
+    | ({ACC_W{y_select_high_reg[7]}} & ~(rd_acc >>> LOCK_SHIFT))
+    | ({ACC_W{y_select_high_reg[8]}} & drive_q_a_acc)
+    | ({ACC_W{y_select_high_reg[9]}} & error_a_acc)
+    | ({ACC_W{y_select_high_reg[10]}} & drive_q_b_acc)
+    | ({ACC_W{y_select_high_reg[11]}} & error_b_acc);
+/* verilator lint_on UNUSEDSIGNAL */
+wire signed [ACC_W-1:0] y_value = {y_value_high[ACC_W-1:ACC_W/2], y_value_low[ACC_W/2-1:0]};
 wire signed [ACC_W-1:0] acc_next = x_value + y_value + {{(ACC_W-1){1'b0}}, y_carry_reg};
 
 // ---- quantization points, at the parallel loop's formats -----------------------------------
