@@ -22,7 +22,7 @@ fn root() -> &'static Path {
 /// clocking inputs when the block has them (every block but the combinational calibration).
 fn registry_ports() -> Vec<(&'static str, &'static str, Vec<Port>)> {
     let job = Job::new(Config::embedded()).unwrap();
-    let provenance = Provenance::placeholder();
+    let provenance = Provenance::for_tests();
     let roms = RomImages::new(&job, &provenance);
     REGISTRY
         .iter()
@@ -187,7 +187,7 @@ fn doc_pipeline(page: &str) -> Option<(u32, u32)> {
 #[test]
 fn every_clocked_blocks_page_states_its_pipeline() {
     let job = Job::new(Config::embedded()).unwrap();
-    let provenance = Provenance::placeholder();
+    let provenance = Provenance::for_tests();
     let roms = RomImages::new(&job, &provenance);
     for registered in REGISTRY {
         let block = registered.block(&job, &roms);
@@ -223,7 +223,7 @@ fn the_golden_models_ports_are_the_packages() {
         )
         .unwrap(),
     ];
-    let provenance = Provenance::placeholder();
+    let provenance = Provenance::for_tests();
     for config in configs {
         let job = Job::new(config).unwrap();
         let roms = RomImages::new(&job, &provenance);

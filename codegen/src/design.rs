@@ -83,7 +83,7 @@ mod tests {
     /// system's own chain program under the serial engine's default names.
     #[test]
     fn the_design_carries_each_submodules_images_under_its_default_names() {
-        let provenance = Provenance::placeholder();
+        let provenance = Provenance::for_tests();
         let file = |files: &[(String, String)], name: &str| -> String {
             files
                 .iter()

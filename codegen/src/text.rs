@@ -16,9 +16,9 @@ pub struct Provenance {
 }
 
 impl Provenance {
-    /// A provenance whose fields say nothing (version and command `test`, a config hash of
-    /// zeros): for text built where its generated-by line does not matter, as in tests.
-    pub fn placeholder() -> Self {
+    /// The provenance of text built in a test, where its generated-by line does not matter:
+    /// version and command `test`, a config hash of zeros.
+    pub fn for_tests() -> Self {
         Self {
             version: "test".into(),
             command: "test".into(),

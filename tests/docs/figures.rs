@@ -283,7 +283,7 @@ fn the_pipeline_clocks_the_guide_quotes_are_the_codes() {
     );
 
     // The table's clocks/sample column: each placed block's, per target, every placed block.
-    let provenance = Provenance::placeholder();
+    let provenance = Provenance::for_tests();
     let roms = RomImages::new(&job, &provenance);
     let serial_roms = RomImages::new(&serial, &provenance);
     let page = std::fs::read_to_string(guide().join(place)).unwrap();

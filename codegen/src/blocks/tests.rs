@@ -16,7 +16,7 @@ fn run_embedded(edit: impl FnOnce(&mut Config)) -> (Job, Run) {
     config.samples = 4000;
     edit(&mut config);
     let job = Job::new(config).unwrap();
-    let provenance = Provenance::placeholder();
+    let provenance = Provenance::for_tests();
     let progress = Progress::default();
     let roms = RomImages::new(&job, &provenance);
     let builders = vector_builders(&job, &roms, None).unwrap();
@@ -40,7 +40,7 @@ fn named<'a>(run: &'a Run, name: &str) -> &'a crate::block::Block {
 #[test]
 fn streamed_vector_files_equal_the_kept_rows() {
     let (job, kept) = run_embedded(|config| config.plant.model = "rate".into());
-    let provenance = Provenance::placeholder();
+    let provenance = Provenance::for_tests();
     let roms = RomImages::new(&job, &provenance);
     for (csv, selected) in [(true, None), (false, Some(vec!["kf".to_string()]))] {
         let root = tempfile::tempdir().unwrap();
@@ -256,7 +256,7 @@ fn with_default_blocks(check: impl FnOnce(&[crate::block::Block], &crate::text::
     let mut config = gyrofx_job::config::Config::embedded();
     config.samples = 100;
     let job = Job::new(config).unwrap();
-    let provenance = crate::text::Provenance::placeholder();
+    let provenance = crate::text::Provenance::for_tests();
     let roms = RomImages::new(&job, &provenance);
     let blocks: Vec<_> = super::of(&job).map(|b| b.block(&job, &roms)).collect();
     check(&blocks, &provenance);

@@ -261,7 +261,7 @@ mod design_tests {
     /// An unconnected port, a width mismatch or a missing source fails it.
     #[test]
     fn the_whole_system_wires_the_mean_filter_to_the_published_rate_and_lints_clean() {
-        let provenance = Provenance::placeholder();
+        let provenance = Provenance::for_tests();
         // The default (the rate is s24.14, the mean filter's input too), and a KF output two
         // bits wider with two more fraction bits (the mean filter drops them).
         for (overlay, x) in [
